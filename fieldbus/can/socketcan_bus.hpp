@@ -1,0 +1,93 @@
+#pragma once
+/// \file
+/// SocketCanBus: a Transport on a Linux raw CAN socket (PF_CAN/CAN_RAW).
+///
+/// - non-blocking socket; `send` and `receive` never block;
+/// - receive filters for the COB-IDs in use (CAN_RAW_FILTER);
+/// - error frames enabled (CAN_RAW_ERR_FILTER) and turned into BusEvents:
+///   warning, error passive, bus-off, restarted, other error classes;
+/// - a full transmit queue (ENOBUFS/EAGAIN) is counted and reported as an
+///   event, never fatal;
+/// - kernel receive timestamps kept (SO_TIMESTAMPNS) in TimedFrame::t_ns;
+/// - kernel drop counter (SO_RXQ_OVFL) reported as kRxOverflow.
+///
+/// `open` is not realtime-safe (it allocates and makes system calls);
+/// `send`, `receive`, `poll_events`, `state` and `counters` are.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+#include "fieldbus/can/transport.hpp"
+
+namespace canmotion::can {
+
+/// One receive filter: a frame passes when (id & mask) == (filter.id & mask).
+/// `extended` selects 29-bit ids. Mirrors struct can_filter.
+struct Filter {
+  std::uint32_t id = 0;
+  std::uint32_t mask = 0x7FF;
+  bool extended = false;
+};
+
+class SocketCanBus final : public Transport {
+ public:
+  /// Largest number of filters accepted by open() (the kernel allows more;
+  /// 2 per node for 127 nodes plus NMT/SYNC/EMCY covers any CANopen bus).
+  static constexpr std::size_t kMaxFilters = 512;
+  /// Pending bus events kept between poll_events() calls; older ones are
+  /// dropped (and counted in rx_dropped) when the ring is full.
+  static constexpr std::size_t kEventCapacity = 64;
+
+  /// Open `ifname` (e.g. "vcan0", "can0"). With an empty `filters` span all
+  /// frames are received. On failure returns nullptr and sets `ec`; `detail`
+  /// (if given) receives a sentence naming the interface and the failing call.
+  static std::unique_ptr<SocketCanBus> open(std::string_view ifname, std::span<const Filter> filters,
+                                            std::error_code& ec, std::string* detail = nullptr);
+
+  /// Whether this kernel supports PF_CAN at all (false on kernels built
+  /// without CAN: socket() fails with EAFNOSUPPORT).
+  static bool kernel_has_can() noexcept;
+
+  ~SocketCanBus() override;
+  SocketCanBus(const SocketCanBus&) = delete;
+  SocketCanBus& operator=(const SocketCanBus&) = delete;
+
+  SendResult send(const Frame& frame) noexcept override;
+  std::size_t receive(std::span<TimedFrame> out) noexcept override;
+  std::size_t poll_events(std::span<BusEvent> out) noexcept override;
+  [[nodiscard]] BusState state() const noexcept override { return state_; }
+  [[nodiscard]] BusCounters counters() const noexcept override { return counters_; }
+  [[nodiscard]] std::string_view name() const noexcept override { return name_; }
+
+  /// The socket, for poll()/epoll in non-RT tools that want to block.
+  [[nodiscard]] int fd() const noexcept { return fd_; }
+  /// errno of the last failed send (0 if none). Realtime-safe.
+  [[nodiscard]] int last_errno() const noexcept { return last_errno_; }
+
+  /// Turn one error frame (id with CAN_ERR_FLAG stripped, payload) into
+  /// events, updating the bus state. Exposed for golden tests. Realtime-safe.
+  void handle_error_frame(std::uint32_t err_class, std::span<const std::uint8_t> data,
+                          std::int64_t t_ns) noexcept;
+
+ private:
+  SocketCanBus(int fd, std::string name) noexcept;
+  void push_event(const BusEvent& ev) noexcept;
+  void set_state(BusState s, std::int64_t t_ns) noexcept;
+
+  int fd_ = -1;
+  std::string name_;
+  BusState state_ = BusState::kErrorActive;
+  BusCounters counters_{};
+  int last_errno_ = 0;
+  std::uint32_t last_kernel_drops_ = 0;
+  std::array<BusEvent, kEventCapacity> events_{};
+  std::size_t ev_head_ = 0;  // next to read
+  std::size_t ev_count_ = 0;
+};
+
+}  // namespace canmotion::can
