@@ -1,0 +1,106 @@
+#pragma once
+/// \file
+/// NMT command specifiers and NMT states (CiA 301 §7.2.8), with frame builders.
+/// Everything here is constexpr and realtime-safe.
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "fieldbus/can/frame.hpp"
+#include "fieldbus/canopen/cob_id.hpp"
+
+namespace canmotion::canopen {
+
+/// NMT command specifier, byte 0 of an NMT frame (ID 0x000, DLC 2: [cs, node]).
+enum class NmtCommand : std::uint8_t {
+  kStart = 0x01,                ///< start remote node -> Operational
+  kStop = 0x02,                 ///< stop remote node -> Stopped
+  kEnterPreOperational = 0x80,  ///< -> Pre-operational
+  kResetNode = 0x81,            ///< reset application + communication
+  kResetCommunication = 0x82,   ///< reset communication
+};
+
+/// NMT state as sent in byte 0 of a heartbeat (ID 0x700 + node, DLC 1).
+enum class NmtState : std::uint8_t {
+  kBootUp = 0x00,
+  kStopped = 0x04,
+  kOperational = 0x05,
+  kPreOperational = 0x7F,
+  kUnknown = 0xFF,  ///< not a spec value: nothing heard yet / not a valid state byte
+};
+
+[[nodiscard]] constexpr std::string_view nmt_command_name(NmtCommand c) noexcept {
+  switch (c) {
+    case NmtCommand::kStart: return "start";
+    case NmtCommand::kStop: return "stop";
+    case NmtCommand::kEnterPreOperational: return "enter pre-operational";
+    case NmtCommand::kResetNode: return "reset node";
+    case NmtCommand::kResetCommunication: return "reset communication";
+  }
+  return "unknown";
+}
+
+/// Name of an NMT command byte, "unknown" if it is not a command specifier.
+[[nodiscard]] constexpr std::string_view nmt_command_name(std::uint8_t cs) noexcept {
+  switch (cs) {
+    case 0x01: case 0x02: case 0x80: case 0x81: case 0x82:
+      return nmt_command_name(static_cast<NmtCommand>(cs));
+    default: return "unknown";
+  }
+}
+
+[[nodiscard]] constexpr std::string_view nmt_state_name(NmtState s) noexcept {
+  switch (s) {
+    case NmtState::kBootUp: return "boot-up";
+    case NmtState::kStopped: return "stopped";
+    case NmtState::kOperational: return "operational";
+    case NmtState::kPreOperational: return "pre-operational";
+    case NmtState::kUnknown: break;
+  }
+  return "unknown";
+}
+
+/// Decode a heartbeat state byte (bit 7, the node-guarding toggle, is ignored).
+[[nodiscard]] constexpr NmtState nmt_state_from_byte(std::uint8_t b) noexcept {
+  switch (b & 0x7Fu) {
+    case 0x00: return NmtState::kBootUp;
+    case 0x04: return NmtState::kStopped;
+    case 0x05: return NmtState::kOperational;
+    case 0x7F: return NmtState::kPreOperational;
+    default: return NmtState::kUnknown;
+  }
+}
+
+/// NMT command frame: ID 0x000, [cs, node] (node 0 = all nodes).
+[[nodiscard]] constexpr can::Frame make_nmt_frame(NmtCommand cs, std::uint8_t node) noexcept {
+  can::Frame f;
+  f.id = cob::kNmt;
+  f.len = 2;
+  f.data[0] = static_cast<std::uint8_t>(cs);
+  f.data[1] = node;
+  return f;
+}
+
+/// Heartbeat / boot-up frame: ID 0x700 + node, [state].
+[[nodiscard]] constexpr can::Frame make_heartbeat_frame(std::uint8_t node, NmtState s) noexcept {
+  can::Frame f;
+  f.id = cob::heartbeat(node);
+  f.len = 1;
+  f.data[0] = static_cast<std::uint8_t>(s);
+  return f;
+}
+
+/// A decoded NMT command frame.
+struct NmtFrame {
+  std::uint8_t command = 0;  ///< raw command specifier (see NmtCommand)
+  std::uint8_t node = 0;     ///< 0 = all nodes
+};
+
+/// Decode an NMT command frame (ID 0x000, DLC 2); nullopt if it is not one.
+[[nodiscard]] constexpr std::optional<NmtFrame> decode_nmt(const can::Frame& f) noexcept {
+  if (f.id != cob::kNmt || f.extended() || f.remote() || f.len != 2) return std::nullopt;
+  return NmtFrame{f.data[0], f.data[1]};
+}
+
+}  // namespace canmotion::canopen
