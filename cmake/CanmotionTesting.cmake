@@ -25,16 +25,21 @@ function(canmotion_gtest name)
     PROPERTIES LABELS ${ARG_LABEL} TIMEOUT ${ARG_TIMEOUT})
 endfunction()
 
-# canmotion_vcan_test(NAME COMMAND cmd args... [IFACES n] [TIMEOUT s])
+# canmotion_vcan_test(NAME COMMAND cmd args... [CHECK cmd args...] [IFACES n] [TIMEOUT s])
 # Runs COMMAND on real SocketCAN with vcan0..vcan<n-1> up, through
 # tests/vcan/run-vcan-test (VM when the host has no vcan). A candump -L trace of
 # every vcan interface is kept in ${CMAKE_BINARY_DIR}/vcan-artifacts/NAME/.
-# The command sees CANMOTION_ARTIFACTS (that folder) and CANMOTION_BUILD_DIR.
+# COMMAND and CHECK see CANMOTION_TRACE (the candump -L log; complete when
+# CHECK runs), CANMOTION_ARTIFACTS (that folder), CANMOTION_BUILD_DIR and
+# CANMOTION_IFACES. CHECK runs after COMMAND succeeded and candump stopped.
 function(canmotion_vcan_test name)
   if(CANMOTION_FUZZ)
     return()  # a fuzz build (clang, instrumented) builds only fuzz targets
   endif()
-  cmake_parse_arguments(ARG "" "IFACES;TIMEOUT" "COMMAND" ${ARGN})
+  cmake_parse_arguments(ARG "" "IFACES;TIMEOUT" "COMMAND;CHECK" ${ARGN})
+  if(ARG_CHECK)
+    set(check_args ::check:: ${ARG_CHECK})
+  endif()
   if(NOT ARG_IFACES)
     set(ARG_IFACES 1)
   endif()
@@ -46,7 +51,7 @@ function(canmotion_vcan_test name)
             --name ${name} --ifaces ${ARG_IFACES}
             --artifacts ${CMAKE_BINARY_DIR}/vcan-artifacts/${name}
             --build-dir ${CMAKE_BINARY_DIR}
-            -- ${ARG_COMMAND}
+            -- ${ARG_COMMAND} ${check_args}
     WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
   set_tests_properties(${name} PROPERTIES LABELS vcan TIMEOUT ${ARG_TIMEOUT})
 endfunction()

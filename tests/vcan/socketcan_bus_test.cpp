@@ -1,0 +1,90 @@
+// Unit tests of SocketCanBus that need no CAN kernel support: error-frame
+// decoding into bus events, and explanatory open() failures.
+#include <gtest/gtest.h>
+#include <linux/can/error.h>
+
+#include <array>
+
+#include "fieldbus/can/socketcan_bus.hpp"
+
+namespace canmotion::can {
+namespace {
+
+TEST(SocketCanBusOpen, FailureNamesTheInterfaceAndCall) {
+  std::error_code ec;
+  std::string why;
+  auto bus = SocketCanBus::open("nosuchcan7", {}, ec, &why);
+  ASSERT_EQ(bus, nullptr);
+  EXPECT_TRUE(ec);
+  EXPECT_NE(why.find("nosuchcan7"), std::string::npos) << why;
+  if (SocketCanBus::kernel_has_can()) {
+    EXPECT_EQ(ec.value(), ENODEV) << why;
+    EXPECT_NE(why.find("ip link add"), std::string::npos) << why;
+  } else {
+    EXPECT_EQ(ec.value(), EAFNOSUPPORT) << why;
+    EXPECT_NE(why.find("vcan-vm"), std::string::npos) << why;
+  }
+}
+
+TEST(SocketCanBusOpen, RejectsOverlongName) {
+  std::error_code ec;
+  EXPECT_EQ(SocketCanBus::open("a-name-longer-than-ifnamsiz", {}, ec), nullptr);
+  EXPECT_EQ(ec.value(), EINVAL);
+}
+
+}  // namespace
+
+// Error frames need a bus object; the kernel-free path builds one from a
+// socketpair-like dummy by opening a real socket only when CAN exists, so the
+// decoder is tested through a subclass-free friend-less route: a bus opened
+// on vcan in the VM covers the socket; here we exercise handle_error_frame on
+// a bus obtained when possible, and skip otherwise.
+class ErrorFrames : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::error_code ec;
+    bus_ = SocketCanBus::open("vcan0", {}, ec);
+    if (!bus_) GTEST_SKIP() << "no vcan0 here (" << ec.message() << "); covered in the vcan test run";
+  }
+  std::vector<BusEvent> drain() {
+    std::array<BusEvent, 16> ev{};
+    const std::size_t n = bus_->poll_events(ev);
+    return {ev.begin(), ev.begin() + static_cast<std::ptrdiff_t>(n)};
+  }
+  std::unique_ptr<SocketCanBus> bus_;
+};
+
+TEST_F(ErrorFrames, WarningPassiveBusOffRestarted) {
+  const std::array<std::uint8_t, 8> warn{0, CAN_ERR_CRTL_TX_WARNING, 0, 0, 0, 0, 96, 0};
+  bus_->handle_error_frame(CAN_ERR_CRTL, warn, 1);
+  EXPECT_EQ(bus_->state(), BusState::kErrorWarning);
+  const std::array<std::uint8_t, 8> passive{0, CAN_ERR_CRTL_RX_PASSIVE, 0, 0, 0, 0, 0, 128};
+  bus_->handle_error_frame(CAN_ERR_CRTL, passive, 2);
+  EXPECT_EQ(bus_->state(), BusState::kErrorPassive);
+  bus_->handle_error_frame(CAN_ERR_BUSOFF, {}, 3);
+  EXPECT_EQ(bus_->state(), BusState::kBusOff);
+  EXPECT_EQ(bus_->send(Frame{0x123, {1}}), SendResult::kBusOff);
+  bus_->handle_error_frame(CAN_ERR_RESTARTED, {}, 4);
+  EXPECT_EQ(bus_->state(), BusState::kErrorActive);
+  auto ev = drain();
+  ASSERT_EQ(ev.size(), 5u);
+  EXPECT_EQ(ev[0].state, BusState::kErrorWarning);
+  EXPECT_EQ(ev[1].state, BusState::kErrorPassive);
+  EXPECT_EQ(ev[2].state, BusState::kBusOff);
+  EXPECT_EQ(ev[3].kind, BusEvent::Kind::kRestarted);
+  EXPECT_EQ(ev[4].state, BusState::kErrorActive);
+}
+
+TEST_F(ErrorFrames, OtherClassesAndRingOverflow) {
+  bus_->handle_error_frame(CAN_ERR_ACK | CAN_ERR_PROT, {}, 1);
+  auto ev = drain();
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, BusEvent::Kind::kErrorFrame);
+  EXPECT_EQ(ev[0].detail, static_cast<std::uint32_t>(CAN_ERR_ACK | CAN_ERR_PROT));
+  for (int i = 0; i < 100; ++i) bus_->handle_error_frame(CAN_ERR_LOSTARB, {}, i);
+  std::array<BusEvent, 128> all{};
+  EXPECT_EQ(bus_->poll_events(all), SocketCanBus::kEventCapacity);
+  EXPECT_EQ(all[0].t_ns, 100 - static_cast<std::int64_t>(SocketCanBus::kEventCapacity));  // oldest dropped
+}
+
+}  // namespace canmotion::can
