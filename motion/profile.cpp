@@ -1,0 +1,290 @@
+#include "motion/profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace canmotion::motion {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+inline double sgn(double x) noexcept { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
+
+/// Integrates the state without storing segments (distance evaluation).
+struct Sim {
+  double t = 0, x = 0, v = 0, a = 0;
+  bool ok = true;
+  void push(double dt, double j) noexcept {
+    if (!(dt > 0)) return;
+    x += v * dt + a * dt * dt / 2 + j * dt * dt * dt / 6;
+    v += a * dt + j * dt * dt / 2;
+    a += j * dt;
+    t += dt;
+  }
+};
+
+}  // namespace
+
+/// Appends segments to a Profile while integrating the state.
+class ProfileBuilder {
+ public:
+  ProfileBuilder(Profile& p, const Kin& s) noexcept : prof_(p) {
+    prof_.n_ = 0;
+    prof_.origin_ = s.p;
+    v = s.v;
+    a = s.a;
+  }
+  double t = 0, x = 0, v = 0, a = 0;
+  bool ok = true;
+
+  void push(double dt, double j) noexcept {
+    if (!(dt > 0)) return;
+    if (prof_.n_ >= Profile::kMaxSegments) { ok = false; return; }
+    prof_.seg_[static_cast<std::size_t>(prof_.n_++)] = Segment{t, x, v, a, j};
+    x += v * dt + a * dt * dt / 2 + j * dt * dt * dt / 6;
+    v += a * dt + j * dt * dt / 2;
+    a += j * dt;
+    t += dt;
+  }
+  Sim sim() const noexcept { return Sim{t, x, v, a, true}; }
+  void finish(double end_x) noexcept {
+    prof_.duration_ = t;
+    prof_.end_x_ = end_x;
+  }
+  void finish_hold() noexcept {  // infinite cruise at the current velocity
+    if (prof_.n_ < Profile::kMaxSegments) {
+      prof_.seg_[static_cast<std::size_t>(prof_.n_++)] = Segment{t, x, v, 0.0, 0.0};
+    } else {
+      ok = false;
+    }
+    prof_.duration_ = kInf;
+    prof_.end_x_ = x;
+  }
+
+ private:
+  Profile& prof_;
+};
+
+namespace {
+
+/// Velocity change to vt, ending with a = 0, with peak |accel| A and jerk J
+/// (J = inf: trapezoidal, the acceleration steps). Closed form.
+template <class B>
+void vel_change(B& b, double vt, double A, double J) noexcept {
+  if (std::isinf(J)) {
+    const double dv = vt - b.v;
+    if (dv != 0) {
+      b.a = sgn(dv) * A;
+      b.push(std::fabs(dv) / A, 0.0);
+    }
+    b.a = 0;
+    b.v = vt;
+    return;
+  }
+  const double a = b.a;
+  const double vs = b.v + a * std::fabs(a) / (2 * J);
+  const double diff = vt - vs;
+  if (diff == 0) {
+    if (a != 0) b.push(std::fabs(a) / J, -sgn(a) * J);
+  } else {
+    const double s = sgn(diff);
+    const double a0 = s * a;
+    const double dv = s * (vt - b.v);
+    const double ap_tri = std::sqrt(std::max(0.0, J * dv + a0 * a0 / 2));
+    if (ap_tri <= A) {
+      b.push((ap_tri - a0) / J, s * J);
+      b.push(ap_tri / J, -s * J);
+    } else {
+      const double t1 = std::fabs(A - a0) / J;
+      const double dv1 = (A + a0) / 2 * t1;
+      const double dv3 = A * A / (2 * J);
+      const double t2 = std::max(0.0, (dv - dv1 - dv3) / A);
+      b.push(t1, A >= a0 ? s * J : -s * J);
+      b.push(t2, 0.0);
+      b.push(A / J, -s * J);
+    }
+  }
+  b.a = 0;
+  b.v = vt;
+}
+
+inline double ramp_vel(double v, double a, double J) noexcept {
+  return std::isinf(J) ? v : v + a * std::fabs(a) / (2 * J);
+}
+
+/// Velocity change choosing the limits: (a, ja) while the speed in direction
+/// `sg` grows, (d, jd) while it shrinks.
+template <class B>
+void vel_change_lim(B& b, double vt, const Limits& lim, double sg) noexcept {
+  if (sg * (vt - ramp_vel(b.v, b.a, lim.ja)) >= 0) return vel_change(b, vt, lim.a, lim.ja);
+  if (sg * (vt - ramp_vel(b.v, b.a, lim.jd)) <= 0) return vel_change(b, vt, lim.d, lim.jd);
+  // Between the two ramp-down velocities (a != 0 and ja != jd): use the lower jerk.
+  const double J = std::min(lim.ja, lim.jd);
+  const double A = sg * (vt - ramp_vel(b.v, b.a, J)) >= 0 ? lim.a : lim.d;
+  vel_change(b, vt, A, J);
+}
+
+bool limits_valid(const Limits& l) noexcept {
+  return l.v > 0 && l.a > 0 && l.d > 0 && l.ja > 0 && l.jd > 0 && std::isfinite(l.v) &&
+         std::isfinite(l.a) && std::isfinite(l.d) && !std::isnan(l.ja) && !std::isnan(l.jd);
+}
+
+bool kin_valid(const Kin& k) noexcept {
+  return std::isfinite(k.p) && std::isfinite(k.v) && std::isfinite(k.a);
+}
+
+}  // namespace
+
+Kin Profile::sample(double t, int& hint) const noexcept {
+  if (n_ == 0 || (t >= duration_ && finite())) return Kin{origin_ + end_x_, 0.0, 0.0};
+  if (hint < 0 || hint >= n_ || t < seg_[static_cast<std::size_t>(hint)].t0) hint = 0;
+  while (hint + 1 < n_ && t >= seg_[static_cast<std::size_t>(hint + 1)].t0) ++hint;
+  const Segment& s = seg_[static_cast<std::size_t>(hint)];
+  const double dt = std::max(0.0, t - s.t0);
+  Kin k;
+  k.p = origin_ + s.p + s.v * dt + s.a * dt * dt / 2 + s.j * dt * dt * dt / 6;
+  k.v = s.v + s.a * dt + s.j * dt * dt / 2;
+  k.a = s.a + s.j * dt;
+  return k;
+}
+
+double Profile::peak_velocity() const noexcept {
+  double m = 0;
+  for (int i = 0; i < n_; ++i) {
+    const Segment& s = seg_[static_cast<std::size_t>(i)];
+    const double t1 = (i + 1 < n_) ? seg_[static_cast<std::size_t>(i + 1)].t0 - s.t0 : 0.0;
+    m = std::max(m, std::fabs(s.v));
+    m = std::max(m, std::fabs(s.v + s.a * t1 + s.j * t1 * t1 / 2));
+    if (s.j != 0) {
+      const double tm = -s.a / s.j;  // extremum of v inside the segment
+      if (tm > 0 && tm < t1) m = std::max(m, std::fabs(s.v + s.a * tm + s.j * tm * tm / 2));
+    }
+  }
+  return m;
+}
+
+double jerk_from_percent_of_time(double rate, double speed, double percent) noexcept {
+  if (!(percent > 0) || !(speed > 0)) return kInf;
+  return rate * rate / speed * (200.0 / percent - 1.0);
+}
+
+bool plan_stop(Profile& out, const Kin& start, double d, double jd) noexcept {
+  if (!(d > 0) || !(jd > 0) || !kin_valid(start)) return false;
+  ProfileBuilder b(out, start);
+  const double sg = b.v != 0 ? sgn(b.v) : -sgn(b.a);
+  Limits lim{1.0, d, d, jd, jd};
+  if (sg == 0) {
+    b.finish(0.0);
+    return true;
+  }
+  vel_change_lim(b, 0.0, lim, sg);
+  b.finish(b.x);
+  return b.ok;
+}
+
+bool plan_velocity(Profile& out, const Kin& start, double velocity, const Limits& lim) noexcept {
+  if (!limits_valid(lim) || !kin_valid(start) || !std::isfinite(velocity)) return false;
+  ProfileBuilder b(out, start);
+  const double cur = b.v != 0 ? sgn(b.v) : sgn(b.a);
+  if (cur != 0 && sgn(velocity) == -cur) {
+    vel_change_lim(b, 0.0, lim, cur);  // stop first, then reverse
+  }
+  const double sg = velocity != 0 ? sgn(velocity) : (b.v != 0 ? sgn(b.v) : sgn(b.a));
+  if (sg != 0) vel_change_lim(b, velocity, lim, sg);
+  b.finish_hold();
+  return b.ok;
+}
+
+bool plan_move(Profile& out, const Kin& start, double distance, const Limits& lim, Overshoot policy) noexcept {
+  if (!limits_valid(lim) || !kin_valid(start) || !std::isfinite(distance)) return false;
+  ProfileBuilder b(out, start);
+  const double X = distance;
+  for (int pass = 0; pass < 3; ++pass) {
+    const double R = X - b.x;
+    double sg = sgn(R);
+    if (sg == 0) sg = b.v != 0 ? sgn(b.v) : sgn(b.a);
+    if (sg == 0) break;  // on target, at rest
+    const double vrel = sg * b.v;
+    const double arel = sg * b.a;
+    if (vrel < 0 || (vrel == 0 && arel < 0)) {  // moving away: brake, then re-plan
+      vel_change_lim(b, 0.0, lim, -sg);
+      continue;
+    }
+    const double Rabs = std::fabs(R);
+    auto stop_dist = [&](const Limits& l) noexcept {
+      Sim s = b.sim();
+      vel_change_lim(s, 0.0, l, sg);
+      return sg * (s.x - b.x);
+    };
+    const double dstop = stop_dist(lim);
+    if (dstop > Rabs) {
+      if (policy == Overshoot::Reverse) {
+        vel_change_lim(b, 0.0, lim, sg);
+        continue;
+      }
+      // Stop exactly on target: scale decel (and jerk) up by k >= 1.
+      double lo = 0.0, hi = std::log(1e9);  // log k
+      for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
+        const double mid = (lo + hi) / 2;
+        const double k = std::exp(mid);
+        Limits l = lim;
+        l.a *= k; l.d *= k; l.ja *= k; l.jd *= k;
+        if (stop_dist(l) > Rabs) lo = mid; else hi = mid;
+      }
+      const double k = std::exp(hi);
+      Limits l = lim;
+      l.a *= k; l.d *= k; l.ja *= k; l.jd *= k;
+      vel_change_lim(b, 0.0, l, sg);
+      break;
+    }
+    auto f = [&](double vp) noexcept {
+      Sim s = b.sim();
+      vel_change_lim(s, sg * vp, lim, sg);
+      vel_change_lim(s, 0.0, lim, sg);
+      return sg * (s.x - b.x);
+    };
+    auto build = [&](double vp, double fvp) noexcept {
+      vel_change_lim(b, sg * vp, lim, sg);
+      const double cruise = Rabs - fvp;
+      if (vp > 0 && cruise > 0) b.push(cruise / vp, 0.0);
+      vel_change_lim(b, 0.0, lim, sg);
+    };
+    const double V = lim.v;
+    const double vs_up = ramp_vel(vrel, arel, lim.ja);
+    const double fV = f(V);
+    if (fV <= Rabs) {
+      build(V, fV);
+      break;
+    }
+    if (vs_up <= V) {
+      const double vlo = std::max(vs_up, 0.0);
+      const double flo = f(vlo);
+      if (flo <= Rabs) {
+        double lo = vlo, hi = V, flo_v = flo;
+        for (int i = 0; i < kSolveIterations && hi - lo > 1e-13 * hi; ++i) {
+          const double mid = (lo + hi) / 2;
+          const double fm = f(mid);
+          if (fm <= Rabs) { lo = mid; flo_v = fm; } else { hi = mid; }
+        }
+        build(lo, flo_v);
+        break;
+      }
+    }
+    // dstop <= R < f(...): stop now with a softer deceleration d' in (0, d].
+    double lo = std::log(1e-12), hi = 0.0;  // log(d'/d); stop distance decreases with d'
+    for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
+      const double mid = (lo + hi) / 2;
+      Limits l = lim;
+      l.d = lim.d * std::exp(mid);
+      if (stop_dist(l) > Rabs) lo = mid; else hi = mid;
+    }
+    Limits l = lim;
+    l.d = lim.d * std::exp(hi);
+    vel_change_lim(b, 0.0, l, sg);
+    break;
+  }
+  b.finish(X);
+  return b.ok;
+}
+
+}  // namespace canmotion::motion

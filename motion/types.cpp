@@ -1,0 +1,61 @@
+#include "motion/types.hpp"
+
+namespace canmotion::motion {
+
+std::string_view err_name(Err e) noexcept {
+  switch (e) {
+    case Err::None: return "No Error";
+    case Err::ExecutionCollision: return "Execution Collision";
+    case Err::ServoOnState: return "Servo On State Error";
+    case Err::ServoOffState: return "Servo Off State Error";
+    case Err::DriveOnState: return "Drive On State Error";
+    case Err::ShutdownState: return "Shutdown State Error";
+    case Err::WrongAxisType: return "Wrong Axis Type";
+    case Err::OvertravelCondition: return "Overtravel Condition";
+    case Err::MasterAxisConflict: return "Master Axis Conflict";
+    case Err::AxisNotConfigured: return "Axis Not Configured";
+    case Err::ServoMessageFailure: return "Servo Message Failure";
+    case Err::ParameterOutOfRange: return "Parameter Out Of Range";
+    case Err::TuneProcess: return "Tune Process Error";
+    case Err::TestProcess: return "Test Process Error";
+    case Err::HomeInProcess: return "Home In Process Error";
+    case Err::AxisModeNotRotary: return "Axis Mode Not Rotary";
+    case Err::AxisTypeUnused: return "Axis Type Unused";
+    case Err::GroupNotSynchronized: return "Group Not Synchronized";
+    case Err::AxisInFaultedState: return "Axis In Faulted State";
+    case Err::GroupInFaultedState: return "Group In Faulted State";
+    case Err::AxisInMotion: return "Axis In Motion";
+    case Err::IllegalDynamicChange: return "Illegal Dynamic Change";
+    case Err::IllegalControllerMode: return "Illegal Controller Mode";
+    case Err::IllegalInstruction: return "Illegal Instruction";
+    case Err::IllegalCamLength: return "Illegal Cam Length";
+    case Err::IllegalCamProfileLength: return "Illegal Cam Profile Length";
+    case Err::IllegalCamType: return "Illegal Cam Type";
+    case Err::IllegalCamOrder: return "Illegal Cam Order";
+    case Err::CamProfileBeingCalculated: return "Cam Profile Being Calculated";
+    case Err::CamProfileBeingUsed: return "Cam Profile Being Used";
+    case Err::CamProfileNotCalculated: return "Cam Profile Not Calculated";
+    case Err::PositionCamNotEnabled: return "Position Cam Not Enabled";
+    case Err::ProcessConflict: return "Process Conflict";
+    case Err::DriveLocallyDisabled: return "Drive Locally Disabled";
+    case Err::IllegalHomingConfig: return "Illegal Homing Config";
+    case Err::AxisIsInhibited: return "Axis Is Inhibited";
+    case Err::ZeroMaxDecel: return "Zero Max Decel";
+    case Err::InstructionNotSupported: return "Instruction Not Supported";
+    case Err::ZeroMaxDecelJerk: return "Zero Max Decel Jerk";
+    case Err::NotAllowedWhileStopping: return "Not Allowed While Stopping";
+    case Err::CipAxisInIncorrectState: return "CIP Axis In Incorrect State";
+    case Err::RedefinePositionInProcess: return "Redefine Position In Process";
+    case Err::NotAllowedWhileInDirectMotion: return "Not Allowed While In Direct Motion";
+    case Err::NotAllowedWhilePlannerActive: return "Not Allowed While Planner Active";
+    case Err::MdscNotActivated: return "MDSC Not Activated";
+    case Err::MdscUnitsConflict: return "MDSC Units Conflict";
+    case Err::MdscLockDirConflict: return "MDSC Lock Direction Conflict";
+    case Err::MdscMdacAllConflict: return "MDSC MDAC All Conflict";
+    case Err::FeatureNotSupported: return "Feature Not Supported";
+    case Err::AxisNotAtRest: return "Axis Not At Rest";
+  }
+  return "Unknown Error";
+}
+
+}  // namespace canmotion::motion
