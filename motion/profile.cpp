@@ -40,7 +40,7 @@ class ProfileBuilder {
   void push(double dt, double j) noexcept {
     if (!(dt > 0)) return;
     if (prof_.n_ >= Profile::kMaxSegments) { ok = false; return; }
-    prof_.seg_[static_cast<std::size_t>(prof_.n_++)] = Segment{t, x, v, a, j};
+    prof_.seg_[static_cast<std::size_t>(prof_.n_++)] = Segment{t, dt, x, v, a, j};
     x += v * dt + a * dt * dt / 2 + j * dt * dt * dt / 6;
     v += a * dt + j * dt * dt / 2;
     a += j * dt;
@@ -53,7 +53,7 @@ class ProfileBuilder {
   }
   void finish_hold() noexcept {  // infinite cruise at the current velocity
     if (prof_.n_ < Profile::kMaxSegments) {
-      prof_.seg_[static_cast<std::size_t>(prof_.n_++)] = Segment{t, x, v, 0.0, 0.0};
+      prof_.seg_[static_cast<std::size_t>(prof_.n_++)] = Segment{t, kInf, x, v, 0.0, 0.0};
     } else {
       ok = false;
     }
@@ -112,16 +112,27 @@ inline double ramp_vel(double v, double a, double J) noexcept {
   return std::isinf(J) ? v : v + a * std::fabs(a) / (2 * J);
 }
 
-/// Velocity change choosing the limits: (a, ja) while the speed in direction
-/// `sg` grows, (d, jd) while it shrinks.
+/// Velocity change choosing the limits: (a, ja) while the speed in the
+/// direction of motion `sg` grows, (d, jd) while it shrinks. When the present
+/// acceleration opposes the change, it is first ramped to zero with the jerk
+/// of the phase it belongs to (ja if it speeds up the motion, jd if it brakes).
 template <class B>
 void vel_change_lim(B& b, double vt, const Limits& lim, double sg) noexcept {
-  if (sg * (vt - ramp_vel(b.v, b.a, lim.ja)) >= 0) return vel_change(b, vt, lim.a, lim.ja);
-  if (sg * (vt - ramp_vel(b.v, b.a, lim.jd)) <= 0) return vel_change(b, vt, lim.d, lim.jd);
-  // Between the two ramp-down velocities (a != 0 and ja != jd): use the lower jerk.
-  const double J = std::min(lim.ja, lim.jd);
-  const double A = sg * (vt - ramp_vel(b.v, b.a, J)) >= 0 ? lim.a : lim.d;
-  vel_change(b, vt, A, J);
+  const double jc = sg * b.a >= 0 ? lim.ja : lim.jd;
+  const double vs = ramp_vel(b.v, b.a, jc);
+  const double s = sgn(vt - vs);
+  if (b.a != 0 && sgn(b.a) != s) {
+    if (!std::isinf(jc)) b.push(std::fabs(b.a) / jc, -sgn(b.a) * jc);
+    b.a = 0;
+    b.v = vs;
+  }
+  if (s == 0) {
+    b.a = 0;
+    b.v = vt;
+    return;
+  }
+  const bool speedup = (s == sg) || sg == 0;
+  vel_change(b, vt, speedup ? lim.a : lim.d, speedup ? lim.ja : lim.jd);
 }
 
 bool limits_valid(const Limits& l) noexcept {
@@ -152,7 +163,7 @@ double Profile::peak_velocity() const noexcept {
   double m = 0;
   for (int i = 0; i < n_; ++i) {
     const Segment& s = seg_[static_cast<std::size_t>(i)];
-    const double t1 = (i + 1 < n_) ? seg_[static_cast<std::size_t>(i + 1)].t0 - s.t0 : 0.0;
+    const double t1 = std::isinf(s.dt) ? 0.0 : s.dt;
     m = std::max(m, std::fabs(s.v));
     m = std::max(m, std::fabs(s.v + s.a * t1 + s.j * t1 * t1 / 2));
     if (s.j != 0) {
@@ -250,7 +261,7 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
       vel_change_lim(b, 0.0, lim, sg);
     };
     const double V = lim.v;
-    const double vs_up = ramp_vel(vrel, arel, lim.ja);
+    const double vs_up = ramp_vel(vrel, arel, arel >= 0 ? lim.ja : lim.jd);
     const double fV = f(V);
     if (fV <= Rabs) {
       build(V, fV);

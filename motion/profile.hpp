@@ -43,6 +43,7 @@ enum class Overshoot : std::uint8_t {
 /// One constant-jerk piece, in the profile's frame (position relative to origin).
 struct Segment {
   double t0 = 0.0;  ///< start time, seconds since the profile start
+  double dt = 0.0;  ///< duration (+inf for the final hold of a jog)
   double p = 0.0, v = 0.0, a = 0.0;  ///< state at t0
   double j = 0.0;   ///< jerk over the segment
 };
