@@ -82,7 +82,7 @@ enum class DataType : std::uint16_t {
 /// Object access.
 enum class Access : std::uint8_t { kRo, kRw, kWo, kConst };
 /// PDO mappability.
-enum class PdoMap : std::uint8_t { kNo, kRpdo, kTpdo, kBoth };
+enum class PdoMappable : std::uint8_t { kNo, kRpdo, kTpdo, kBoth };
 
 /// One entry (or a range of entries) of the known-object table.
 struct ObjectInfo {
@@ -92,14 +92,14 @@ struct ObjectInfo {
   std::uint8_t sub_last;
   DataType type;
   Access access;
-  PdoMap pdo;
+  PdoMappable pdo;
   std::string_view name;
 };
 
 namespace detail {
 using DT = DataType;
 using AC = Access;
-using PM = PdoMap;
+using PM = PdoMappable;
 // clang-format off
 inline constexpr ObjectInfo kObjects[] = {
   // ---- CiA 301 communication profile ---------------------------------------

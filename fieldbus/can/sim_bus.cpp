@@ -1,0 +1,131 @@
+#include "fieldbus/can/sim_bus.hpp"
+
+#include <algorithm>
+
+namespace canmotion::can {
+
+SimBus::Endpoint::Endpoint(SimBus& bus, std::string name, std::size_t capacity)
+    : bus_(bus), name_(std::move(name)), rx_(capacity), ev_(kEventCapacity) {}
+
+SendResult SimBus::Endpoint::send(const Frame& frame) noexcept {
+  const SendResult r = bus_.transmit(*this, frame);
+  if (r == SendResult::kOk) {
+    ++counters_.tx_frames;
+  } else {
+    ++counters_.tx_errors;
+  }
+  return r;
+}
+
+std::size_t SimBus::Endpoint::receive(std::span<TimedFrame> out) noexcept {
+  std::size_t n = 0;
+  while (n < out.size() && rx_count_ > 0) {
+    out[n++] = rx_[rx_head_];
+    rx_head_ = (rx_head_ + 1) % rx_.size();
+    --rx_count_;
+  }
+  return n;
+}
+
+std::size_t SimBus::Endpoint::poll_events(std::span<BusEvent> out) noexcept {
+  std::size_t n = 0;
+  while (n < out.size() && ev_count_ > 0) {
+    out[n++] = ev_[ev_head_];
+    ev_head_ = (ev_head_ + 1) % ev_.size();
+    --ev_count_;
+  }
+  return n;
+}
+
+BusState SimBus::Endpoint::state() const noexcept { return bus_.state_; }
+
+void SimBus::Endpoint::push(const TimedFrame& f) noexcept {
+  if (rx_count_ == rx_.size()) {
+    ++counters_.rx_dropped;
+    push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, f.t_ns});
+    return;
+  }
+  rx_[(rx_head_ + rx_count_) % rx_.size()] = f;
+  ++rx_count_;
+  ++counters_.rx_frames;
+}
+
+void SimBus::Endpoint::push_event(const BusEvent& e) noexcept {
+  if (ev_count_ == ev_.size()) {
+    ev_head_ = (ev_head_ + 1) % ev_.size();  // drop the oldest
+    --ev_count_;
+  }
+  ev_[(ev_head_ + ev_count_) % ev_.size()] = e;
+  ++ev_count_;
+}
+
+SimBus::SimBus(std::string name) : name_(std::move(name)) {}
+
+SimBus::Endpoint& SimBus::add_endpoint(std::string name, std::size_t rx_capacity) {
+  endpoints_.push_back(std::unique_ptr<Endpoint>(new Endpoint(*this, std::move(name), std::max<std::size_t>(rx_capacity, 1))));
+  return *endpoints_.back();
+}
+
+void SimBus::add_fault(const SimFault& f) { faults_.push_back(Rule{f, 0, 0}); }
+
+void SimBus::set_time(std::int64_t now_ns) noexcept {
+  if (now_ns < now_ns_) return;
+  now_ns_ = now_ns;
+  while (!delayed_.empty() && delayed_.front().due_ns <= now_ns_) {
+    const Delayed d = delayed_.front();
+    delayed_.pop_front();
+    deliver(d.from, d.frame, d.due_ns);
+  }
+}
+
+void SimBus::set_state(BusState s) noexcept {
+  state_ = s;
+  for (auto& ep : endpoints_) ep->push_event(BusEvent{BusEvent::Kind::kStateChanged, s, 0, now_ns_});
+}
+
+SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
+  if (state_ == BusState::kBusOff) return SendResult::kBusOff;
+  ++counters_.sent;
+  Frame frame = f;
+  for (Rule& r : faults_) {
+    if (r.fault.cob_id != SimFault::kAnyId && r.fault.cob_id != f.id) continue;
+    ++r.seen;
+    if (r.seen <= r.fault.skip) continue;
+    if (r.fault.count != 0 && r.acted >= r.fault.count) continue;
+    ++r.acted;
+    switch (r.fault.action) {
+      case SimFault::Action::kDrop:
+        ++counters_.dropped;
+        return SendResult::kOk;  // the sender cannot tell
+      case SimFault::Action::kDelay: {
+        ++counters_.delayed;
+        Delayed d{now_ns_ + r.fault.delay_ns, seq_++, &from, frame};
+        // Delays are only used by fault-injection tests; the deque insert may allocate.
+        auto it = std::upper_bound(delayed_.begin(), delayed_.end(), d, [](const Delayed& a, const Delayed& b) {
+          return a.due_ns < b.due_ns || (a.due_ns == b.due_ns && a.seq < b.seq);
+        });
+        delayed_.insert(it, d);
+        return SendResult::kOk;
+      }
+      case SimFault::Action::kCorrupt:
+        ++counters_.corrupted;
+        if (r.fault.byte < kMaxPayload) frame.data[r.fault.byte] ^= r.fault.xor_mask;
+        if (r.fault.new_len >= 0) frame.len = static_cast<std::uint8_t>(std::min<int>(r.fault.new_len, kMaxPayload));
+        break;
+    }
+    break;
+  }
+  deliver(&from, frame, now_ns_);
+  return SendResult::kOk;
+}
+
+void SimBus::deliver(const Endpoint* from, const Frame& f, std::int64_t t_ns) noexcept {
+  ++counters_.delivered;
+  const TimedFrame tf{f, t_ns};
+  if (tap_) tap_(tf, name_);
+  for (auto& ep : endpoints_) {
+    if (ep.get() != from) ep->push(tf);
+  }
+}
+
+}  // namespace canmotion::can

@@ -1,0 +1,153 @@
+#pragma once
+/// \file
+/// SimBus: a deterministic in-process CAN bus for tests and simulations.
+///
+/// Several endpoints (each a can::Transport) share one broadcast medium: a
+/// frame sent by one endpoint is delivered to every other endpoint (not back
+/// to the sender, like a SocketCAN socket without CAN_RAW_RECV_OWN_MSGS).
+/// There is no thread and no wall clock: the owner sets the virtual time with
+/// set_time(); frames are stamped with it. Fault injection rules per COB-ID
+/// drop, delay or corrupt frames so that tests reproduce bus faults exactly.
+///
+/// Threading: single-threaded by design (one simulation loop drives the
+/// master and the emulated drives). Endpoint::send/receive/poll_events are
+/// realtime-safe (fixed-size rings allocated when the endpoint is added).
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fieldbus/can/frame.hpp"
+#include "fieldbus/can/transport.hpp"
+
+namespace canmotion::can {
+
+/// A fault injection rule. A rule matches frames whose id equals `cob_id`
+/// (or every frame when `cob_id == kAnyId`); it skips the first `skip`
+/// matches, then acts on the next `count` matches (0 = on every later match).
+struct SimFault {
+  static constexpr std::uint32_t kAnyId = 0xFFFFFFFF;
+  enum class Action : std::uint8_t {
+    kDrop,     ///< the frame never reaches the wire
+    kDelay,    ///< the frame is delivered `delay_ns` later
+    kCorrupt,  ///< payload byte `byte` is XORed with `xor_mask`; `len` replaced if `new_len` >= 0
+  };
+  std::uint32_t cob_id = kAnyId;
+  Action action = Action::kDrop;
+  std::uint64_t skip = 0;
+  std::uint64_t count = 1;
+  std::int64_t delay_ns = 0;
+  std::uint8_t byte = 0;
+  std::uint8_t xor_mask = 0xFF;
+  int new_len = -1;
+};
+
+/// Totals of the whole bus.
+struct SimBusCounters {
+  std::uint64_t sent = 0;       ///< frames handed to send()
+  std::uint64_t delivered = 0;  ///< frames that reached the wire (each counted once)
+  std::uint64_t dropped = 0;    ///< dropped by fault injection
+  std::uint64_t delayed = 0;
+  std::uint64_t corrupted = 0;
+};
+
+class SimBus {
+ public:
+  /// Receive ring per endpoint; bounds the frames one endpoint may have
+  /// pending between two receive() calls (a 127-node bus at one cycle needs
+  /// < 600, 4096 leaves room for SDO bursts and delayed frames).
+  static constexpr std::size_t kDefaultRxCapacity = 4096;
+  static constexpr std::size_t kEventCapacity = 64;
+
+  class Endpoint final : public Transport {
+   public:
+    SendResult send(const Frame& frame) noexcept override;
+    std::size_t receive(std::span<TimedFrame> out) noexcept override;
+    std::size_t poll_events(std::span<BusEvent> out) noexcept override;
+    [[nodiscard]] BusState state() const noexcept override;
+    [[nodiscard]] BusCounters counters() const noexcept override { return counters_; }
+    [[nodiscard]] std::string_view name() const noexcept override { return name_; }
+    /// Frames waiting in this endpoint's receive ring.
+    [[nodiscard]] std::size_t pending() const noexcept { return rx_count_; }
+
+   private:
+    friend class SimBus;
+    Endpoint(SimBus& bus, std::string name, std::size_t capacity);
+    void push(const TimedFrame& f) noexcept;
+    void push_event(const BusEvent& e) noexcept;
+    SimBus& bus_;
+    std::string name_;
+    std::vector<TimedFrame> rx_;
+    std::size_t rx_head_ = 0;
+    std::size_t rx_count_ = 0;
+    std::vector<BusEvent> ev_;
+    std::size_t ev_head_ = 0;
+    std::size_t ev_count_ = 0;
+    BusCounters counters_{};
+  };
+
+  /// `name` is the interface name used in traces ("sim0").
+  explicit SimBus(std::string name = "sim0");
+  SimBus(const SimBus&) = delete;
+  SimBus& operator=(const SimBus&) = delete;
+
+  /// Add an endpoint (set-up time: allocates its rings). The reference stays
+  /// valid for the bus's lifetime.
+  Endpoint& add_endpoint(std::string name, std::size_t rx_capacity = kDefaultRxCapacity);
+
+  /// Virtual time in ns. Moving it forward delivers the delayed frames that
+  /// are due. Time never goes backwards (earlier values are ignored).
+  void set_time(std::int64_t now_ns) noexcept;
+  [[nodiscard]] std::int64_t now_ns() const noexcept { return now_ns_; }
+
+  /// Add a fault injection rule (set-up time). Rules are tried in order; the
+  /// first one that acts on a frame wins.
+  void add_fault(const SimFault& f);
+  void clear_faults() noexcept { faults_.clear(); }
+
+  /// Put every endpoint into `s` (error passive, bus-off, ...) and queue a
+  /// kStateChanged event on each; kBusOff makes send() return kBusOff.
+  void set_state(BusState s) noexcept;
+  [[nodiscard]] BusState state() const noexcept { return state_; }
+
+  /// Observer called once for each frame that reaches the wire (after fault
+  /// injection), with its time: used for candump traces. Not realtime-safe
+  /// by itself (std::function); tests and demos only.
+  void set_tap(std::function<void(const TimedFrame&, std::string_view iface)> tap) { tap_ = std::move(tap); }
+
+  [[nodiscard]] const SimBusCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] std::string_view name() const noexcept { return name_; }
+
+ private:
+  friend class Endpoint;
+  struct Delayed {
+    std::int64_t due_ns;
+    std::uint64_t seq;
+    const Endpoint* from;
+    Frame frame;
+  };
+  struct Rule {
+    SimFault fault;
+    std::uint64_t seen = 0;
+    std::uint64_t acted = 0;
+  };
+  SendResult transmit(const Endpoint& from, const Frame& f) noexcept;
+  void deliver(const Endpoint* from, const Frame& f, std::int64_t t_ns) noexcept;
+
+  std::string name_;
+  std::vector<std::unique_ptr<Endpoint>> endpoints_;
+  std::vector<Rule> faults_;
+  std::deque<Delayed> delayed_;  // kept sorted by (due, seq); only touched when delays are injected
+  std::uint64_t seq_ = 0;
+  std::int64_t now_ns_ = 0;
+  BusState state_ = BusState::kErrorActive;
+  SimBusCounters counters_{};
+  std::function<void(const TimedFrame&, std::string_view)> tap_;
+};
+
+}  // namespace canmotion::can

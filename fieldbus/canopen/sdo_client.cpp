@@ -1,0 +1,226 @@
+#include "fieldbus/canopen/sdo_client.hpp"
+
+#include <algorithm>
+
+#include "fieldbus/canopen/cob_id.hpp"
+#include "fieldbus/canopen/sdo_frame.hpp"
+
+namespace canmotion::canopen {
+
+namespace {
+can::Frame sdo_frame(std::uint8_t node, std::uint8_t b0, std::uint16_t index, std::uint8_t sub) noexcept {
+  can::Frame f;
+  f.id = cob::sdo_rx(node);
+  f.len = 8;
+  f.data[0] = b0;
+  f.data[1] = static_cast<std::uint8_t>(index & 0xFF);
+  f.data[2] = static_cast<std::uint8_t>(index >> 8);
+  f.data[3] = sub;
+  return f;
+}
+}  // namespace
+
+SdoClient::SdoClient(std::uint8_t node, std::int64_t timeout_ns)
+    : node_(node), timeout_ns_(timeout_ns), queue_(kQueueCapacity), results_(kResultCapacity) {}
+
+bool SdoClient::download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                         std::uint32_t tag) noexcept {
+  if (queue_count_ == kQueueCapacity || data.empty() || data.size() > kSdoMaxDownload) return false;
+  Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
+  r.tag = tag;
+  r.index = index;
+  r.sub = sub;
+  r.upload = false;
+  r.len = static_cast<std::uint8_t>(data.size());
+  std::copy(data.begin(), data.end(), r.data.begin());
+  ++queue_count_;
+  return true;
+}
+
+bool SdoClient::upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag) noexcept {
+  if (queue_count_ == kQueueCapacity) return false;
+  Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
+  r.tag = tag;
+  r.index = index;
+  r.sub = sub;
+  r.upload = true;
+  r.len = 0;
+  ++queue_count_;
+  return true;
+}
+
+void SdoClient::cancel_all() noexcept {
+  queue_count_ = 0;
+  if (phase_ != Phase::kIdle) cancel_pending_ = true;
+}
+
+void SdoClient::start(const Request& r, std::int64_t now_ns) noexcept {
+  cur_ = r;
+  res_.tag = r.tag;
+  res_.node = node_;
+  res_.index = r.index;
+  res_.sub = r.sub;
+  res_.upload = r.upload;
+  res_.abort = SdoAbort::kNone;
+  res_.aborted_by_server = false;
+  res_.segmented = false;
+  res_.started_ns = now_ns;
+  res_.size = 0;
+  toggle_ = false;
+  offset_ = 0;
+  expected_ = 0;
+  size_known_ = false;
+  if (r.upload) {
+    phase_ = Phase::kInitUpload;
+    queue_tx(sdo_frame(node_, 0x40, r.index, r.sub));
+  } else if (r.len <= 4) {
+    phase_ = Phase::kInitDownload;
+    const auto n = static_cast<std::uint8_t>(4 - r.len);
+    can::Frame f = sdo_frame(node_, static_cast<std::uint8_t>(0x20 | (n << 2) | sdo::kExpedited | sdo::kSizeIndicated),
+                             r.index, r.sub);
+    std::copy_n(r.data.begin(), r.len, f.data.begin() + 4);
+    queue_tx(f);
+  } else {
+    phase_ = Phase::kInitDownload;
+    res_.segmented = true;
+    can::Frame f = sdo_frame(node_, 0x21, r.index, r.sub);
+    f.data[4] = r.len;
+    queue_tx(f);
+  }
+}
+
+void SdoClient::finish(SdoAbort abort, bool by_server, std::int64_t now_ns) noexcept {
+  res_.abort = abort;
+  res_.aborted_by_server = by_server;
+  res_.finished_ns = now_ns;
+  if (abort == SdoAbort::kNone) {
+    ++completed_;
+  } else {
+    ++failed_;
+  }
+  if (result_count_ == kResultCapacity) {  // overwrite the oldest: the caller stopped polling
+    result_head_ = (result_head_ + 1) % kResultCapacity;
+    --result_count_;
+  }
+  results_[(result_head_ + result_count_) % kResultCapacity] = res_;
+  ++result_count_;
+  phase_ = Phase::kIdle;
+}
+
+void SdoClient::abort_transfer(SdoAbort abort, std::int64_t now_ns) noexcept {
+  can::Frame f = sdo_frame(node_, 0x80, cur_.index, cur_.sub);
+  const auto code = static_cast<std::uint32_t>(abort);
+  for (int i = 0; i < 4; ++i) f.data[4 + i] = static_cast<std::uint8_t>(code >> (8 * i));
+  queue_tx(f);
+  finish(abort, false, now_ns);
+}
+
+void SdoClient::send_next_download_segment() noexcept {
+  const std::size_t remaining = cur_.len - offset_;
+  const std::size_t n = std::min<std::size_t>(7, remaining);
+  const bool last = n == remaining;
+  can::Frame f;
+  f.id = cob::sdo_rx(node_);
+  f.len = 8;
+  f.data[0] = static_cast<std::uint8_t>((toggle_ ? sdo::kToggle : 0) | ((7 - n) << 1) | (last ? sdo::kLastSegment : 0));
+  std::copy_n(cur_.data.begin() + static_cast<std::ptrdiff_t>(offset_), n, f.data.begin() + 1);
+  offset_ += n;
+  queue_tx(f);
+}
+
+void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
+  if (f.id != cob::sdo_tx(node_) || f.extended() || f.remote()) return;
+  if (phase_ == Phase::kIdle) return;  // late or unsolicited response
+  if (f.len != 8) {
+    abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
+    return;
+  }
+  const sdo::SdoFrame s = sdo::decode(f, true);
+  if (s.kind == sdo::SdoFrameKind::kAbort) {
+    if (s.index == cur_.index && s.sub == cur_.sub) finish(static_cast<SdoAbort>(s.abort_code), true, now_ns);
+    return;
+  }
+  switch (phase_) {
+    case Phase::kInitDownload:
+      if (s.kind != sdo::SdoFrameKind::kInitiateDownloadResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
+      if (s.index != cur_.index || s.sub != cur_.sub) return abort_transfer(SdoAbort::kGeneral, now_ns);
+      if (cur_.len <= 4) return finish(SdoAbort::kNone, false, now_ns);
+      phase_ = Phase::kDownloadSegment;
+      toggle_ = false;
+      send_next_download_segment();
+      return;
+    case Phase::kDownloadSegment:
+      if (s.kind != sdo::SdoFrameKind::kDownloadSegmentResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
+      if (s.toggle != toggle_) return abort_transfer(SdoAbort::kToggleBit, now_ns);
+      if (offset_ >= cur_.len) return finish(SdoAbort::kNone, false, now_ns);
+      toggle_ = !toggle_;
+      send_next_download_segment();
+      return;
+    case Phase::kInitUpload:
+      if (s.kind != sdo::SdoFrameKind::kInitiateUploadResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
+      if (s.index != cur_.index || s.sub != cur_.sub) return abort_transfer(SdoAbort::kGeneral, now_ns);
+      if (s.expedited) {
+        res_.size = s.data_len;
+        std::copy_n(s.data, s.data_len, res_.data.begin());
+        return finish(SdoAbort::kNone, false, now_ns);
+      }
+      res_.segmented = true;
+      size_known_ = s.size_indicated;
+      expected_ = s.size;
+      if (size_known_ && expected_ > kSdoMaxUpload) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
+      phase_ = Phase::kUploadSegment;
+      toggle_ = false;
+      queue_tx(sdo_frame(node_, 0x60, 0, 0));
+      tx_.data[1] = tx_.data[2] = tx_.data[3] = 0;
+      return;
+    case Phase::kUploadSegment: {
+      if (s.kind != sdo::SdoFrameKind::kUploadSegmentResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
+      if (s.toggle != toggle_) return abort_transfer(SdoAbort::kToggleBit, now_ns);
+      if (offset_ + s.data_len > kSdoMaxUpload) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
+      std::copy_n(s.data, s.data_len, res_.data.begin() + static_cast<std::ptrdiff_t>(offset_));
+      offset_ += s.data_len;
+      res_.size = static_cast<std::uint16_t>(offset_);
+      if (s.last) {
+        if (size_known_ && offset_ != expected_) {
+          return abort_transfer(offset_ > expected_ ? SdoAbort::kLengthTooHigh : SdoAbort::kLengthTooLow, now_ns);
+        }
+        return finish(SdoAbort::kNone, false, now_ns);
+      }
+      toggle_ = !toggle_;
+      queue_tx(sdo_frame(node_, static_cast<std::uint8_t>(0x60 | (toggle_ ? sdo::kToggle : 0)), 0, 0));
+      return;
+    }
+    case Phase::kIdle: return;
+  }
+}
+
+void SdoClient::step(std::int64_t now_ns, FrameSink& out) noexcept {
+  if (cancel_pending_) {
+    cancel_pending_ = false;
+    if (phase_ != Phase::kIdle) abort_transfer(SdoAbort::kGeneral, now_ns);
+  }
+  if (phase_ != Phase::kIdle && !tx_pending_ && now_ns - last_tx_ns_ > timeout_ns_) {
+    abort_transfer(SdoAbort::kTimeout, now_ns);
+  }
+  if (phase_ == Phase::kIdle && !tx_pending_ && queue_count_ > 0) {
+    const Request r = queue_[queue_head_];
+    queue_head_ = (queue_head_ + 1) % kQueueCapacity;
+    --queue_count_;
+    start(r, now_ns);
+  }
+  if (tx_pending_) {
+    out.send(tx_);
+    tx_pending_ = false;
+    last_tx_ns_ = now_ns;
+  }
+}
+
+bool SdoClient::poll(SdoResult& out) noexcept {
+  if (result_count_ == 0) return false;
+  out = results_[result_head_];
+  result_head_ = (result_head_ + 1) % kResultCapacity;
+  --result_count_;
+  return true;
+}
+
+}  // namespace canmotion::canopen

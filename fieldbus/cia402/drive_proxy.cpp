@@ -1,0 +1,557 @@
+#include "fieldbus/cia402/drive_proxy.hpp"
+
+#include <cinttypes>
+#include <cstdio>
+#include <stdexcept>
+
+#include "fieldbus/canopen/cob_id.hpp"
+#include "fieldbus/canopen/emcy.hpp"
+#include "fieldbus/canopen/sdo_abort.hpp"
+
+namespace canmotion::cia402 {
+
+namespace {
+constexpr std::uint32_t kModeWriteTag = 0xFFFF0001u;  // tag of a run-time 0x6060 write
+
+void put_u32(SdoWrite& w, std::uint16_t index, std::uint8_t sub, std::uint8_t size, std::uint32_t value) {
+  w = SdoWrite{index, sub, size, value};
+}
+}  // namespace
+
+// ============================================================================
+// Failure
+// ============================================================================
+std::size_t Failure::describe(std::span<char> out) const noexcept {
+  if (out.empty()) return 0;
+  char emcy[96] = "";
+  if (has_emcy) {
+    std::snprintf(emcy, sizeof emcy, ", last EMCY 0x%04X (%.*s)", emcy_code,
+                  static_cast<int>(canopen::emcy_code_text(emcy_code).size()), canopen::emcy_code_text(emcy_code).data());
+  }
+  const double waited_ms = static_cast<double>(waited_ns) / 1e6;
+  const auto sn = state_name(reached);
+  int n = 0;
+  switch (kind) {
+    case FailureKind::kNone:
+      n = std::snprintf(out.data(), out.size(), "node %u: no failure", node);
+      break;
+    case FailureKind::kBootTimeout:
+      n = std::snprintf(out.data(), out.size(),
+                        "node %u: no boot-up or heartbeat within %.1f ms, even after NMT reset node (timeout %.1f ms)",
+                        node, waited_ms, static_cast<double>(timeout_ns) / 1e6);
+      break;
+    case FailureKind::kSdoAbort: {
+      const auto name = canopen::object_name(sdo_index, sdo_sub);
+      const auto text = canopen::sdo_abort_text(sdo_abort);
+      n = std::snprintf(out.data(), out.size(),
+                        "node %u: configuration write to 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms",
+                        node, sdo_index, sdo_sub, static_cast<int>(name.size()), name.data(), sdo_abort,
+                        static_cast<int>(text.size()), text.data(), waited_ms);
+      break;
+    }
+    case FailureKind::kSdoQueueFull:
+      n = std::snprintf(out.data(), out.size(), "node %u: SDO queue full while configuring", node);
+      break;
+    case FailureKind::kStartTimeout:
+      n = std::snprintf(out.data(), out.size(), "node %u: no TPDO within %.1f ms after NMT start%s", node,
+                        static_cast<double>(timeout_ns) / 1e6, emcy);
+      break;
+    case FailureKind::kTransitionTimeout: {
+      const auto wn = state_name(wanted);
+      const auto from = transition < kTransitions.size() ? state_name(kTransitions[transition].from) : "?";
+      const auto to = transition < kTransitions.size() ? state_name(kTransitions[transition].to) : wn;
+      n = std::snprintf(out.data(), out.size(),
+                        "node %u: transition %u (%.*s -> %.*s) towards %.*s timed out after %.1f ms: drive is in %.*s, "
+                        "statusword 0x%04X%s",
+                        node, transition, static_cast<int>(from.size()), from.data(), static_cast<int>(to.size()),
+                        to.data(), static_cast<int>(wn.size()), wn.data(), waited_ms, static_cast<int>(sn.size()),
+                        sn.data(), statusword, emcy);
+      break;
+    }
+    case FailureKind::kDriveFault:
+      n = std::snprintf(out.data(), out.size(), "node %u: drive entered %.*s (statusword 0x%04X)%s", node,
+                        static_cast<int>(sn.size()), sn.data(), statusword, emcy);
+      break;
+    case FailureKind::kHeartbeatLost:
+      n = std::snprintf(out.data(), out.size(),
+                        "node %u: heartbeat lost (none for %.1f ms; drive was in %.*s, statusword 0x%04X)%s", node,
+                        static_cast<double>(timeout_ns) / 1e6, static_cast<int>(sn.size()), sn.data(), statusword, emcy);
+      break;
+    case FailureKind::kUnexpectedBootUp:
+      n = std::snprintf(out.data(), out.size(), "node %u: unexpected boot-up while %.*s (drive reset itself)%s", node,
+                        static_cast<int>(phase_name(phase).size()), phase_name(phase).data(), emcy);
+      break;
+  }
+  if (n < 0) {
+    out[0] = '\0';
+    return 0;
+  }
+  return std::min<std::size_t>(static_cast<std::size_t>(n), out.size() - 1);
+}
+
+std::string Failure::to_string() const {
+  char buf[512];
+  const std::size_t n = describe(buf);
+  return std::string(buf, n);
+}
+
+// ============================================================================
+// DriveProxy
+// ============================================================================
+DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(cfg), master_(master) {
+  if (!master_.add_node(cfg_.node, cfg_.sdo_timeout_ns)) {
+    throw std::invalid_argument("node-ID " + std::to_string(cfg_.node) +
+                                " is invalid (1..127, not the master's own ID) or already used");
+  }
+  if (!is_cyclic(cfg_.mode) && cfg_.mode != Mode::kHoming) {
+    throw std::invalid_argument("node " + std::to_string(cfg_.node) + ": mode " + std::string(mode_name(cfg_.mode)) +
+                                " is not supported by the proxy (valid: 8 CSP, 9 CSV, 10 CST, 6 homing)");
+  }
+  if (!encode_interpolation_period(cfg_.cycle_ns)) {
+    throw std::invalid_argument("node " + std::to_string(cfg_.node) + ": cycle period " + std::to_string(cfg_.cycle_ns) +
+                                " ns cannot be written to 0x60C2");
+  }
+  mode_ = cfg_.mode;
+  pdos_ = default_drive_pdos(cfg_.pdo_profile, cfg_.node);
+  auto find = [this](bool rx, std::uint16_t index) {
+    Slot s;
+    const auto& arr = rx ? pdos_.rpdo : pdos_.tpdo;
+    const std::uint8_t n = rx ? pdos_.rpdo_count : pdos_.tpdo_count;
+    for (std::uint8_t p = 0; p < n; ++p) {
+      const int e = arr[p].find(index, 0);
+      if (e >= 0) return Slot{static_cast<std::int8_t>(p), static_cast<std::int8_t>(e)};
+    }
+    return s;
+  };
+  cw_slot_ = find(true, obj::kControlword);
+  tpos_slot_ = find(true, obj::kTargetPosition);
+  tvel_slot_ = find(true, obj::kTargetVelocity);
+  ttrq_slot_ = find(true, obj::kTargetTorque);
+  mode_slot_ = find(true, obj::kModesOfOperation);
+  sw_slot_ = find(false, obj::kStatusword);
+  pos_slot_ = find(false, obj::kPositionActualValue);
+  vel_slot_ = find(false, obj::kVelocityActualValue);
+  trq_slot_ = find(false, obj::kTorqueActualValue);
+  mdisp_slot_ = find(false, obj::kModesOfOperationDisplay);
+  build_configuration();
+}
+
+void DriveProxy::build_configuration() {
+  writes_.clear();
+  SdoWrite w;
+  put_u32(w, obj::kModesOfOperation, 0, 1, static_cast<std::uint8_t>(static_cast<std::int8_t>(cfg_.mode)));
+  writes_.push_back(w);
+  const auto ip = *encode_interpolation_period(cfg_.cycle_ns);
+  writes_.push_back(SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value});
+  writes_.push_back(SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)});
+  // PDOs: the CiA 301 procedure for the used ones, COB-ID invalid for PDO 1..4 not used.
+  auto add_map = [this](const canopen::PdoMap& m) {
+    const std::uint32_t cob = m.cob_id & 0x7FFu;
+    writes_.push_back(SdoWrite{m.comm_index(), 1, 4, cob | canopen::kPdoInvalid});
+    writes_.push_back(SdoWrite{m.map_index(), 0, 1, 0});
+    for (std::uint8_t i = 0; i < m.count; ++i)
+      writes_.push_back(SdoWrite{m.map_index(), static_cast<std::uint8_t>(i + 1), 4, m.entries[i].raw()});
+    writes_.push_back(SdoWrite{m.map_index(), 0, 1, m.count});
+    writes_.push_back(SdoWrite{m.comm_index(), 2, 1, m.transmission_type});
+    writes_.push_back(SdoWrite{m.comm_index(), 1, 4, cob});
+  };
+  for (std::uint8_t n = 1; n <= 4; ++n) {
+    if (n <= pdos_.rpdo_count) {
+      add_map(pdos_.rpdo[n - 1]);
+    } else {
+      writes_.push_back(SdoWrite{static_cast<std::uint16_t>(0x1400 + n - 1), 1, 4,
+                                 canopen::cob::rpdo(n, cfg_.node) | canopen::kPdoInvalid});
+    }
+  }
+  for (std::uint8_t n = 1; n <= 4; ++n) {
+    if (n <= pdos_.tpdo_count) {
+      add_map(pdos_.tpdo[n - 1]);
+    } else {
+      writes_.push_back(SdoWrite{static_cast<std::uint16_t>(0x1800 + n - 1), 1, 4,
+                                 canopen::cob::tpdo(n, cfg_.node) | canopen::kPdoInvalid});
+    }
+  }
+  writes_.push_back(SdoWrite{0x1017, 0, 2, cfg_.producer_heartbeat_ms});
+  const std::uint32_t consumer =
+      cfg_.consumer_heartbeat_ms == 0 ? 0u
+                                      : (static_cast<std::uint32_t>(master_.config().node_id) << 16) | cfg_.consumer_heartbeat_ms;
+  writes_.push_back(SdoWrite{0x1016, 1, 4, consumer});
+  for (const SdoWrite& x : cfg_.extra_writes) writes_.push_back(x);
+}
+
+void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept {
+  failure_.kind = k;
+  failure_.node = cfg_.node;
+  failure_.phase = phase_;
+  failure_.reached = state_;
+  failure_.wanted = wanted_;
+  failure_.statusword = fb_.statusword;
+  failure_.has_emcy = has_emcy_;
+  failure_.emcy_code = emcy_code_;
+  failure_.waited_ns = waited;
+  failure_.timeout_ns = timeout;
+  failure_.t_ns = now_ns;
+}
+
+void DriveProxy::restart() noexcept {
+  phase_ = Phase::kWaitBoot;
+  started_ = false;
+  next_write_ = done_writes_ = 0;
+  tpdo_seen_ = expect_tpdo_ = got_tpdo_ = false;
+  state_ = State::kUnknown;
+  wanted_ = State::kSwitchOnDisabled;
+  in_flight_ = false;
+  failure_ = Failure{};
+  master_.sdo(cfg_.node).cancel_all();
+}
+
+bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
+  const can::Frame& f = tf.frame;
+  if (f.extended() || f.remote() || f.error()) return false;
+  for (std::uint8_t p = 0; p < pdos_.tpdo_count; ++p) {
+    const canopen::PdoMap& m = pdos_.tpdo[p];
+    if (f.id != (m.cob_id & 0x7FFu)) continue;
+    if (f.len < m.size_bytes) return true;  // length error: ignored (the drive reports 0x8210 on its side)
+    const auto payload = f.payload();
+    auto get = [&](const Slot& s) -> std::uint64_t {
+      const canopen::PdoEntry& e = pdos_.tpdo[static_cast<std::size_t>(s.pdo)].entries[static_cast<std::size_t>(s.entry)];
+      return canopen::unpack_bits(payload, e.bit_offset, e.bits);
+    };
+    if (sw_slot_.pdo == p) fb_.statusword = static_cast<std::uint16_t>(get(sw_slot_));
+    if (pos_slot_.pdo == p) fb_.position = static_cast<std::int32_t>(canopen::sign_extend(get(pos_slot_), 32));
+    if (vel_slot_.pdo == p) fb_.velocity = static_cast<std::int32_t>(canopen::sign_extend(get(vel_slot_), 32));
+    if (trq_slot_.pdo == p) fb_.torque = static_cast<std::int16_t>(canopen::sign_extend(get(trq_slot_), 16));
+    if (mdisp_slot_.pdo == p) fb_.mode_display = static_cast<std::int8_t>(canopen::sign_extend(get(mdisp_slot_), 8));
+    if (p == 0) {
+      ++fb_.tpdo_count;
+      fb_.last_tpdo_ns = tf.t_ns;
+      got_tpdo_ = true;
+      tpdo_seen_ = true;
+    }
+    return true;
+  }
+  return false;
+}
+
+void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
+  if (e.node != cfg_.node) return;
+  switch (e.kind) {
+    case canopen::NodeEvent::Kind::kEmcy:
+      if (e.emcy.code != canopen::emcy_code::kNoError) {
+        has_emcy_ = true;
+        emcy_code_ = e.emcy.code;
+      }
+      break;
+    case canopen::NodeEvent::Kind::kHeartbeatLost:
+      if (phase_ == Phase::kOperational || phase_ == Phase::kStarting) {
+        fail(FailureKind::kHeartbeatLost, e.t_ns, 0, master_.status(cfg_.node).heartbeat_timeout_ns);
+      }
+      break;
+    case canopen::NodeEvent::Kind::kBootUp:
+      if (phase_ == Phase::kOperational || phase_ == Phase::kStarting || phase_ == Phase::kConfiguring) {
+        fail(FailureKind::kUnexpectedBootUp, e.t_ns, 0, 0);
+        phase_ = Phase::kFailed;
+        expect_tpdo_ = false;
+      }
+      break;
+    default: break;
+  }
+}
+
+void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
+  const canopen::NodeStatus& st = master_.status(cfg_.node);
+  canopen::SdoClient& sdo = master_.sdo(cfg_.node);
+  switch (phase_) {
+    case Phase::kWaitBoot:
+      if (cfg_.reset_node_first && !st.booted) {
+        master_.send_nmt(canopen::NmtCommand::kResetNode, cfg_.node, out);
+        phase_ = Phase::kResetWait;
+        phase_since_ns_ = now_ns;
+      } else if (st.seen) {
+        if (st.state == canopen::NmtState::kOperational || st.state == canopen::NmtState::kStopped) {
+          master_.send_nmt(canopen::NmtCommand::kEnterPreOperational, cfg_.node, out);
+        }
+        phase_ = Phase::kConfiguring;
+        phase_since_ns_ = now_ns;
+      } else if (now_ns - phase_since_ns_ > cfg_.boot_timeout_ns) {
+        master_.send_nmt(canopen::NmtCommand::kResetNode, cfg_.node, out);
+        phase_ = Phase::kResetWait;
+        phase_since_ns_ = now_ns;
+      }
+      return;
+    case Phase::kResetWait:
+      if (st.booted) {
+        phase_ = Phase::kConfiguring;
+        phase_since_ns_ = now_ns;
+      } else if (now_ns - phase_since_ns_ > cfg_.boot_timeout_ns) {
+        fail(FailureKind::kBootTimeout, now_ns, now_ns - phase_since_ns_, cfg_.boot_timeout_ns);
+        phase_ = Phase::kFailed;
+      }
+      return;
+    case Phase::kConfiguring: {
+      canopen::SdoResult r;
+      while (sdo.poll(r)) {
+        if (r.tag == kModeWriteTag) continue;
+        if (!r.ok()) {
+          fail(FailureKind::kSdoAbort, now_ns, r.finished_ns - r.started_ns, r.abort == canopen::SdoAbort::kTimeout ? sdo.timeout() : 0);
+          failure_.sdo_index = r.index;
+          failure_.sdo_sub = r.sub;
+          failure_.sdo_abort = static_cast<std::uint32_t>(r.abort);
+          sdo.cancel_all();
+          phase_ = Phase::kFailed;
+          return;
+        }
+        ++done_writes_;
+      }
+      while (next_write_ < writes_.size() && sdo.queued() < canopen::SdoClient::kQueueCapacity) {
+        const SdoWrite& w = writes_[next_write_];
+        std::uint8_t b[4];
+        for (int i = 0; i < 4; ++i) b[i] = static_cast<std::uint8_t>(w.value >> (8 * i));
+        if (!sdo.download(w.index, w.sub, std::span<const std::uint8_t>(b, w.size), static_cast<std::uint32_t>(next_write_))) {
+          break;
+        }
+        ++next_write_;
+      }
+      if (done_writes_ == writes_.size()) {
+        if (cfg_.producer_heartbeat_ms > 0) {
+          const std::int64_t hb = cfg_.heartbeat_timeout_ns > 0 ? cfg_.heartbeat_timeout_ns
+                                                                : 3 * static_cast<std::int64_t>(cfg_.producer_heartbeat_ms) * 1'000'000;
+          master_.set_heartbeat_timeout(cfg_.node, hb, now_ns);
+        }
+        master_.send_nmt(canopen::NmtCommand::kStart, cfg_.node, out);
+        phase_ = Phase::kStarting;
+        phase_since_ns_ = now_ns;
+      }
+      return;
+    }
+    case Phase::kStarting:
+      if (tpdo_seen_) {
+        phase_ = Phase::kOperational;
+        phase_since_ns_ = now_ns;
+        state_ = decode_state(fb_.statusword);
+        follow_actual();
+      } else if (now_ns - phase_since_ns_ > cfg_.start_timeout_ns) {
+        fail(FailureKind::kStartTimeout, now_ns, now_ns - phase_since_ns_, cfg_.start_timeout_ns);
+        phase_ = Phase::kFailed;
+      }
+      return;
+    default: return;
+  }
+}
+
+void DriveProxy::follow_actual() noexcept {
+  target_position_ = fb_.position;
+  target_velocity_ = 0;
+  target_torque_ = 0;
+}
+
+void DriveProxy::set_wanted(State s) noexcept {
+  wanted_ = s;
+  in_flight_ = false;
+  if (failure_.kind == FailureKind::kTransitionTimeout) failure_ = Failure{};
+}
+
+void DriveProxy::enable() noexcept { set_wanted(State::kOperationEnabled); }
+void DriveProxy::disable() noexcept { set_wanted(State::kSwitchOnDisabled); }
+void DriveProxy::disable_operation() noexcept { set_wanted(State::kSwitchedOn); }
+void DriveProxy::quick_stop() noexcept { set_wanted(State::kQuickStopActive); }
+void DriveProxy::fault_reset() noexcept {
+  set_wanted(State::kSwitchOnDisabled);
+  reset_requested_ = true;
+  if (failure_.kind == FailureKind::kDriveFault) failure_ = Failure{};
+}
+
+bool DriveProxy::set_mode(Mode m) noexcept {
+  if (!is_cyclic(m)) return false;
+  if (mode_slot_.pdo < 0) {
+    if (!master_.sdo(cfg_.node).download_value<std::int8_t>(obj::kModesOfOperation, 0, static_cast<std::int8_t>(m), kModeWriteTag))
+      return false;
+    sdo_mode_pending_ = m;
+  }
+  mode_ = m;
+  target_position_ = fb_.position;
+  target_velocity_ = vel_slot_.pdo >= 0 ? fb_.velocity : 0;
+  target_torque_ = trq_slot_.pdo >= 0 ? fb_.torque : 0;
+  return true;
+}
+
+void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
+  state_ = decode_state(fb_.statusword);
+  const bool faulted = state_ == State::kFault || state_ == State::kFaultReactionActive;
+  if (faulted && !reset_requested_) {
+    if (failure_.kind == FailureKind::kNone || failure_.kind == FailureKind::kTransitionTimeout) {
+      fail(FailureKind::kDriveFault, now_ns, 0, 0);
+    }
+    wanted_ = State::kSwitchOnDisabled;
+    in_flight_ = false;
+    cw_ = cia402::controlword(Command::kDisableVoltage);
+    follow_actual();
+    return;
+  }
+  if (state_ != State::kOperationEnabled) follow_actual();
+  if (state_ == wanted_) {
+    in_flight_ = false;
+    reset_requested_ = false;
+    switch (wanted_) {
+      case State::kOperationEnabled: cw_ = cia402::controlword(Command::kEnableOperation); break;
+      case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
+      case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
+      case State::kQuickStopActive: cw_ = cia402::controlword(Command::kQuickStop); break;
+      default: cw_ = cia402::controlword(Command::kDisableVoltage); break;
+    }
+    return;
+  }
+  const auto plan = next_step(state_, wanted_);
+  if (!plan) {
+    // Only the drive can move on (not ready, fault reaction) or the wanted
+    // state cannot be reached from here: time it like a transition.
+    if (!in_flight_ || flight_from_ != state_) {
+      in_flight_ = true;
+      flight_ = PlanStep{Command::kDisableVoltage, kNoTransition, wanted_};
+      flight_from_ = state_;
+      flight_since_ns_ = now_ns;
+      flight_cycles_ = 0;
+    }
+  } else if (!in_flight_ || flight_.transition != plan->transition || flight_from_ != state_) {
+    in_flight_ = true;
+    flight_ = *plan;
+    flight_from_ = state_;
+    flight_since_ns_ = now_ns;
+    flight_cycles_ = 0;
+  }
+  const std::int64_t waited = now_ns - flight_since_ns_;
+  if (waited > cfg_.transition_timeout_ns) {
+    fail(FailureKind::kTransitionTimeout, now_ns, waited, cfg_.transition_timeout_ns);
+    failure_.transition = flight_.transition;
+    failure_.wanted = wanted_;
+    wanted_ = state_;  // stop pushing; enable()/disable() try again
+    in_flight_ = false;
+    reset_requested_ = false;
+    return;
+  }
+  if (plan) {
+    if (plan->command == Command::kFaultReset) {
+      // The drive acts on the rising edge of bit 7: one cycle without it first.
+      cw_ = flight_cycles_ == 0 ? std::uint16_t{0} : cia402::controlword(Command::kFaultReset);
+    } else {
+      cw_ = cia402::controlword(plan->command);
+    }
+  }
+  ++flight_cycles_;
+}
+
+void DriveProxy::send_rpdos(canopen::FrameSink& out) noexcept {
+  for (std::uint8_t p = 0; p < pdos_.rpdo_count; ++p) {
+    const canopen::PdoMap& m = pdos_.rpdo[p];
+    can::Frame f;
+    f.id = m.cob_id & 0x7FFu;
+    f.len = m.size_bytes;
+    std::span<std::uint8_t> payload(f.data.data(), f.len);
+    auto put = [&](const Slot& s, std::uint64_t v) {
+      if (s.pdo != p) return;
+      const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(s.entry)];
+      canopen::pack_bits(payload, e.bit_offset, e.bits, v);
+    };
+    put(cw_slot_, cw_);
+    put(tpos_slot_, static_cast<std::uint32_t>(target_position_));
+    put(tvel_slot_, static_cast<std::uint32_t>(target_velocity_));
+    put(ttrq_slot_, static_cast<std::uint16_t>(target_torque_));
+    put(mode_slot_, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_)));
+    out.send(f);
+  }
+}
+
+void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
+  now_ns_ = now_ns;
+  if (!started_) {
+    started_ = true;
+    phase_since_ns_ = now_ns;
+  }
+  if (phase_ != Phase::kOperational) {
+    step_boot(now_ns, out);
+    if (phase_ != Phase::kOperational) return;
+  }
+  // Missed TPDO accounting: a SYNC went out last cycle and TPDO1 did not come.
+  if (expect_tpdo_ && !got_tpdo_) ++fb_.tpdo_missed;
+  got_tpdo_ = false;
+  // Results of run-time SDO writes (mode switches without RPDO2).
+  canopen::SdoResult r;
+  while (master_.sdo(cfg_.node).poll(r)) {
+    if (r.tag == kModeWriteTag && r.ok() && mdisp_slot_.pdo < 0) fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);
+  }
+  if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
+  step_state_machine(now_ns);
+  send_rpdos(out);
+}
+
+void DriveProxy::on_sync_sent() noexcept { expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_; }
+
+// ============================================================================
+// DriveNetwork
+// ============================================================================
+DriveNetwork::DriveNetwork(const NetworkConfig& cfg) : master_(cfg.master), events_(kEventCapacity) { index_.fill(-1); }
+
+DriveProxy& DriveNetwork::add_drive(const DriveConfig& cfg) {
+  drives_.push_back(std::make_unique<DriveProxy>(cfg, master_));
+  index_[cfg.node] = static_cast<std::int16_t>(drives_.size() - 1);
+  return *drives_.back();
+}
+
+DriveProxy* DriveNetwork::drive(std::uint8_t node) noexcept {
+  if (node > 127 || index_[node] < 0) return nullptr;
+  return drives_[static_cast<std::size_t>(index_[node])].get();
+}
+
+void DriveNetwork::on_frame(const can::TimedFrame& f) noexcept {
+  if (master_.on_frame(f)) return;
+  const canopen::CobInfo c = canopen::classify(f.frame.id);
+  if (c.kind != canopen::FrameKind::kTpdo) return;
+  if (DriveProxy* d = drive(c.node)) d->on_frame(f);
+}
+
+void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
+  master_.step(now_ns, out);
+  canopen::NodeEvent e;
+  while (master_.poll_event(e)) {
+    if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
+    if (ev_count_ < kEventCapacity) {
+      events_[(ev_head_ + ev_count_) % kEventCapacity] = e;
+      ++ev_count_;
+    }
+  }
+  for (auto& d : drives_) d->step(now_ns, out);
+  master_.send_sync(out);
+  for (auto& d : drives_) d->on_sync_sent();
+}
+
+bool DriveNetwork::poll_event(canopen::NodeEvent& out) noexcept {
+  if (ev_count_ == 0) return false;
+  out = events_[ev_head_];
+  ev_head_ = (ev_head_ + 1) % kEventCapacity;
+  --ev_count_;
+  return true;
+}
+
+bool DriveNetwork::all_operational() const noexcept {
+  for (const auto& d : drives_)
+    if (d->phase() != Phase::kOperational) return false;
+  return !drives_.empty();
+}
+bool DriveNetwork::all_enabled() const noexcept {
+  for (const auto& d : drives_)
+    if (!d->enabled()) return false;
+  return !drives_.empty();
+}
+bool DriveNetwork::any_failed() const noexcept {
+  for (const auto& d : drives_)
+    if (d->failed()) return true;
+  return false;
+}
+void DriveNetwork::enable_all() noexcept {
+  for (auto& d : drives_) d->enable();
+}
+void DriveNetwork::disable_all() noexcept {
+  for (auto& d : drives_) d->disable();
+}
+
+}  // namespace canmotion::cia402

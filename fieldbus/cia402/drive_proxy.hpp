@@ -1,0 +1,286 @@
+#pragma once
+/// \file
+/// Master-side CiA 402 drive proxy (one per node) and DriveNetwork (the
+/// CANopen master plus its proxies), the objects the RT controller drives
+/// once per cycle.
+///
+/// Per node: boot (wait for boot-up / heartbeat, or reset the node), SDO
+/// configuration (0x6060 mode, 0x60C2 interpolation period = cycle, PDO
+/// maps by the CiA 301 procedure, heartbeat producer 0x1017 and consumer
+/// 0x1016 watching the master, extra writes), NMT start, then the 402 state
+/// machine through its numbered transitions with a per-node timeout. Until
+/// Operation enabled is reached the targets follow the actual values, so
+/// enabling never jumps. A failure explains itself (Failure::describe).
+///
+/// Set-up (constructors, add_drive) allocates. on_frame(), step()/cycle(),
+/// the setters and getters are realtime-safe: no allocation, no locks, no
+/// exceptions, no logging.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "fieldbus/can/frame.hpp"
+#include "fieldbus/canopen/frame_sink.hpp"
+#include "fieldbus/canopen/master.hpp"
+#include "fieldbus/canopen/pdo.hpp"
+#include "fieldbus/cia402/cia402.hpp"
+#include "fieldbus/cia402/drive_pdos.hpp"
+
+namespace canmotion::cia402 {
+
+/// One expedited SDO write (1, 2 or 4 bytes) from the configuration.
+struct SdoWrite {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  std::uint8_t size = 4;  ///< 1, 2, 3 or 4 bytes
+  std::uint32_t value = 0;
+};
+
+struct DriveConfig {
+  std::uint8_t node = 1;
+  Mode mode = Mode::kCsp;                  ///< written to 0x6060 at boot
+  std::int64_t cycle_ns = 1'000'000;       ///< written to 0x60C2
+  PdoProfile pdo_profile = PdoProfile::kCsp;
+  std::uint16_t producer_heartbeat_ms = 100;  ///< drive's 0x1017 (0 = off)
+  std::uint16_t consumer_heartbeat_ms = 300;  ///< drive's 0x1016:1, watching the master (0 = off)
+  std::int64_t heartbeat_timeout_ns = 0;      ///< master-side consumer; 0 = 3 x producer period
+  std::vector<SdoWrite> extra_writes;         ///< written after the standard configuration
+  std::int64_t boot_timeout_ns = 2'000'000'000;     ///< wait for boot-up/heartbeat before resetting the node
+  std::int64_t sdo_timeout_ns = 200'000'000;        ///< per SDO response
+  std::int64_t start_timeout_ns = 1'000'000'000;    ///< NMT start -> first TPDO
+  std::int64_t transition_timeout_ns = 500'000'000; ///< per state machine transition
+  bool reset_node_first = false;  ///< send NMT reset node instead of waiting for a boot-up first
+};
+
+/// Where the proxy is in bringing its node up.
+enum class Phase : std::uint8_t { kWaitBoot, kResetWait, kConfiguring, kStarting, kOperational, kFailed };
+[[nodiscard]] constexpr std::string_view phase_name(Phase p) noexcept {
+  switch (p) {
+    case Phase::kWaitBoot: return "waiting for boot-up";
+    case Phase::kResetWait: return "waiting for boot-up after NMT reset node";
+    case Phase::kConfiguring: return "configuring over SDO";
+    case Phase::kStarting: return "waiting for the first TPDO after NMT start";
+    case Phase::kOperational: return "operational";
+    case Phase::kFailed: return "failed";
+  }
+  return "?";
+}
+
+enum class FailureKind : std::uint8_t {
+  kNone,
+  kBootTimeout,        ///< no boot-up even after NMT reset node
+  kSdoAbort,           ///< a configuration write was aborted (by the drive or by timeout)
+  kSdoQueueFull,
+  kStartTimeout,       ///< no TPDO after NMT start
+  kTransitionTimeout,  ///< the drive did not make the wanted transition in time
+  kDriveFault,         ///< the drive went to Fault (reaction) on its own
+  kHeartbeatLost,      ///< heartbeat consumer timed out
+  kUnexpectedBootUp,   ///< the drive rebooted while operational
+};
+
+/// A failure with everything needed to explain it.
+struct Failure {
+  FailureKind kind = FailureKind::kNone;
+  std::uint8_t node = 0;
+  Phase phase = Phase::kWaitBoot;
+  std::uint8_t transition = kNoTransition;  ///< the wanted transition (0..16)
+  State wanted = State::kUnknown;           ///< the state the master wanted
+  State reached = State::kUnknown;          ///< the state the drive was in
+  std::uint16_t statusword = 0;             ///< last statusword
+  bool has_emcy = false;
+  std::uint16_t emcy_code = 0;              ///< last EMCY code, if any
+  std::int64_t waited_ns = 0;               ///< time waited
+  std::int64_t timeout_ns = 0;              ///< the timeout that expired (0: not a timeout)
+  std::uint16_t sdo_index = 0;
+  std::uint8_t sdo_sub = 0;
+  std::uint32_t sdo_abort = 0;
+  std::int64_t t_ns = 0;                    ///< when it was detected
+
+  /// One sentence, e.g. "node 2: transition 4 (Switched on -> Operation
+  /// enabled) timed out after 500.0 ms: drive is in Switched on, statusword
+  /// 0x0233, last EMCY 0x8611 (following error)". Writes at most out.size()-1
+  /// characters plus NUL; returns the length. Uses snprintf: call it from a
+  /// non-RT thread.
+  std::size_t describe(std::span<char> out) const noexcept;
+  [[nodiscard]] std::string to_string() const;
+};
+
+/// Feedback from the TPDOs, in drive units (counts).
+struct Feedback {
+  std::uint16_t statusword = 0;
+  std::int32_t position = 0;     ///< 0x6064
+  std::int32_t velocity = 0;     ///< 0x606C (if mapped)
+  std::int16_t torque = 0;       ///< 0x6077 (if mapped)
+  std::int8_t mode_display = 0;  ///< 0x6061 (if mapped; otherwise the mode last confirmed over SDO)
+  std::uint64_t tpdo_count = 0;
+  std::uint64_t tpdo_missed = 0;  ///< cycles in which TPDO1 did not arrive after a SYNC
+  std::int64_t last_tpdo_ns = 0;
+};
+
+class DriveProxy {
+ public:
+  /// Registers `cfg.node` with `master` (set-up; allocates).
+  DriveProxy(const DriveConfig& cfg, canopen::Master& master);
+
+  /// Feed a received frame; consumes this node's TPDOs (returns true).
+  bool on_frame(const can::TimedFrame& f) noexcept;
+  /// Feed a master event concerning this node.
+  void on_node_event(const canopen::NodeEvent& e) noexcept;
+  /// Boot/configuration progress, state machine, then the RPDOs of this
+  /// cycle (only when operational). Call before the cycle's SYNC.
+  void step(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  /// Tell the proxy the cycle's SYNC went out (arms missed-TPDO counting).
+  void on_sync_sent() noexcept;
+
+  // ---- commands ---------------------------------------------------------
+  /// Go to Operation enabled (2, 3, 4; a fault must be reset first). Clears a
+  /// previous transition failure.
+  void enable() noexcept;
+  /// Go to Switch on disabled (disable voltage: 7, 9, 10, 12).
+  void disable() noexcept;
+  /// Go to Switched on (disable operation: 5).
+  void disable_operation() noexcept;
+  /// Quick stop (11).
+  void quick_stop() noexcept;
+  /// Reset a fault (15, with the 0 -> 1 edge of bit 7); ends in Switch on disabled.
+  void fault_reset() noexcept;
+  /// Switch between CSP, CSV and CST (through RPDO2 with PdoProfile::kCspCsvCst,
+  /// otherwise an SDO write of 0x6060). The new mode's target starts at the
+  /// actual value. False for other modes or a full SDO queue.
+  bool set_mode(Mode m) noexcept;
+  /// Targets in drive units; used only while Operation enabled.
+  void set_target_position(std::int32_t counts) noexcept { target_position_ = counts; }
+  void set_target_velocity(std::int32_t counts_per_s) noexcept { target_velocity_ = counts_per_s; }
+  void set_target_torque(std::int16_t per_mille) noexcept { target_torque_ = per_mille; }
+  /// Restart the boot sequence (after a failure or an unexpected reboot).
+  void restart() noexcept;
+
+  // ---- state --------------------------------------------------------------
+  [[nodiscard]] std::uint8_t node() const noexcept { return cfg_.node; }
+  [[nodiscard]] Phase phase() const noexcept { return phase_; }
+  [[nodiscard]] State state() const noexcept { return state_; }
+  [[nodiscard]] State wanted() const noexcept { return wanted_; }
+  /// True in Operation enabled with the targets taken from the setters.
+  [[nodiscard]] bool enabled() const noexcept { return phase_ == Phase::kOperational && state_ == State::kOperationEnabled; }
+  /// True while no transition is in progress (the state is the wanted one).
+  [[nodiscard]] bool settled() const noexcept { return state_ == wanted_; }
+  [[nodiscard]] const Feedback& feedback() const noexcept { return fb_; }
+  [[nodiscard]] Mode mode() const noexcept { return mode_; }
+  [[nodiscard]] std::int32_t target_position() const noexcept { return target_position_; }
+  [[nodiscard]] std::int32_t target_velocity() const noexcept { return target_velocity_; }
+  [[nodiscard]] std::int16_t target_torque() const noexcept { return target_torque_; }
+  [[nodiscard]] std::uint16_t controlword() const noexcept { return cw_; }
+  [[nodiscard]] const Failure& failure() const noexcept { return failure_; }
+  [[nodiscard]] bool failed() const noexcept { return failure_.kind != FailureKind::kNone; }
+  /// Clear the recorded failure (the state machine keeps its state).
+  void clear_failure() noexcept { failure_ = Failure{}; }
+  [[nodiscard]] std::uint16_t last_emcy_code() const noexcept { return emcy_code_; }
+  [[nodiscard]] bool has_emcy() const noexcept { return has_emcy_; }
+  [[nodiscard]] const DriveConfig& config() const noexcept { return cfg_; }
+  [[nodiscard]] const DrivePdoSet& pdos() const noexcept { return pdos_; }
+
+ private:
+  void build_configuration();
+  void fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept;
+  void step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  void step_state_machine(std::int64_t now_ns) noexcept;
+  void send_rpdos(canopen::FrameSink& out) noexcept;
+  void follow_actual() noexcept;
+  void set_wanted(State s) noexcept;
+
+  DriveConfig cfg_;
+  canopen::Master& master_;
+  DrivePdoSet pdos_;
+  std::vector<SdoWrite> writes_;  // the whole boot configuration, built at set-up
+  std::size_t next_write_ = 0;
+  std::size_t done_writes_ = 0;
+
+  Phase phase_ = Phase::kWaitBoot;
+  bool started_ = false;
+  std::int64_t phase_since_ns_ = 0;
+  State state_ = State::kUnknown;
+  State wanted_ = State::kSwitchOnDisabled;
+  bool reset_requested_ = false;
+  // The transition in progress.
+  bool in_flight_ = false;
+  PlanStep flight_{Command::kShutdown, kNoTransition, State::kUnknown};
+  State flight_from_ = State::kUnknown;
+  std::int64_t flight_since_ns_ = 0;
+  std::uint32_t flight_cycles_ = 0;
+
+  Mode mode_ = Mode::kCsp;
+  Mode sdo_mode_pending_ = Mode::kNoMode;
+  std::uint16_t cw_ = 0;
+  std::int32_t target_position_ = 0;
+  std::int32_t target_velocity_ = 0;
+  std::int16_t target_torque_ = 0;
+  Feedback fb_{};
+  bool got_tpdo_ = false;
+  bool expect_tpdo_ = false;
+  bool tpdo_seen_ = false;
+  bool has_emcy_ = false;
+  std::uint16_t emcy_code_ = 0;
+  Failure failure_{};
+  std::int64_t now_ns_ = 0;
+  // Offsets of the mapped objects (computed at set-up): RPDO/TPDO number
+  // (0-based) and entry index, or -1.
+  struct Slot {
+    std::int8_t pdo = -1;
+    std::int8_t entry = -1;
+  };
+  Slot cw_slot_, tpos_slot_, tvel_slot_, ttrq_slot_, mode_slot_;
+  Slot sw_slot_, pos_slot_, vel_slot_, trq_slot_, mdisp_slot_;
+};
+
+struct NetworkConfig {
+  canopen::MasterConfig master{};
+};
+
+/// The CANopen master plus one DriveProxy per node: the object the RT
+/// controller calls each cycle.
+class DriveNetwork {
+ public:
+  /// Events kept for the application between poll_event() calls.
+  static constexpr std::size_t kEventCapacity = 512;
+
+  explicit DriveNetwork(const NetworkConfig& cfg = {});
+  /// Add a drive (set-up time). Throws std::invalid_argument for an invalid
+  /// or duplicate node-ID.
+  DriveProxy& add_drive(const DriveConfig& cfg);
+
+  /// Feed one received frame (heartbeat, EMCY, SDO, TPDO). Realtime-safe.
+  void on_frame(const can::TimedFrame& f) noexcept;
+  /// One cycle: master step (heartbeat, SDO), events to the proxies, each
+  /// proxy's step (RPDOs), then SYNC. Realtime-safe.
+  void cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+
+  [[nodiscard]] canopen::Master& master() noexcept { return master_; }
+  [[nodiscard]] DriveProxy* drive(std::uint8_t node) noexcept;
+  [[nodiscard]] std::size_t size() const noexcept { return drives_.size(); }
+  [[nodiscard]] DriveProxy& at(std::size_t i) noexcept { return *drives_[i]; }
+  /// All drives operational (NMT started, first TPDO seen).
+  [[nodiscard]] bool all_operational() const noexcept;
+  /// All drives in Operation enabled.
+  [[nodiscard]] bool all_enabled() const noexcept;
+  /// Any drive has a recorded failure.
+  [[nodiscard]] bool any_failed() const noexcept;
+  void enable_all() noexcept;
+  void disable_all() noexcept;
+  /// Master events (boot-up, heartbeat lost, EMCY, ...) for the application.
+  bool poll_event(canopen::NodeEvent& out) noexcept;
+
+ private:
+  canopen::Master master_;
+  std::vector<std::unique_ptr<DriveProxy>> drives_;
+  std::array<std::int16_t, 128> index_{};
+  std::vector<canopen::NodeEvent> events_;
+  std::size_t ev_head_ = 0;
+  std::size_t ev_count_ = 0;
+};
+
+}  // namespace canmotion::cia402
