@@ -1,0 +1,159 @@
+#pragma once
+/// \file
+/// canmotion configuration: the YAML file's data model, loading and
+/// validation. Nothing here touches a bus: a configuration is fully validated
+/// (keys, types, ranges, names, node ids, COB-IDs, 0x60C2 against the period,
+/// bus budget) before the runtime opens anything.
+///
+/// Not realtime-safe: everything here runs at start-up.
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fieldbus/cia402/drive_pdos.hpp"
+#include "motion/axis.hpp"
+
+namespace canmotion::config {
+
+/// Where a value came from: 1-based line and column (0 = unknown).
+struct Location {
+  int line = 0;
+  int column = 0;
+};
+
+/// One finding of the validator. `key` is the dotted path, e.g. `axes[2].max_speed`.
+struct Diagnostic {
+  enum class Severity : std::uint8_t { kError, kWarning };
+  Severity severity = Severity::kError;
+  std::string file;
+  Location where;
+  std::string key;
+  std::string message;
+  /// `file:line:column: error: key: message`
+  [[nodiscard]] std::string str() const;
+};
+
+/// Thrown by load_file/load_string when the configuration has errors. what()
+/// lists every error, one per line; diagnostics() has them as data.
+class ConfigError : public std::runtime_error {
+ public:
+  explicit ConfigError(std::vector<Diagnostic> diags);
+  [[nodiscard]] const std::vector<Diagnostic>& diagnostics() const noexcept { return diags_; }
+
+ private:
+  std::vector<Diagnostic> diags_;
+};
+
+/// `controller:` section.
+struct ControllerSettings {
+  double period_s = 0.001;  ///< cycle period; 0.25 ms .. 100 ms
+  int priority = 80;        ///< SCHED_FIFO priority 1..99; 0 = run without real-time scheduling
+  int cpu = -1;             ///< CPU to pin the cyclic thread to; -1 = no affinity
+  bool lock_memory = true;  ///< mlockall + stack prefault
+  Location where;
+};
+
+/// One `buses:` entry.
+struct BusSettings {
+  std::string name;
+  std::string interface = "sim";     ///< "sim" (in-process SimBus) or a SocketCAN interface (vcan0, can0)
+  std::uint32_t bitrate = 1'000'000;  ///< bit/s, for the bus budget
+  std::uint8_t master_node = 127;     ///< node id of the master's own heartbeat (0x700 + id)
+  std::uint16_t master_heartbeat_ms = 100;  ///< master heartbeat producer period; 0 = off
+  std::uint8_t sync_counter_overflow = 0;   ///< 0 = SYNC without counter, else 2..240
+  Location where;
+  [[nodiscard]] bool is_sim() const noexcept { return interface == "sim"; }
+};
+
+/// Per-node timeouts.
+struct DriveTimeouts {
+  std::uint32_t sdo_ms = 200;          ///< one SDO transfer
+  std::uint32_t boot_ms = 5000;        ///< boot-up through configuration to NMT operational
+  std::uint32_t transition_ms = 1000;  ///< one CiA 402 state transition
+  std::uint32_t mode_switch_ms = 500;  ///< 0x6061 following a 0x6060 change
+};
+
+/// One extra SDO download done at boot, after canmotion's own configuration.
+struct SdoWrite {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  std::uint8_t size = 4;  ///< bytes: 1, 2 or 4
+  std::int64_t value = 0;
+  Location where;
+};
+
+/// Drive settings: top-level `drives:` gives the defaults, an axis's own
+/// `drive:` block overrides them key by key.
+struct DriveSettings {
+  DriveTimeouts timeouts;
+  cia402::PdoProfile pdo = cia402::PdoProfile::kCsp;
+  std::uint16_t heartbeat_ms = 50;                ///< drive heartbeat producer (0x1017)
+  std::uint16_t master_heartbeat_timeout_ms = 300;  ///< drive's consumer of the master's heartbeat (0x1016); 0 = off
+  std::uint16_t following_error_window = 0;       ///< written to 0x6065 when non-zero (counts)
+  std::vector<SdoWrite> sdo_writes;
+};
+
+/// One `axes:` entry.
+struct AxisSettings {
+  std::string name;
+  motion::AxisConfig axis;  ///< planner configuration (type, units, limits, homing, exception actions)
+  std::string bus;          ///< AXIS_CIP_DRIVE only
+  std::uint8_t node = 0;    ///< AXIS_CIP_DRIVE only: CANopen node id 1..127
+  DriveSettings drive;      ///< AXIS_CIP_DRIVE only
+  Location where;
+};
+
+/// One cam point as in a Logix CAM array.
+struct CamPoint {
+  double master = 0.0;
+  double slave = 0.0;
+  bool cubic = false;  ///< segment type: false linear, true cubic
+};
+
+/// One `cams:` entry; computed (MCCP) at load by the runtime.
+struct CamSettings {
+  std::string name;
+  std::vector<CamPoint> points;
+  double start_slope = 0.0;
+  double end_slope = 0.0;
+  Location where;
+};
+
+/// A whole, validated configuration.
+struct Config {
+  std::string path;
+  ControllerSettings controller;
+  std::vector<BusSettings> buses;
+  std::vector<AxisSettings> axes;
+  std::vector<CamSettings> cams;
+  std::vector<Diagnostic> warnings;  ///< e.g. bus load over 70 %
+
+  [[nodiscard]] const BusSettings* find_bus(std::string_view name) const noexcept;
+  [[nodiscard]] const AxisSettings* find_axis(std::string_view name) const noexcept;
+};
+
+/// Load and validate a file. Throws ConfigError (all errors at once) or
+/// std::system_error when the file cannot be read.
+[[nodiscard]] Config load_file(const std::string& path);
+
+/// Load and validate YAML text; `name` stands for the file in messages.
+[[nodiscard]] Config load_string(std::string_view yaml, const std::string& name = "<string>");
+
+/// The closest of `candidates` to `word` by edit distance, if close enough to
+/// be a plausible typo (at most a third of the word's length, min 2).
+[[nodiscard]] std::optional<std::string> nearest(std::string_view word, const std::vector<std::string_view>& candidates);
+
+/// 0x60C2 representation of a period: mantissa (0x60C2:01, 1..255) and
+/// exponent (0x60C2:02, -128..63) with mantissa * 10^exponent == period
+/// exactly (to 1 ns). nullopt when the period has no such form.
+struct InterpolationPeriod {
+  std::uint8_t mantissa = 1;
+  std::int8_t exponent = -3;
+};
+[[nodiscard]] std::optional<InterpolationPeriod> interpolation_period(double period_s) noexcept;
+
+}  // namespace canmotion::config

@@ -1,0 +1,636 @@
+// YAML loading and validation of the canmotion configuration.
+//
+// The loader walks the document once, collecting every problem as a
+// Diagnostic (file, line, column, dotted key, message with what would be
+// valid) instead of stopping at the first, then runs the cross-checks (names,
+// node ids, COB-IDs, 0x60C2, bus budget). Only a configuration without errors
+// is returned.
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include <fmt/format.h>
+
+#include "config/config.hpp"
+#include "fieldbus/canopen/bus_budget.hpp"
+#include "fieldbus/canopen/cob_id.hpp"
+
+namespace canmotion::config {
+
+std::string Diagnostic::str() const {
+  return fmt::format("{}:{}:{}: {}: {}{}{}", file, where.line, where.column,
+                     severity == Severity::kError ? "error" : "warning", key, key.empty() ? "" : ": ", message);
+}
+
+namespace {
+
+std::string join_errors(const std::vector<Diagnostic>& d) {
+  std::string s;
+  for (const auto& x : d) {
+    if (!s.empty()) s += '\n';
+    s += x.str();
+  }
+  return s;
+}
+
+}  // namespace
+
+ConfigError::ConfigError(std::vector<Diagnostic> diags) : std::runtime_error(join_errors(diags)), diags_(std::move(diags)) {}
+
+const BusSettings* Config::find_bus(std::string_view name) const noexcept {
+  for (const auto& b : buses)
+    if (b.name == name) return &b;
+  return nullptr;
+}
+
+const AxisSettings* Config::find_axis(std::string_view name) const noexcept {
+  for (const auto& a : axes)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+std::optional<std::string> nearest(std::string_view word, const std::vector<std::string_view>& candidates) {
+  std::size_t best = std::string_view::npos;
+  std::string_view best_word;
+  for (std::string_view c : candidates) {
+    // Levenshtein distance, two rows.
+    std::vector<std::size_t> prev(c.size() + 1), cur(c.size() + 1);
+    for (std::size_t j = 0; j <= c.size(); ++j) prev[j] = j;
+    for (std::size_t i = 1; i <= word.size(); ++i) {
+      cur[0] = i;
+      for (std::size_t j = 1; j <= c.size(); ++j) {
+        const bool same = std::tolower(static_cast<unsigned char>(word[i - 1])) ==
+                          std::tolower(static_cast<unsigned char>(c[j - 1]));
+        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (same ? 0 : 1)});
+      }
+      std::swap(prev, cur);
+    }
+    if (prev[c.size()] < best) {
+      best = prev[c.size()];
+      best_word = c;
+    }
+  }
+  const std::size_t limit = std::max<std::size_t>(2, word.size() / 3);
+  if (best_word.empty() || best > limit) return std::nullopt;
+  return std::string(best_word);
+}
+
+std::optional<InterpolationPeriod> interpolation_period(double period_s) noexcept {
+  if (!(period_s > 0)) return std::nullopt;
+  // The first exponent (from 10^-9 up) giving an integral mantissa <= 255,
+  // then reduced so the mantissa has no factor 10: 1 ms -> 1 x 10^-3.
+  for (int e = -9; e <= 0; ++e) {
+    const double m = period_s / std::pow(10.0, e);
+    const double r = std::round(m);
+    if (r >= 1 && r <= 255 && std::abs(m - r) < 1e-6) {
+      // Reduce: a mantissa divisible by 10 moves to a larger exponent.
+      long mi = static_cast<long>(r);
+      int ei = e;
+      while (mi % 10 == 0 && mi > 0) {
+        mi /= 10;
+        ++ei;
+      }
+      return InterpolationPeriod{static_cast<std::uint8_t>(mi), static_cast<std::int8_t>(ei)};
+    }
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+using Severity = Diagnostic::Severity;
+
+std::string lower_compact(std::string_view s) {
+  std::string out;
+  for (char c : s)
+    if (c != ' ' && c != '_' && c != '-') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+/// Walks one document, collecting diagnostics.
+class Loader {
+ public:
+  explicit Loader(std::string file) : file_(std::move(file)) {}
+
+  std::vector<Diagnostic> diags;
+
+  Location loc(const YAML::Node& n) const {
+    const YAML::Mark m = n.Mark();
+    if (m.line < 0) return {};
+    return {m.line + 1, m.column + 1};
+  }
+
+  void error(const YAML::Node& n, const std::string& key, std::string msg) {
+    diags.push_back({Severity::kError, file_, loc(n), key, std::move(msg)});
+  }
+  void error_at(Location l, const std::string& key, std::string msg) {
+    diags.push_back({Severity::kError, file_, l, key, std::move(msg)});
+  }
+  void warning_at(Location l, const std::string& key, std::string msg) {
+    diags.push_back({Severity::kWarning, file_, l, key, std::move(msg)});
+  }
+
+  /// Reject keys of `map` not in `allowed`, suggesting the nearest.
+  bool check_map(const YAML::Node& map, const std::string& path, const std::vector<std::string_view>& allowed) {
+    if (!map.IsMap()) {
+      error(map, path, "must be a mapping (key: value lines)");
+      return false;
+    }
+    for (auto it = map.begin(); it != map.end(); ++it) {
+      const std::string k = it->first.Scalar();
+      if (std::find(allowed.begin(), allowed.end(), k) != allowed.end()) continue;
+      std::string msg = fmt::format("unknown key '{}'", k);
+      if (auto s = nearest(k, allowed)) msg += fmt::format("; did you mean '{}'?", *s);
+      else msg += fmt::format("; valid keys: {}", fmt::join(allowed, ", "));
+      error(it->first, path.empty() ? k : path + "." + k, msg);
+    }
+    return true;
+  }
+
+  static std::string sub(const std::string& path, std::string_view key) {
+    return path.empty() ? std::string(key) : path + "." + std::string(key);
+  }
+
+  template <class T>
+  bool scalar(const YAML::Node& parent, const std::string& path, std::string_view key, T& out, T lo, T hi,
+              std::string_view unit = {}) {
+    const YAML::Node n = parent[std::string(key)];
+    if (!n) return false;
+    const std::string p = sub(path, key);
+    if (!n.IsScalar()) {
+      error(n, p, "must be a single value");
+      return false;
+    }
+    T v{};
+    bool ok = true;
+    if constexpr (std::is_same_v<T, bool>) {
+      const std::string s = lower_compact(n.Scalar());
+      if (s == "true" || s == "yes" || s == "on" || s == "1") v = true;
+      else if (s == "false" || s == "no" || s == "off" || s == "0") v = false;
+      else ok = false;
+      if (!ok) {
+        error(n, p, fmt::format("must be true or false, got '{}'", n.Scalar()));
+        return false;
+      }
+      out = v;
+      return true;
+    } else if constexpr (std::is_floating_point_v<T>) {
+      ok = YAML::convert<double>::decode(n, v) && std::isfinite(v);
+    } else {
+      // Integers: decimal or 0x hex, no fraction.
+      const std::string& s = n.Scalar();
+      errno = 0;
+      char* end = nullptr;
+      const long long ll = std::strtoll(s.c_str(), &end, 0);
+      ok = !s.empty() && end != nullptr && *end == '\0' && errno == 0;
+      v = static_cast<T>(ll);
+      if (ok && (ll < static_cast<long long>(lo) || ll > static_cast<long long>(hi))) {
+        error(n, p, fmt::format("must be {} .. {}{}{}, got {}", lo, hi, unit.empty() ? "" : " ", unit, s));
+        return false;
+      }
+    }
+    if (!ok) {
+      error(n, p, fmt::format("must be a {} number{}{}, got '{}'", std::is_floating_point_v<T> ? "real" : "whole",
+                              unit.empty() ? "" : " in ", unit, n.Scalar()));
+      return false;
+    }
+    if (v < lo || v > hi) {
+      error(n, p, fmt::format("must be {} .. {}{}{}, got {}", lo, hi, unit.empty() ? "" : " ", unit, n.Scalar()));
+      return false;
+    }
+    out = v;
+    return true;
+  }
+
+  bool string(const YAML::Node& parent, const std::string& path, std::string_view key, std::string& out) {
+    const YAML::Node n = parent[std::string(key)];
+    if (!n) return false;
+    if (!n.IsScalar() || n.Scalar().empty()) {
+      error(n, sub(path, key), "must be a non-empty string");
+      return false;
+    }
+    out = n.Scalar();
+    return true;
+  }
+
+  /// Enumeration by text (case, spaces and underscores ignored) or number.
+  template <class E>
+  bool enumeration(const YAML::Node& parent, const std::string& path, std::string_view key, E& out,
+                   const std::vector<std::pair<std::string_view, E>>& table) {
+    const YAML::Node n = parent[std::string(key)];
+    if (!n) return false;
+    const std::string p = sub(path, key);
+    if (n.IsScalar()) {
+      const std::string s = lower_compact(n.Scalar());
+      for (const auto& [name, val] : table) {
+        if (lower_compact(name) == s || std::to_string(static_cast<int>(val)) == s) {
+          out = val;
+          return true;
+        }
+      }
+    }
+    std::vector<std::string> names;
+    for (const auto& [name, val] : table) names.push_back(fmt::format("{} ({})", name, static_cast<int>(val)));
+    error(n, p, fmt::format("'{}' is not one of: {}", n.IsScalar() ? n.Scalar() : std::string("<non-scalar>"),
+                            fmt::join(names, ", ")));
+    return false;
+  }
+
+  ControllerSettings controller(const YAML::Node& n) {
+    ControllerSettings c;
+    c.where = loc(n);
+    if (!check_map(n, "controller", {"period_ms", "priority", "cpu", "lock_memory"})) return c;
+    double ms = c.period_s * 1e3;
+    if (scalar(n, "controller", "period_ms", ms, 0.25, 100.0, "ms")) c.period_s = ms / 1e3;
+    scalar(n, "controller", "priority", c.priority, 0, 99);
+    scalar(n, "controller", "cpu", c.cpu, -1, 1023);
+    scalar(n, "controller", "lock_memory", c.lock_memory, false, true);
+    return c;
+  }
+
+  BusSettings bus(const YAML::Node& n, const std::string& path) {
+    BusSettings b;
+    b.where = loc(n);
+    if (!check_map(n, path, {"name", "interface", "bitrate", "master_node", "master_heartbeat_ms", "sync_counter_overflow"}))
+      return b;
+    if (!string(n, path, "name", b.name)) error(n, path + ".name", "missing: every bus needs a name");
+    if (string(n, path, "interface", b.interface) && b.interface.size() >= 16)
+      error(n["interface"], path + ".interface", "an interface name has at most 15 characters");
+    scalar(n, path, "bitrate", b.bitrate, 10'000u, 1'000'000u, "bit/s");
+    scalar(n, path, "master_node", b.master_node, std::uint8_t{1}, std::uint8_t{127});
+    scalar(n, path, "master_heartbeat_ms", b.master_heartbeat_ms, std::uint16_t{0}, std::uint16_t{65535}, "ms");
+    std::uint8_t sc = b.sync_counter_overflow;
+    if (scalar(n, path, "sync_counter_overflow", sc, std::uint8_t{0}, std::uint8_t{240})) {
+      if (sc == 1) error(n["sync_counter_overflow"], path + ".sync_counter_overflow",
+                         "must be 0 (no counter) or 2 .. 240 (CiA 301 0x1019), got 1");
+      else b.sync_counter_overflow = sc;
+    }
+    return b;
+  }
+
+  void timeouts(const YAML::Node& n, const std::string& path, DriveTimeouts& t) {
+    if (!check_map(n, path, {"sdo_ms", "boot_ms", "transition_ms", "mode_switch_ms"})) return;
+    scalar(n, path, "sdo_ms", t.sdo_ms, 1u, 60'000u, "ms");
+    scalar(n, path, "boot_ms", t.boot_ms, 10u, 600'000u, "ms");
+    scalar(n, path, "transition_ms", t.transition_ms, 1u, 60'000u, "ms");
+    scalar(n, path, "mode_switch_ms", t.mode_switch_ms, 1u, 60'000u, "ms");
+  }
+
+  void drive(const YAML::Node& n, const std::string& path, DriveSettings& d) {
+    if (!check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
+                             "following_error_window", "sdo_writes"}))
+      return;
+    if (n["timeouts"]) timeouts(n["timeouts"], path + ".timeouts", d.timeouts);
+    enumeration(n, path, "pdo", d.pdo,
+                {{"csp", cia402::PdoProfile::kCsp}, {"csp_csv_cst", cia402::PdoProfile::kCspCsvCst}});
+    scalar(n, path, "heartbeat_ms", d.heartbeat_ms, std::uint16_t{0}, std::uint16_t{65535}, "ms");
+    scalar(n, path, "master_heartbeat_timeout_ms", d.master_heartbeat_timeout_ms, std::uint16_t{0},
+           std::uint16_t{65535}, "ms");
+    scalar(n, path, "following_error_window", d.following_error_window, std::uint16_t{0}, std::uint16_t{65535},
+           "counts");
+    if (const YAML::Node w = n["sdo_writes"]) {
+      if (!w.IsSequence()) {
+        error(w, path + ".sdo_writes", "must be a list of {index, sub, size, value}");
+      } else {
+        d.sdo_writes.clear();
+        for (std::size_t i = 0; i < w.size(); ++i) {
+          const std::string p = fmt::format("{}.sdo_writes[{}]", path, i);
+          const YAML::Node e = w[i];
+          SdoWrite s;
+          s.where = loc(e);
+          if (!check_map(e, p, {"index", "sub", "size", "value"})) continue;
+          if (!e["index"] || !e["value"]) {
+            error(e, p, "needs at least index and value");
+            continue;
+          }
+          scalar(e, p, "index", s.index, std::uint16_t{0x1000}, std::uint16_t{0xFFFF});
+          scalar(e, p, "sub", s.sub, std::uint8_t{0}, std::uint8_t{254});
+          if (scalar(e, p, "size", s.size, std::uint8_t{1}, std::uint8_t{4}) && s.size == 3)
+            error(e["size"], p + ".size", "must be 1, 2 or 4 bytes, got 3");
+          scalar(e, p, "value", s.value, std::int64_t{-2147483648LL}, std::int64_t{4294967295LL});
+          d.sdo_writes.push_back(s);
+        }
+      }
+    }
+  }
+
+  void homing(const YAML::Node& n, const std::string& path, motion::HomingConfig& h) {
+    if (!check_map(n, path, {"mode", "sequence", "position", "method", "speed_search", "speed_zero", "accel"})) return;
+    using M = motion::HomingConfig::Mode;
+    using S = motion::HomingConfig::Sequence;
+    enumeration(n, path, "mode", h.mode, {{"Passive", M::Passive}, {"Active", M::Active}, {"Absolute", M::Absolute}});
+    enumeration(n, path, "sequence", h.sequence,
+                {{"Immediate", S::Immediate}, {"Switch", S::Switch}, {"Marker", S::Marker},
+                 {"Switch Marker", S::SwitchMarker}, {"Torque Level", S::TorqueLevel},
+                 {"Torque Level Marker", S::TorqueLevelMarker}});
+    scalar(n, path, "position", h.home_position, -1e12, 1e12, "units");
+    scalar(n, path, "method", h.cia_method, std::int8_t{-128}, std::int8_t{127});
+    scalar(n, path, "speed_search", h.speed_search, 0.0, 1e12, "units/s");
+    scalar(n, path, "speed_zero", h.speed_zero, 0.0, 1e12, "units/s");
+    scalar(n, path, "accel", h.accel, 0.0, 1e15, "units/s^2");
+  }
+
+  void exception_actions(const YAML::Node& n, const std::string& path, motion::AxisConfig& a) {
+    using K = motion::ExceptionKind;
+    using A = motion::ExceptionAction;
+    static const std::vector<std::pair<std::string_view, K>> kinds = {
+        {"position_error", K::PositionError},       {"drive_fault", K::DriveFault},
+        {"node_lost", K::NodeLost},                 {"soft_overtravel_positive", K::SoftOvertravelPos},
+        {"soft_overtravel_negative", K::SoftOvertravelNeg}, {"bus_off", K::BusOff}};
+    std::vector<std::string_view> keys;
+    for (const auto& k : kinds) keys.push_back(k.first);
+    if (!check_map(n, path, keys)) return;
+    const std::vector<std::pair<std::string_view, A>> actions = {
+        {"Ignore", A::Ignore},           {"Alarm", A::Alarm},         {"Fault Status Only", A::FaultStatusOnly},
+        {"Stop Planner", A::StopPlanner}, {"Stop Drive", A::StopDrive}, {"Shutdown", A::Shutdown}};
+    for (const auto& [name, kind] : kinds)
+      enumeration(n, path, name, a.exception_actions[static_cast<std::size_t>(kind)], actions);
+  }
+
+  AxisSettings axis(const YAML::Node& n, const std::string& path, const DriveSettings& defaults) {
+    AxisSettings a;
+    a.where = loc(n);
+    a.drive = defaults;
+    if (!check_map(n, path, {"name", "type", "bus", "node", "units", "conversion_constant", "rotary", "unwind",
+                             "max_speed", "max_accel", "max_decel", "max_accel_jerk", "max_decel_jerk",
+                             "soft_limits", "position_error_tolerance", "homing", "exception_actions", "drive"}))
+      return a;
+    if (!string(n, path, "name", a.name)) error(n, path + ".name", "missing: every axis needs a name");
+    auto& c = a.axis;
+    if (!n["type"]) {
+      error(n, path + ".type", "missing: AXIS_VIRTUAL or AXIS_CIP_DRIVE");
+    } else {
+      enumeration(n, path, "type", c.type,
+                  {{"AXIS_VIRTUAL", motion::AxisType::Virtual}, {"AXIS_CIP_DRIVE", motion::AxisType::CipDrive}});
+    }
+    std::string units;
+    if (string(n, path, "units", units)) {
+      if (units.size() >= sizeof c.units_name) error(n["units"], path + ".units", "at most 15 characters");
+      else std::copy(units.c_str(), units.c_str() + units.size() + 1, c.units_name);
+    }
+    scalar(n, path, "conversion_constant", c.conversion_constant, 1e-9, 1e12, "counts/unit");
+    scalar(n, path, "rotary", c.rotary, false, true);
+    scalar(n, path, "unwind", c.unwind, 1e-9, 1e12, "units/rev");
+    scalar(n, path, "max_speed", c.max_speed, 1e-12, 1e12, "units/s");
+    scalar(n, path, "max_accel", c.max_accel, 1e-12, 1e15, "units/s^2");
+    scalar(n, path, "max_decel", c.max_decel, 1e-12, 1e15, "units/s^2");
+    scalar(n, path, "max_accel_jerk", c.max_accel_jerk, 1e-12, 1e18, "units/s^3");
+    scalar(n, path, "max_decel_jerk", c.max_decel_jerk, 1e-12, 1e18, "units/s^3");
+    scalar(n, path, "position_error_tolerance", c.position_error_tolerance, 0.0, 1e12, "units");
+    if (const YAML::Node s = n["soft_limits"]) {
+      const std::string p = path + ".soft_limits";
+      if (check_map(s, p, {"enabled", "positive", "negative"})) {
+        scalar(s, p, "enabled", c.soft_limits_enabled, false, true);
+        scalar(s, p, "positive", c.soft_limit_pos, -1e12, 1e12, "units");
+        scalar(s, p, "negative", c.soft_limit_neg, -1e12, 1e12, "units");
+        if (c.soft_limits_enabled && c.soft_limit_neg >= c.soft_limit_pos)
+          error(s, p, fmt::format("negative limit {} must be below positive limit {}", c.soft_limit_neg,
+                                  c.soft_limit_pos));
+      }
+    }
+    if (n["homing"]) homing(n["homing"], path + ".homing", c.homing);
+    if (n["exception_actions"]) exception_actions(n["exception_actions"], path + ".exception_actions", c);
+    const bool cip = c.type == motion::AxisType::CipDrive;
+    if (cip) {
+      if (!string(n, path, "bus", a.bus)) error(n, path + ".bus", "missing: an AXIS_CIP_DRIVE axis needs the bus of its drive");
+      if (!n["node"]) error(n, path + ".node", "missing: an AXIS_CIP_DRIVE axis needs its drive's node id (1 .. 127)");
+      scalar(n, path, "node", a.node, std::uint8_t{1}, std::uint8_t{127});
+      if (n["drive"]) drive(n["drive"], path + ".drive", a.drive);
+    } else {
+      for (std::string_view k : {"bus", "node", "drive"})
+        if (n[std::string(k)]) error(n[std::string(k)], sub(path, k), "only an AXIS_CIP_DRIVE axis has a drive; this axis is AXIS_VIRTUAL");
+    }
+    if (c.rotary && c.homing.home_position >= c.unwind)
+      error(n["homing"] ? n["homing"] : n, path + ".homing.position",
+            fmt::format("on a rotary axis the home position must be in [0, unwind={})", c.unwind));
+    return a;
+  }
+
+  CamSettings cam(const YAML::Node& n, const std::string& path) {
+    CamSettings c;
+    c.where = loc(n);
+    if (!check_map(n, path, {"name", "points", "start_slope", "end_slope"})) return c;
+    if (!string(n, path, "name", c.name)) error(n, path + ".name", "missing: every cam needs a name");
+    scalar(n, path, "start_slope", c.start_slope, -1e12, 1e12);
+    scalar(n, path, "end_slope", c.end_slope, -1e12, 1e12);
+    const YAML::Node pts = n["points"];
+    if (!pts || !pts.IsSequence()) {
+      error(pts ? pts : n, path + ".points", "must be a list of [master, slave] or [master, slave, linear|cubic]");
+      return c;
+    }
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const YAML::Node p = pts[i];
+      const std::string key = fmt::format("{}.points[{}]", path, i);
+      if (!p.IsSequence() || (p.size() != 2 && p.size() != 3)) {
+        error(p, key, "must be [master, slave] or [master, slave, linear|cubic]");
+        continue;
+      }
+      CamPoint cp;
+      if (!YAML::convert<double>::decode(p[0], cp.master) || !YAML::convert<double>::decode(p[1], cp.slave)) {
+        error(p, key, "master and slave must be numbers");
+        continue;
+      }
+      if (p.size() == 3) {
+        const std::string t = lower_compact(p[2].Scalar());
+        if (t == "cubic" || t == "1") cp.cubic = true;
+        else if (t != "linear" && t != "0") error(p[2], key, fmt::format("segment type must be linear (0) or cubic (1), got '{}'", p[2].Scalar()));
+      }
+      if (!c.points.empty() && cp.master <= c.points.back().master)
+        error(p, key, fmt::format("master values must increase: {} follows {}", cp.master, c.points.back().master));
+      c.points.push_back(cp);
+    }
+    if (c.points.size() < 2) error(pts, path + ".points", fmt::format("needs at least 2 points, got {}", c.points.size()));
+    return c;
+  }
+
+  Config document(const YAML::Node& root) {
+    Config cfg;
+    cfg.path = file_;
+    if (!root || root.IsNull()) {
+      error_at({1, 1}, "", "the file is empty; it needs at least `axes:`");
+      return cfg;
+    }
+    if (!check_map(root, "", {"controller", "buses", "drives", "axes", "cams"})) return cfg;
+    if (root["controller"]) cfg.controller = controller(root["controller"]);
+    if (const YAML::Node b = root["buses"]) {
+      if (!b.IsSequence()) error(b, "buses", "must be a list of buses");
+      else
+        for (std::size_t i = 0; i < b.size(); ++i) cfg.buses.push_back(bus(b[i], fmt::format("buses[{}]", i)));
+    }
+    DriveSettings defaults;
+    if (root["drives"]) drive(root["drives"], "drives", defaults);
+    if (const YAML::Node a = root["axes"]) {
+      if (!a.IsSequence()) error(a, "axes", "must be a list of axes");
+      else
+        for (std::size_t i = 0; i < a.size(); ++i) cfg.axes.push_back(axis(a[i], fmt::format("axes[{}]", i), defaults));
+    } else {
+      error(root, "axes", "missing: a configuration needs at least one axis");
+    }
+    if (const YAML::Node c = root["cams"]) {
+      if (!c.IsSequence()) error(c, "cams", "must be a list of cams");
+      else
+        for (std::size_t i = 0; i < c.size(); ++i) cfg.cams.push_back(cam(c[i], fmt::format("cams[{}]", i)));
+    }
+    return cfg;
+  }
+
+  // ---- cross-checks ---------------------------------------------------------
+  void cross_check(Config& cfg) {
+    std::map<std::string, Location> names;
+    auto unique = [&](const std::string& name, Location l, const std::string& key, const char* what) {
+      if (name.empty()) return;
+      auto [it, fresh] = names.emplace(name, l);
+      if (!fresh)
+        error_at(l, key, fmt::format("{} name '{}' is already used at line {}", what, name, it->second.line));
+    };
+    for (std::size_t i = 0; i < cfg.buses.size(); ++i) unique(cfg.buses[i].name, cfg.buses[i].where, fmt::format("buses[{}].name", i), "bus");
+    names.clear();
+    for (std::size_t i = 0; i < cfg.axes.size(); ++i) unique(cfg.axes[i].name, cfg.axes[i].where, fmt::format("axes[{}].name", i), "axis");
+    for (std::size_t i = 0; i < cfg.cams.size(); ++i) unique(cfg.cams[i].name, cfg.cams[i].where, fmt::format("cams[{}].name", i), "tag");
+
+    const auto ip = interpolation_period(cfg.controller.period_s);
+    if (!ip)
+      error_at(cfg.controller.where, "controller.period_ms",
+               fmt::format("{} ms cannot be written to 0x60C2 (mantissa 1..255 x 10^exponent); use e.g. 0.5, 1, 2 or 4",
+                           cfg.controller.period_s * 1e3));
+
+    // Per bus: axes on it, node ids, COB-ID clashes, 0x60C2 writes, budget.
+    for (std::size_t bi = 0; bi < cfg.buses.size(); ++bi) {
+      const BusSettings& bus = cfg.buses[bi];
+      std::map<std::uint32_t, std::string> cob_owner;  // COB-ID -> who uses it
+      auto claim = [&](std::uint32_t cob, const std::string& who, Location l, const std::string& key) {
+        auto [it, fresh] = cob_owner.emplace(cob, who);
+        if (!fresh) error_at(l, key, fmt::format("COB-ID 0x{:03X} of {} clashes with {}", cob, who, it->second));
+      };
+      if (bus.master_heartbeat_ms > 0)
+        claim(canopen::cob::heartbeat(bus.master_node), fmt::format("the master's heartbeat (node {})", bus.master_node),
+              bus.where, fmt::format("buses[{}].master_node", bi));
+      std::vector<canopen::NodeTraffic> traffic;
+      for (std::size_t ai = 0; ai < cfg.axes.size(); ++ai) {
+        const AxisSettings& a = cfg.axes[ai];
+        if (a.axis.type != motion::AxisType::CipDrive || a.bus != bus.name || a.node == 0) continue;
+        const std::string key = fmt::format("axes[{}].node", ai);
+        const std::string who = fmt::format("axis '{}' (node {})", a.name, a.node);
+        const auto pdos = cia402::default_drive_pdos(a.drive.pdo, a.node);
+        claim(canopen::cob::heartbeat(a.node), who + " heartbeat", a.where, key);
+        claim(canopen::cob::sdo_tx(a.node), who + " SDO", a.where, key);
+        claim(canopen::cob::emcy(a.node), who + " EMCY", a.where, key);
+        canopen::NodeTraffic t;
+        for (std::uint8_t i = 0; i < pdos.rpdo_count; ++i) {
+          claim(pdos.rpdo[i].cob_id, fmt::format("{} RPDO{}", who, pdos.rpdo[i].number), a.where, key);
+          t.rpdo_bytes[t.rpdo_count++] = pdos.rpdo[i].size_bytes;
+        }
+        for (std::uint8_t i = 0; i < pdos.tpdo_count; ++i) {
+          claim(pdos.tpdo[i].cob_id, fmt::format("{} TPDO{}", who, pdos.tpdo[i].number), a.where, key);
+          t.tpdo_bytes[t.tpdo_count++] = pdos.tpdo[i].size_bytes;
+        }
+        t.heartbeat_ms = a.drive.heartbeat_ms;
+        traffic.push_back(t);
+        if (a.drive.master_heartbeat_timeout_ms > 0 && bus.master_heartbeat_ms == 0)
+          error_at(a.where, fmt::format("axes[{}].drive.master_heartbeat_timeout_ms", ai),
+                   fmt::format("the drive watches the master's heartbeat but bus '{}' has master_heartbeat_ms: 0", bus.name));
+        if (a.drive.master_heartbeat_timeout_ms > 0 && a.drive.master_heartbeat_timeout_ms <= bus.master_heartbeat_ms)
+          error_at(a.where, fmt::format("axes[{}].drive.master_heartbeat_timeout_ms", ai),
+                   fmt::format("{} ms must exceed the master's heartbeat period {} ms (CiA 301: consumer time > producer time)",
+                               a.drive.master_heartbeat_timeout_ms, bus.master_heartbeat_ms));
+        for (std::size_t wi = 0; wi < a.drive.sdo_writes.size(); ++wi) {
+          const SdoWrite& w = a.drive.sdo_writes[wi];
+          if (w.index != 0x60C2 || !ip) continue;
+          const bool mant = w.sub == 1 && w.value != ip->mantissa;
+          const bool expo = w.sub == 2 && w.value != ip->exponent;
+          if (mant || expo)
+            error_at(w.where, fmt::format("axes[{}].drive.sdo_writes[{}]", ai, wi),
+                     fmt::format("0x60C2:{:02X} = {} contradicts the controller period {} ms (0x60C2 = {} x 10^{} s, "
+                                 "written automatically; remove this write)",
+                                 w.sub, w.value, cfg.controller.period_s * 1e3, ip->mantissa, ip->exponent));
+        }
+      }
+      canopen::BusBudgetInput in;
+      in.cycle_ns = static_cast<std::int64_t>(std::llround(cfg.controller.period_s * 1e9));
+      in.bitrate = bus.bitrate;
+      in.sync_counter = bus.sync_counter_overflow != 0;
+      in.master_heartbeat_ms = bus.master_heartbeat_ms;
+      in.nodes = traffic;
+      const canopen::BusBudget b = canopen::bus_budget(in);
+      const std::string msg = fmt::format(
+          "worst-case bus load {:.1f} % ({} frames, {:.0f} of {:.0f} bits per {} ms cycle at {} bit/s)", b.load_percent,
+          b.frames_per_cycle, b.bits_per_cycle, b.capacity_bits, cfg.controller.period_s * 1e3, bus.bitrate);
+      if (b.load_percent > 100.0)
+        error_at(bus.where, fmt::format("buses[{}]", bi),
+                 msg + "; over 100 % cannot work: lengthen the period, raise the bitrate or move axes to another bus");
+      else if (b.load_percent > 70.0)
+        warning_at(bus.where, fmt::format("buses[{}]", bi), msg + "; over 70 % leaves little room for SDO and EMCY");
+    }
+
+    std::map<std::pair<std::string, int>, std::size_t> nodes;
+    for (std::size_t ai = 0; ai < cfg.axes.size(); ++ai) {
+      const AxisSettings& a = cfg.axes[ai];
+      if (a.axis.type != motion::AxisType::CipDrive || a.bus.empty()) continue;
+      if (!cfg.find_bus(a.bus)) {
+        std::vector<std::string_view> bus_names;
+        for (const auto& b : cfg.buses) bus_names.push_back(b.name);
+        std::string msg = fmt::format("no bus named '{}'", a.bus);
+        if (auto s = nearest(a.bus, bus_names)) msg += fmt::format("; did you mean '{}'?", *s);
+        else if (bus_names.empty()) msg += "; the configuration has no `buses:` section";
+        else msg += fmt::format("; buses: {}", fmt::join(bus_names, ", "));
+        error_at(a.where, fmt::format("axes[{}].bus", ai), msg);
+        continue;
+      }
+      auto [it, fresh] = nodes.emplace(std::make_pair(a.bus, static_cast<int>(a.node)), ai);
+      if (!fresh)
+        error_at(a.where, fmt::format("axes[{}].node", ai),
+                 fmt::format("node {} on bus '{}' is already axis '{}'", a.node, a.bus, cfg.axes[it->second].name));
+    }
+  }
+
+ private:
+  std::string file_;
+};
+
+Config finish(Loader& l, Config cfg) {
+  l.cross_check(cfg);
+  std::vector<Diagnostic> errors;
+  for (auto& d : l.diags) {
+    if (d.severity == Severity::kError) errors.push_back(d);
+    else cfg.warnings.push_back(d);
+  }
+  if (!errors.empty()) {
+    std::stable_sort(errors.begin(), errors.end(),
+                     [](const Diagnostic& a, const Diagnostic& b) { return a.where.line < b.where.line; });
+    throw ConfigError(std::move(errors));
+  }
+  return cfg;
+}
+
+}  // namespace
+
+Config load_string(std::string_view yaml, const std::string& name) {
+  Loader l(name);
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml));
+  } catch (const YAML::Exception& e) {
+    throw ConfigError({Diagnostic{Severity::kError, name, {e.mark.line + 1, e.mark.column + 1}, "",
+                                  "YAML syntax: " + e.msg}});
+  }
+  Config cfg = l.document(root);
+  return finish(l, std::move(cfg));
+}
+
+Config load_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::system_error(errno, std::generic_category(), "cannot read configuration file '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return load_string(ss.str(), path);
+}
+
+}  // namespace canmotion::config

@@ -1,0 +1,214 @@
+// Configuration loading and validation: every message names file, line,
+// column and key; nothing is returned when anything is wrong.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "config/config.hpp"
+
+namespace canmotion::config {
+namespace {
+
+const char* kGood = R"(controller:
+  period_ms: 1
+  priority: 80
+  cpu: 1
+buses:
+  - name: can0
+    interface: sim
+    bitrate: 1000000
+drives:
+  heartbeat_ms: 100
+  timeouts: {sdo_ms: 150, boot_ms: 4000}
+axes:
+  - name: Master
+    type: AXIS_VIRTUAL
+    units: mm
+    max_speed: 500
+  - name: X
+    type: AXIS_CIP_DRIVE
+    bus: can0
+    node: 2
+    conversion_constant: 10000
+    rotary: true
+    unwind: 360
+    exception_actions: {position_error: Fault Status Only, node_lost: 5}
+    drive:
+      pdo: csp_csv_cst
+      timeouts: {transition_ms: 250}
+      sdo_writes:
+        - {index: 0x6065, sub: 0, size: 4, value: 20000}
+cams:
+  - name: cam1
+    points: [[0, 0], [90, 45, cubic], [180, 90, cubic]]
+)";
+
+/// Load text that must fail; return the whole message.
+std::string errors_of(const std::string& yaml) {
+  try {
+    (void)load_string(yaml, "test.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "configuration was accepted:\n" << yaml;
+  return {};
+}
+
+TEST(Config, LoadsAGoodFile) {
+  const Config c = load_string(kGood, "good.yaml");
+  EXPECT_DOUBLE_EQ(c.controller.period_s, 0.001);
+  EXPECT_EQ(c.controller.cpu, 1);
+  ASSERT_EQ(c.axes.size(), 2u);
+  const AxisSettings& x = c.axes[1];
+  EXPECT_EQ(x.axis.type, motion::AxisType::CipDrive);
+  EXPECT_EQ(x.node, 2);
+  EXPECT_TRUE(x.axis.rotary);
+  EXPECT_EQ(x.axis.action(motion::ExceptionKind::PositionError), motion::ExceptionAction::FaultStatusOnly);
+  EXPECT_EQ(x.axis.action(motion::ExceptionKind::NodeLost), motion::ExceptionAction::Shutdown);
+  EXPECT_EQ(x.drive.pdo, cia402::PdoProfile::kCspCsvCst);
+  // Defaults from `drives:` with the axis's own override on top.
+  EXPECT_EQ(x.drive.timeouts.sdo_ms, 150u);
+  EXPECT_EQ(x.drive.timeouts.boot_ms, 4000u);
+  EXPECT_EQ(x.drive.timeouts.transition_ms, 250u);
+  EXPECT_EQ(x.drive.heartbeat_ms, 100);
+  ASSERT_EQ(x.drive.sdo_writes.size(), 1u);
+  EXPECT_EQ(x.drive.sdo_writes[0].index, 0x6065);
+  EXPECT_EQ(x.drive.sdo_writes[0].where.line, 29);
+  ASSERT_EQ(c.cams.size(), 1u);
+  EXPECT_TRUE(c.cams[0].points[1].cubic);
+  EXPECT_FALSE(c.cams[0].points[0].cubic);
+  EXPECT_TRUE(c.warnings.empty());
+}
+
+TEST(Config, UnknownKeySuggestsNearestWithLineAndColumn) {
+  std::string y = kGood;
+  y.replace(y.find("    max_speed: 500"), 18, "    max_sped: 500");
+  const std::string e = errors_of(y);
+  EXPECT_NE(e.find("test.yaml:16:5: error: axes[0].max_sped: unknown key 'max_sped'; did you mean 'max_speed'?"),
+            std::string::npos)
+      << e;
+}
+
+TEST(Config, TypesAndRangesNameTheKey) {
+  std::string y = kGood;
+  y.replace(y.find("priority: 80"), 12, "priority: 180");
+  y.replace(y.find("max_speed: 500"), 14, "max_speed: fast");
+  const std::string e = errors_of(y);
+  EXPECT_NE(e.find("test.yaml:3:13: error: controller.priority: must be 0 .. 99, got 180"), std::string::npos) << e;
+  EXPECT_NE(e.find("axes[0].max_speed: must be a real number in units/s, got 'fast'"), std::string::npos) << e;
+}
+
+TEST(Config, EnumerationListsValidValues) {
+  std::string y = kGood;
+  y.replace(y.find("AXIS_VIRTUAL"), 12, "AXIS_VIRTUL");
+  const std::string e = errors_of(y);
+  EXPECT_NE(e.find("axes[0].type: 'AXIS_VIRTUL' is not one of: AXIS_VIRTUAL (0), AXIS_CIP_DRIVE (1)"),
+            std::string::npos)
+      << e;
+}
+
+TEST(Config, DuplicateNamesAndNodes) {
+  std::string y = kGood;
+  y += R"(  - name: cam1
+    points: [[0, 0], [1, 1]]
+)";
+  const std::string dup_axis = std::string(kGood).replace(std::string(kGood).find("- name: Master"), 14, "- name: X");
+  EXPECT_NE(errors_of(y).find("tag name 'cam1' is already used at line 31"), std::string::npos) << errors_of(y);
+  EXPECT_NE(errors_of(dup_axis).find("axis name 'X' is already used"), std::string::npos);
+  std::string two = kGood;
+  two.insert(two.find("cams:"), R"(  - name: Y
+    type: AXIS_CIP_DRIVE
+    bus: can0
+    node: 2
+)");
+  const std::string e = errors_of(two);
+  EXPECT_NE(e.find("node 2 on bus 'can0' is already axis 'X'"), std::string::npos) << e;
+  EXPECT_NE(e.find("COB-ID 0x702 of axis 'Y' (node 2) heartbeat clashes with axis 'X' (node 2) heartbeat"),
+            std::string::npos)
+      << e;
+}
+
+TEST(Config, MasterHeartbeatCobIdClash) {
+  std::string y = kGood;
+  y.replace(y.find("    bitrate: 1000000"), 20, "    bitrate: 1000000\n    master_node: 2");
+  const std::string e = errors_of(y);
+  EXPECT_NE(e.find("COB-ID 0x702 of axis 'X' (node 2) heartbeat clashes with the master's heartbeat (node 2)"),
+            std::string::npos)
+      << e;
+}
+
+TEST(Config, InterpolationPeriodAgainstThePeriod) {
+  std::string y = kGood;
+  y.replace(y.find("        - {index: 0x6065"), 0, "        - {index: 0x60C2, sub: 1, size: 1, value: 2}\n");
+  const std::string e = errors_of(y);
+  EXPECT_NE(e.find("0x60C2:01 = 2 contradicts the controller period 1 ms (0x60C2 = 1 x 10^-3 s"), std::string::npos)
+      << e;
+  auto p = interpolation_period(0.0025);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->mantissa, 25);
+  EXPECT_EQ(p->exponent, -4);
+  p = interpolation_period(0.004);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->mantissa, 4);
+  EXPECT_EQ(p->exponent, -3);
+  EXPECT_FALSE(interpolation_period(0.0012345));
+  std::string bad = kGood;
+  bad.replace(bad.find("period_ms: 1"), 12, "period_ms: 1.2345");
+  EXPECT_NE(errors_of(bad).find("controller.period_ms: 1.2345 ms cannot be written to 0x60C2"), std::string::npos);
+}
+
+TEST(Config, BusBudgetRefusedOver100AndWarnsOver70) {
+  auto with_axes = [](int n, const char* period, const char* bitrate) {
+    std::string y = std::string("controller: {period_ms: ") + period + "}\nbuses:\n  - {name: can0, bitrate: " + bitrate +
+                    "}\naxes:\n";
+    for (int i = 1; i <= n; ++i)
+      y += "  - {name: A" + std::to_string(i) + ", type: AXIS_CIP_DRIVE, bus: can0, node: " + std::to_string(i) + "}\n";
+    return y;
+  };
+  // Default CSP mapping: 2 x 6-byte PDOs per axis, 115 bits each with worst-case
+  // stuffing, plus SYNC (55 bits): 2 axes = 515 bits = 51.5 % of a 1 ms cycle
+  // at 1 Mbit/s; 3 axes = 745 bits, plus heartbeats (65-bit frames: 3 drives
+  // every 50 ms, the master every 100 ms: 4.55 bits/cycle) = 75.0 % (warning);
+  // 8 axes at 250 kbit/s: refused.
+  EXPECT_TRUE(load_string(with_axes(2, "1", "1000000")).warnings.empty());
+  const std::string e = errors_of(with_axes(8, "1", "250000"));
+  EXPECT_NE(e.find("buses[0]: worst-case bus load"), std::string::npos) << e;
+  EXPECT_NE(e.find("over 100 % cannot work"), std::string::npos) << e;
+  const Config warn = load_string(with_axes(3, "1", "1000000"));
+  ASSERT_EQ(warn.warnings.size(), 1u);
+  EXPECT_NE(warn.warnings[0].message.find("over 70 %"), std::string::npos) << warn.warnings[0].str();
+  EXPECT_NE(warn.warnings[0].message.find("75.0 %"), std::string::npos) << warn.warnings[0].str();
+}
+
+TEST(Config, CrossReferencesAndCamPoints) {
+  std::string y = kGood;
+  y.replace(y.find("bus: can0\n    node: 2"), 9, "bus: cna0");
+  y.replace(y.find("[90, 45, cubic]"), 15, "[-5, 45, cubic]");
+  const std::string e = errors_of(y);
+  EXPECT_NE(e.find("axes[1].bus: no bus named 'cna0'; did you mean 'can0'?"), std::string::npos) << e;
+  EXPECT_NE(e.find("cams[0].points[1]: master values must increase: -5 follows 0"), std::string::npos) << e;
+}
+
+TEST(Config, VirtualAxisHasNoDrive) {
+  std::string y = kGood;
+  y.replace(y.find("    max_speed: 500"), 0, "    node: 4\n");
+  EXPECT_NE(errors_of(y).find("axes[0].node: only an AXIS_CIP_DRIVE axis has a drive"), std::string::npos);
+}
+
+TEST(Config, YamlSyntaxErrorHasPosition) {
+  const std::string e = errors_of("axes:\n  - name: [X\n");
+  EXPECT_NE(e.find("test.yaml:"), std::string::npos);
+  EXPECT_NE(e.find("YAML syntax"), std::string::npos) << e;
+}
+
+TEST(Config, MissingFileIsASystemError) {
+  EXPECT_THROW((void)load_file("/nonexistent/canmotion.yaml"), std::system_error);
+}
+
+TEST(Config, NearestOnlySuggestsPlausibleTypos) {
+  EXPECT_EQ(nearest("prioriy", {"priority", "cpu"}), "priority");
+  EXPECT_EQ(nearest("zzzzzz", {"priority", "cpu"}), std::nullopt);
+}
+
+}  // namespace
+}  // namespace canmotion::config
