@@ -1,5 +1,6 @@
 #include "motion/cam/cam_profile.hpp"
 
+#include <Eigen/Core>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -12,11 +13,7 @@ CamProfile::CamProfile(std::size_t capacity) {
                                 " elements, got " + std::to_string(capacity));
   }
   elems_.resize(capacity);
-  const auto n = static_cast<Eigen::Index>(capacity);
-  lower_ = Eigen::VectorXd::Zero(n);
-  diag_ = Eigen::VectorXd::Zero(n);
-  upper_ = Eigen::VectorXd::Zero(n);
-  rhs_ = Eigen::VectorXd::Zero(n);
+  scratch_.assign(4 * capacity, 0.0);
 }
 
 CamError CamProfile::acquire() noexcept {
@@ -211,10 +208,13 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
   //  * last knot with a cubic last segment: m_{n-1} = EndSlope
   //  * knot between a cubic and a linear segment: m_k = the linear segment's slope
   //  * knot between two linear segments: unused (m_k = 0)
-  Eigen::VectorXd& lo = profile.lower_;
-  Eigen::VectorXd& di = profile.diag_;
-  Eigen::VectorXd& up = profile.upper_;
-  Eigen::VectorXd& r = profile.rhs_;
+  const auto nn = static_cast<Eigen::Index>(n);
+  double* scratch = profile.scratch_.data();
+  const std::size_t cap = profile.capacity();
+  Eigen::Map<Eigen::VectorXd> lo(scratch, nn);
+  Eigen::Map<Eigen::VectorXd> di(scratch + cap, nn);
+  Eigen::Map<Eigen::VectorXd> up(scratch + 2 * cap, nn);
+  Eigen::Map<Eigen::VectorXd> r(scratch + 3 * cap, nn);
   for (std::size_t k = 0; k < n; ++k) {
     const auto ik = static_cast<Eigen::Index>(k);
     const bool left = k > 0 && cubic(k - 1);
@@ -241,7 +241,6 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
   // The matrix is strictly diagonally dominant (C2 rows: 2(a+b) > a+b; other
   // rows are identity rows), so no pivoting is needed and the solve is stable.
   // Eigen offers no allocation-free banded solver, so the two sweeps are here.
-  const auto nn = static_cast<Eigen::Index>(n);
   for (Eigen::Index k = 1; k < nn; ++k) {
     const double w = lo[k] / di[k - 1];
     di[k] -= w * up[k - 1];

@@ -9,8 +9,6 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "motion/cam/cam_error.hpp"
 
 namespace canmotion::motion::cam {
@@ -210,9 +208,11 @@ class CamProfile {
 
   std::vector<CamProfileElement> elems_;  // size == capacity, never resized
   std::size_t count_ = 0;                 // points of the last successful MCCP
-  // Tridiagonal spline system scratch (size == capacity): sub-, main and
-  // super-diagonal, right-hand side / solution.
-  Eigen::VectorXd lower_, diag_, upper_, rhs_;
+  // Tridiagonal spline system scratch, 4 * capacity doubles: sub-, main and
+  // super-diagonal, right-hand side / solution, seen by MCCP as Eigen::Map
+  // vectors. Kept in a std::vector so every allocation goes through operator
+  // new (the RT allocation test counts it).
+  std::vector<double> scratch_;
 };
 
 /// MCCP: validates the request and computes `profile` from

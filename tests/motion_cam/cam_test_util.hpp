@@ -2,8 +2,11 @@
 // Helpers for the cam tests: seeded random generation with the seed and the
 // case count taken from the environment, and random cam tables.
 //
-//   CANMOTION_TEST_SEED=<u64>   seed of every property test (default fixed)
-//   CANMOTION_TEST_COUNT=<n>    number of random cases per property test
+//   CANMOTION_SEED=<u64>        seed of every property test (default fixed;
+//                               CANMOTION_TEST_SEED is accepted too)
+//   CANMOTION_PROP_COUNT=<n>    number of random cases per property test
+//                               (CANMOTION_TEST_COUNT is accepted too)
+// The names match tests/motion (prop_util.hpp).
 #include <cstdint>
 #include <cstdlib>
 #include <random>
@@ -20,17 +23,22 @@ inline std::uint64_t env_u64(const char* name, std::uint64_t fallback) {
   return std::strtoull(v, nullptr, 0);
 }
 
-/// Seed for property tests: $CANMOTION_TEST_SEED, else a fixed default.
-inline std::uint64_t seed() { return env_u64("CANMOTION_TEST_SEED", 0x5eed'ca11ULL); }
-/// Case count for property tests: $CANMOTION_TEST_COUNT, else `fallback`.
-inline int count(int fallback) { return static_cast<int>(env_u64("CANMOTION_TEST_COUNT", static_cast<std::uint64_t>(fallback))); }
+/// Seed for property tests: $CANMOTION_SEED, else a fixed default.
+inline std::uint64_t seed() {
+  return env_u64("CANMOTION_SEED", env_u64("CANMOTION_TEST_SEED", 0x5eed'ca11ULL));
+}
+/// Case count for property tests: $CANMOTION_PROP_COUNT, else `fallback`.
+inline int count(int fallback) {
+  const auto f = static_cast<std::uint64_t>(fallback);
+  return static_cast<int>(env_u64("CANMOTION_PROP_COUNT", env_u64("CANMOTION_TEST_COUNT", f)));
+}
 
 /// Text for SCOPED_TRACE so every failure prints how to reproduce it (the
 /// base seed; each test derives its generator from base seed + a fixed offset).
 inline std::string repro(int c) {
   const auto s = seed();
   return "seed=" + std::to_string(s) + " case=" + std::to_string(c) +
-         " (reproduce: CANMOTION_TEST_SEED=" + std::to_string(s) + " CANMOTION_TEST_COUNT=" + std::to_string(c + 1) +
+         " (reproduce: CANMOTION_SEED=" + std::to_string(s) + " CANMOTION_PROP_COUNT=" + std::to_string(c + 1) +
          ")";
 }
 

@@ -1,0 +1,350 @@
+#include "fieldbus/trace/analyzer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace canmotion::trace {
+
+namespace co = canmotion::canopen;
+
+/// Calibration size of the jitter histogram: the nominal period (if not
+/// given) and the bin width come from the first kCalibration periods.
+static constexpr std::size_t kCalibration = 256;
+
+void RunningStats::add(double x) noexcept {
+  ++n;
+  if (n == 1) {
+    min = max = x;
+  } else {
+    min = std::min(min, x);
+    max = std::max(max, x);
+  }
+  const double delta = x - mean;
+  mean += delta / static_cast<double>(n);
+  m2 += delta * (x - mean);
+}
+
+double RunningStats::stddev() const noexcept { return n > 1 ? std::sqrt(m2 / static_cast<double>(n - 1)) : 0.0; }
+
+double NodeSummary::ferr_rms() const noexcept {
+  return ferr_count != 0 ? std::sqrt(ferr_sum_sq / static_cast<double>(ferr_count)) : 0.0;
+}
+
+std::uint32_t frame_bits_worst_case(const can::Frame& f) noexcept {
+  if (f.error()) return 0;  // reported by the controller, not a frame on the wire
+  const std::uint32_t s = f.remote() ? 0U : std::min<std::uint32_t>(f.len, 8U);
+  if (f.extended()) return 8 * s + 67 + (53 + 8 * s) / 4;
+  return 8 * s + 47 + (33 + 8 * s) / 4;
+}
+
+Analyzer::Analyzer(AnalyzerOptions opt) : opt_(std::move(opt)) {
+  if (opt_.load_window_ns <= 0) opt_.load_window_ns = 100'000'000;
+  if (opt_.max_load_windows < 2) opt_.max_load_windows = 2;
+  load_window_ = opt_.load_window_ns;
+  calib_.reserve(kCalibration);
+}
+
+namespace {
+// 1-2-5 series, at least 1 us.
+std::int64_t nice_width(double x) {
+  std::int64_t w = 1000;
+  while (true) {
+    for (std::int64_t m : {1, 2, 5}) {
+      if (static_cast<double>(w * m) >= x) return w * m;
+    }
+    w *= 10;
+    if (w > 10'000'000'000LL) return w;
+  }
+}
+}  // namespace
+
+void Analyzer::calibrate(const Decoder& decoder) {
+  if (calibrated_) return;
+  calibrated_ = true;
+  if (opt_.nominal_period_ns > 0) {
+    bus_.nominal_period_ns = opt_.nominal_period_ns;
+    bus_.nominal_source = "option";
+  } else if (decoder.sync_period_from_trace_ns() > 0) {
+    bus_.nominal_period_ns = decoder.sync_period_from_trace_ns();
+    bus_.nominal_source = "trace (0x1006)";
+  } else if (!calib_.empty()) {
+    std::vector<std::int64_t> sorted = calib_;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    bus_.nominal_period_ns = sorted[sorted.size() / 2];
+    bus_.nominal_source = "median of first periods";
+  }
+  // Bin width: the 95th percentile of |deviation| spread over the half-width.
+  std::vector<std::int64_t> dev;
+  dev.reserve(calib_.size());
+  for (std::int64_t p : calib_) dev.push_back(std::llabs(p - bus_.nominal_period_ns));
+  double spread = 0;
+  if (!dev.empty()) {
+    const std::size_t k = std::min(dev.size() - 1, dev.size() * 95 / 100);
+    std::nth_element(dev.begin(), dev.begin() + static_cast<std::ptrdiff_t>(k), dev.end());
+    spread = static_cast<double>(dev[k]);
+  }
+  bus_.jitter.bin_width_ns = nice_width(spread / (JitterHistogram::kHalfBins - 2));
+  for (std::int64_t p : calib_) add_jitter(p);
+  calib_.clear();
+  calib_.shrink_to_fit();
+}
+
+void Analyzer::add_jitter(std::int64_t p) {
+  const double dev = static_cast<double>(p - bus_.nominal_period_ns);
+  const double w = static_cast<double>(bus_.jitter.bin_width_ns);
+  const auto bin = static_cast<std::int64_t>(std::floor(dev / w + 0.5)) + JitterHistogram::kHalfBins;
+  if (bin < 0) {
+    ++bus_.jitter.below;
+  } else if (bin >= static_cast<std::int64_t>(JitterHistogram::kBins)) {
+    ++bus_.jitter.above;
+  } else {
+    ++bus_.jitter.bins[static_cast<std::size_t>(bin)];
+  }
+}
+
+void Analyzer::add_period(std::int64_t p) {
+  bus_.period_ns.add(static_cast<double>(p));
+  if (!calibrated_) {
+    calib_.push_back(p);
+    return;
+  }
+  add_jitter(p);
+}
+
+void Analyzer::add_load(std::int64_t t, std::uint32_t bits) {
+  if (bits == 0) return;
+  std::int64_t rel = t - bus_.t_first;
+  if (rel < 0) rel = 0;  // out-of-order timestamps count into the first window
+  auto idx = static_cast<std::size_t>(rel / load_window_);
+  while (idx >= opt_.max_load_windows) {
+    // Full: merge pairs of windows and double the width (bounded memory).
+    std::vector<std::uint64_t> merged((load_bits_.size() + 1) / 2, 0);
+    for (std::size_t i = 0; i < load_bits_.size(); ++i) merged[i / 2] += load_bits_[i];
+    load_bits_ = std::move(merged);
+    load_window_ *= 2;
+    idx = static_cast<std::size_t>(rel / load_window_);
+  }
+  if (idx >= load_bits_.size()) load_bits_.resize(idx + 1, 0);
+  load_bits_[idx] += bits;
+}
+
+void Analyzer::set_nmt(std::uint8_t node, co::NmtState s, std::int64_t t) {
+  Live& l = live_[node];
+  if (l.nmt == s) return;
+  l.nmt = s;
+  if (s != co::NmtState::kOperational) l.producing = false;
+  NodeSummary& ns = nodes_[node];
+  ns.seen = true;
+  if (ns.nmt.size() < opt_.timeline_cap) {
+    ns.nmt.push_back(NmtChange{t, s});
+  } else {
+    ++ns.nmt_dropped;
+  }
+}
+
+void Analyzer::on_sync(const Decoded& d, const Decoder& decoder) {
+  const std::int64_t t = d.tf.t_ns;
+  ++bus_.syncs;
+  if (have_sync_) {
+    add_period(t - last_sync_);
+    if (!calibrated_ && calib_.size() >= kCalibration) calibrate(decoder);
+    const std::size_t fpc = std::min<std::size_t>(frames_since_sync_, bus_.frames_per_cycle.size() - 1);
+    ++bus_.frames_per_cycle[fpc];
+    bus_.frames_per_cycle_stats.add(static_cast<double>(frames_since_sync_));
+  }
+  // Missing feedback: a node that produces synchronous TPDOs should have sent
+  // one since the previous SYNC (every n-th SYNC for transmission type n).
+  for (std::uint8_t n = 1; n <= kMaxNode; ++n) {
+    Live& l = live_[n];
+    if (!l.producing) continue;
+    ++l.syncs_since_tpdo;
+    std::uint8_t every = 1;
+    const std::uint8_t tt = decoder.tpdo_transmission_type(n, 1);
+    if (tt >= 1 && tt <= 240) every = tt;
+    if (tt == 0 || (tt > 240 && tt != 255)) continue;  // acyclic / event driven: nothing expected
+    if (l.syncs_since_tpdo <= every) {
+      if (l.syncs_since_tpdo == every) ++nodes_[n].syncs_checked;
+      continue;
+    }
+    // The previous cycle ended without a TPDO.
+    NodeSummary& ns = nodes_[n];
+    ++ns.syncs_checked;
+    ++ns.missing_tpdo;
+    if (ns.missing_times.size() < opt_.list_cap) ns.missing_times.push_back(last_sync_);
+    l.syncs_since_tpdo = every;  // count each silent cycle once
+  }
+  for (Live& l : live_) {
+    if (l.has_target) {
+      l.has_applied = true;
+      l.applied = l.target;
+    }
+  }
+  have_sync_ = true;
+  last_sync_ = t;
+  frames_since_sync_ = 0;
+}
+
+bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
+  const std::int64_t t = d.tf.t_ns;
+  if (bus_.frames == 0) {
+    bus_.t_first = t;
+    load_window_ = opt_.load_window_ns;
+  }
+  ++bus_.frames;
+  bus_.t_last = t;
+  ++bus_.kind_counts[static_cast<std::size_t>(d.kind)];
+  if (d.problem != nullptr) ++bus_.problems;
+  add_load(t, frame_bits_worst_case(d.tf.frame));
+  if (d.kind == EventKind::kSync) {
+    on_sync(d, decoder);
+    return false;
+  }
+  ++frames_since_sync_;
+  if (d.kind == EventKind::kErrorFrame) {
+    ++bus_.error_frames;
+    for (unsigned b = 0; b < bus_.error_class_counts.size(); ++b) {
+      if ((d.tf.frame.id & (1U << b)) != 0) ++bus_.error_class_counts[b];
+    }
+    if (bus_.error_list.size() < opt_.list_cap) {
+      bus_.error_list.push_back(ErrorFrameRecord{t, d.tf.frame.id, d.tf.frame.data});
+    }
+    return false;
+  }
+  if (d.kind == EventKind::kNmt && d.problem == nullptr) {
+    // Commands change the NMT state of the addressed nodes; keep the
+    // "producing" flag honest so stopped nodes do not count as missing TPDOs.
+    const auto apply = [&](std::uint8_t n) {
+      if (d.nmt_command == 0x01) return;  // start: wait for its heartbeat/TPDOs
+      live_[n].producing = false;
+    };
+    if (d.nmt_target == 0) {
+      for (std::uint8_t n = 1; n <= kMaxNode; ++n) apply(n);
+    } else if (d.nmt_target <= kMaxNode) {
+      apply(d.nmt_target);
+    }
+    return false;
+  }
+  if (d.node == 0 || d.node > kMaxNode) return false;
+  NodeSummary& ns = nodes_[d.node];
+  Live& l = live_[d.node];
+  ns.seen = true;
+  ++ns.frames;
+  switch (d.kind) {
+    case EventKind::kEmcy:
+      ++ns.emcy_count;
+      if (ns.emcys.size() < opt_.list_cap) {
+        ns.emcys.push_back(EmcyRecord{t, d.emcy_code, d.emcy_register, d.emcy_vendor});
+      }
+      break;
+    case EventKind::kBootUp:
+      set_nmt(d.node, co::NmtState::kBootUp, t);
+      // A reboot forgets the CiA 402 state.
+      l.state = cia402::State::kUnknown;
+      l.has_sw = false;
+      break;
+    case EventKind::kHeartbeat:
+      ++ns.heartbeats;
+      if (d.nmt_state != co::NmtState::kUnknown) set_nmt(d.node, d.nmt_state, t);
+      break;
+    case EventKind::kSdo:
+      if (d.sdo_response) {
+        ++ns.sdo_responses;
+      } else {
+        ++ns.sdo_requests;
+      }
+      if (d.sdo.kind == canopen::sdo::SdoFrameKind::kAbort) {
+        ++ns.abort_count;
+        if (ns.aborts.size() < opt_.list_cap) {
+          ns.aborts.push_back(AbortRecord{t, d.sdo_index, d.sdo_sub, d.sdo.abort_code, d.sdo_response});
+        }
+      }
+      break;
+    case EventKind::kPdo:
+      if (d.pdo_tx) {
+        ++ns.tpdos;
+        if (d.pdo_number == 1) {
+          l.producing = true;
+          l.syncs_since_tpdo = 0;
+        }
+      } else {
+        ++ns.rpdos;
+      }
+      break;
+    default:
+      break;
+  }
+  if (d.has_controlword) {
+    l.has_cw = true;
+    l.cw = d.controlword;
+  }
+  if (d.has_target) {
+    l.has_target = true;
+    l.target = d.target_position;
+  }
+  if (d.has_statusword) {
+    const cia402::State s = cia402::decode_state(d.statusword);
+    if (!l.has_sw || s != l.state) {
+      if (ns.timeline.size() < opt_.timeline_cap) {
+        ns.timeline.push_back(StateChange{t, s, d.statusword, l.has_cw, l.cw});
+      } else {
+        ++ns.timeline_dropped;
+      }
+    }
+    l.has_sw = true;
+    l.sw = d.statusword;
+    l.state = s;
+  }
+  if (d.kind != EventKind::kPdo || !d.pdo_tx || (!d.has_statusword && !d.has_actual)) return false;
+  Sample s;
+  s.node = d.node;
+  s.t_ns = t;
+  s.has_controlword = l.has_cw;
+  s.controlword = l.cw;
+  s.has_statusword = l.has_sw;
+  s.statusword = l.sw;
+  s.state = l.state;
+  s.has_target = l.has_applied;
+  s.target = l.applied;
+  s.has_actual = d.has_actual;
+  s.actual = d.actual_position;
+  if (d.has_actual && l.has_applied && l.has_sw && l.state == cia402::State::kOperationEnabled) {
+    s.has_following_error = true;
+    s.following_error = l.applied - d.actual_position;
+    const std::int64_t a = s.following_error < 0 ? -s.following_error : s.following_error;
+    ++ns.ferr_count;
+    ns.ferr_sum_sq += static_cast<double>(s.following_error) * static_cast<double>(s.following_error);
+    if (a > ns.ferr_max_abs || ns.ferr_count == 1) {
+      ns.ferr_max_abs = a;
+      ns.ferr_at_max = s.following_error;
+      ns.ferr_t_max = t;
+    }
+  }
+  if (sample != nullptr) *sample = s;
+  return true;
+}
+
+void Analyzer::finish(const Decoder& decoder) {
+  calibrate(decoder);
+  bus_.load_window_ns = load_window_;
+  bus_.load.clear();
+  bus_.load_peak = 0;
+  double total_bits = 0;
+  const double cap_bits_per_window = opt_.bitrate * static_cast<double>(load_window_) / 1e9;
+  for (std::size_t i = 0; i < load_bits_.size(); ++i) {
+    double window_bits = cap_bits_per_window;
+    if (i + 1 == load_bits_.size()) {
+      // The last window is partial: divide by the time it covers.
+      const auto covered = static_cast<double>(bus_.t_last - bus_.t_first) - static_cast<double>(i) * static_cast<double>(load_window_);
+      if (covered > 0 && covered < static_cast<double>(load_window_)) window_bits = opt_.bitrate * covered / 1e9;
+    }
+    const double l = window_bits > 0 ? static_cast<double>(load_bits_[i]) / window_bits : 0.0;
+    bus_.load.push_back(l);
+    bus_.load_peak = std::max(bus_.load_peak, l);
+    total_bits += static_cast<double>(load_bits_[i]);
+  }
+  const double dur = static_cast<double>(bus_.t_last - bus_.t_first) / 1e9;
+  bus_.load_mean = dur > 0 ? total_bits / (opt_.bitrate * dur) : 0.0;
+}
+
+}  // namespace canmotion::trace

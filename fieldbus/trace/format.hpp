@@ -1,0 +1,49 @@
+#pragma once
+/// \file
+/// Human-readable and JSON renderings of decoded frames. Not realtime-safe
+/// (fmt buffers may grow); meant for tools and trace post-processing.
+
+#include <cstdint>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "fieldbus/trace/decoder.hpp"
+
+namespace canmotion::trace {
+
+/// How to print times.
+struct FormatOptions {
+  bool has_time = true;  ///< false: the trace had no timestamps; print "-"
+  int time_digits = 6;   ///< 6 (us) or 9 (ns) fractional digits
+};
+
+/// Append `t_ns` as seconds ("1700000000.123456") to `out`.
+void append_time(fmt::memory_buffer& out, std::int64_t t_ns, int digits);
+
+/// Append one text line (with '\n'): time, interface, raw frame as ID#DATA
+/// and the decoded description.
+void format_text(const Decoded& d, std::string_view iface, const FormatOptions& opt, fmt::memory_buffer& out);
+
+/// Append the description only (no time, no raw frame, no newline), e.g.
+/// "TPDO1 node 1: Statusword=0x0637 [Operation enabled], Position actual value=100000".
+void format_description(const Decoded& d, fmt::memory_buffer& out);
+
+/// Append one JSON object on one line (with '\n'), for `cantrace --json`.
+void format_json(const Decoded& d, std::string_view iface, const FormatOptions& opt, fmt::memory_buffer& out);
+
+/// Append `s` as a JSON string literal (quotes, escapes).
+void append_json_string(fmt::memory_buffer& out, std::string_view s);
+
+/// "Operation enabled" etc. for a statusword.
+std::string_view statusword_state_name(std::uint16_t statusword) noexcept;
+/// "Enable operation" etc. for a controlword.
+std::string_view controlword_command_name(std::uint16_t controlword) noexcept;
+/// Error-frame class names (CAN_ERR_* bits of the id), comma separated, appended to out.
+void append_error_classes(fmt::memory_buffer& out, std::uint32_t err_class);
+/// Name of error-frame class bit `bit` (0..8), "" beyond.
+std::string_view error_class_name(unsigned bit) noexcept;
+/// Lower-case kind name used in JSON ("nmt", "sync", "tpdo", ...).
+std::string_view event_kind_name(const Decoded& d) noexcept;
+
+}  // namespace canmotion::trace

@@ -1,0 +1,1111 @@
+#include "motion/planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace canmotion::motion {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// MSO/MSF on a CIP drive: how long the planner waits for the drive (seconds)
+/// before ERR 12 (Servo Message Failure, EXERR 16 device in wrong state).
+constexpr double kDriveTimeout = 5.0;
+
+inline int ival(const Request& r, int i) noexcept { return static_cast<int>(r.op[static_cast<std::size_t>(i)].value); }
+inline double dval(const Request& r, int i) noexcept { return r.op[static_cast<std::size_t>(i)].value; }
+
+// Operand indices, looked up once in THE signature table (motion/signatures.cpp).
+struct Idx {
+  int mam_type, mam_pos, mam_speed;
+  int maj_dir, maj_speed;
+  int mas_type, mas_chg_decel, mas_decel, mas_decel_units, mas_chg_jerk, mas_jerk, mas_jerk_units;
+  int mcd_type, mcd_chg_speed, mcd_speed, mcd_chg_accel, mcd_accel, mcd_chg_decel, mcd_decel, mcd_chg_ajerk,
+      mcd_ajerk, mcd_chg_djerk, mcd_djerk, mcd_speed_units, mcd_accel_units, mcd_decel_units, mcd_jerk_units;
+  int mrp_type, mrp_select, mrp_pos;
+  int mgs_mode;
+};
+const Idx& idx() noexcept {
+  static const Idx k{
+      operand_index(Instr::MAM, "MoveType"), operand_index(Instr::MAM, "Position"), operand_index(Instr::MAM, "Speed"),
+      operand_index(Instr::MAJ, "Direction"), operand_index(Instr::MAJ, "Speed"),
+      operand_index(Instr::MAS, "StopType"), operand_index(Instr::MAS, "ChangeDecel"),
+      operand_index(Instr::MAS, "DecelRate"), operand_index(Instr::MAS, "DecelUnits"),
+      operand_index(Instr::MAS, "ChangeDecelJerk"), operand_index(Instr::MAS, "DecelJerk"),
+      operand_index(Instr::MAS, "JerkUnits"),
+      operand_index(Instr::MCD, "MotionType"), operand_index(Instr::MCD, "ChangeSpeed"),
+      operand_index(Instr::MCD, "Speed"), operand_index(Instr::MCD, "ChangeAccel"),
+      operand_index(Instr::MCD, "AccelRate"), operand_index(Instr::MCD, "ChangeDecel"),
+      operand_index(Instr::MCD, "DecelRate"), operand_index(Instr::MCD, "ChangeAccelJerk"),
+      operand_index(Instr::MCD, "AccelJerk"), operand_index(Instr::MCD, "ChangeDecelJerk"),
+      operand_index(Instr::MCD, "DecelJerk"), operand_index(Instr::MCD, "SpeedUnits"),
+      operand_index(Instr::MCD, "AccelUnits"), operand_index(Instr::MCD, "DecelUnits"),
+      operand_index(Instr::MCD, "JerkUnits"),
+      operand_index(Instr::MRP, "Type"), operand_index(Instr::MRP, "PositionSelect"),
+      operand_index(Instr::MRP, "Position"),
+      operand_index(Instr::MGS, "StopMode"),
+  };
+  return k;
+}
+
+inline bool is_md_jerk(int u) noexcept { return u == 4 || u == 6 || u == 7; }
+
+/// Decoded dynamics of MAM/MAJ (operands Speed .. LockDirection are laid out
+/// identically in both; `is` is the index of Speed).
+struct Dyn {
+  Limits lim{};
+  double speed = 0.0;  ///< programmed speed, units/s (0 allowed: paused)
+  bool scurve = false;
+  bool seconds = false;
+  bool merge = false;
+  bool merge_current = false;
+  double t_total = 0, t_acc = 0, t_dec = 0, tj_acc = 0, tj_dec = 0;  // seconds units
+  int jerk_units = 0;
+  double jerk_pct_a = 0, jerk_pct_d = 0;  // % of time (applied once the start speed is known)
+};
+
+Err decode_dynamics(const Request& r, int is, const AxisConfig& cfg, double last_speed, Dyn& d,
+                    std::int8_t& exerr) noexcept {
+  const int su = ival(r, is + 1), au = ival(r, is + 3), du = ival(r, is + 5);
+  const int prof = ival(r, is + 6), ju = ival(r, is + 9);
+  d.scurve = prof == 1;
+  d.merge = ival(r, is + 10) == 1;
+  d.merge_current = ival(r, is + 11) == 1;
+  const int lockdir = ival(r, is + 13);
+  const bool md = is_master_driven(static_cast<std::uint8_t>(su));
+  if (is_master_driven(static_cast<std::uint8_t>(au)) != md || is_master_driven(static_cast<std::uint8_t>(du)) != md ||
+      (d.scurve && is_md_jerk(ju) != md))
+    return Err::MdscUnitsConflict;
+  if (md) return Err::MdscNotActivated;  // no MDAC link exists (issue 5)
+  if (lockdir != 0) return Err::MdscLockDirConflict;  // time-driven needs LockDirection none
+  const double speed = dval(r, is), accel = dval(r, is + 2), decel = dval(r, is + 4);
+  const double ajerk = dval(r, is + 7), djerk = dval(r, is + 8);
+  if (su == 3 || au == 3 || du == 3 || (d.scurve && ju == 3)) {  // seconds: all or nothing
+    if (su != 3) { exerr = static_cast<std::int8_t>(is + 1); return Err::ParameterOutOfRange; }
+    if (au != 3) { exerr = static_cast<std::int8_t>(is + 3); return Err::ParameterOutOfRange; }
+    if (du != 3) { exerr = static_cast<std::int8_t>(is + 5); return Err::ParameterOutOfRange; }
+    if (d.scurve && ju != 3) { exerr = static_cast<std::int8_t>(is + 9); return Err::ParameterOutOfRange; }
+    d.seconds = true;
+    d.t_total = speed; d.t_acc = accel; d.t_dec = decel;
+    if (!(speed > 0)) { exerr = static_cast<std::int8_t>(is); return Err::ParameterOutOfRange; }
+    if (accel + decel > speed) { exerr = static_cast<std::int8_t>(is + 2); return Err::ParameterOutOfRange; }
+    if (d.scurve) {
+      if (!(ajerk >= 0) || ajerk > accel / 2) { exerr = static_cast<std::int8_t>(is + 7); return Err::ParameterOutOfRange; }
+      if (!(djerk >= 0) || djerk > decel / 2) { exerr = static_cast<std::int8_t>(is + 8); return Err::ParameterOutOfRange; }
+      d.tj_acc = ajerk; d.tj_dec = djerk;
+    }
+    return Err::None;
+  }
+  d.speed = su == 1 ? speed / 100.0 * cfg.max_speed : speed;
+  d.lim.a = au == 1 ? accel / 100.0 * cfg.max_accel : accel;
+  if (du == 1 && !(cfg.max_decel > 0)) return Err::ZeroMaxDecel;
+  d.lim.d = du == 1 ? decel / 100.0 * cfg.max_decel : decel;
+  if (!(d.lim.a > 0)) { exerr = static_cast<std::int8_t>(is + 2); return Err::ParameterOutOfRange; }
+  if (!(d.lim.d > 0)) { exerr = static_cast<std::int8_t>(is + 4); return Err::ParameterOutOfRange; }
+  d.lim.v = d.speed;
+  d.lim.ja = d.lim.jd = kInf;
+  d.jerk_units = ju;
+  if (d.scurve) {
+    switch (ju) {
+      case 0:
+        if (!(ajerk > 0)) { exerr = static_cast<std::int8_t>(is + 7); return Err::ParameterOutOfRange; }
+        if (!(djerk > 0)) { exerr = static_cast<std::int8_t>(is + 8); return Err::ParameterOutOfRange; }
+        d.lim.ja = ajerk; d.lim.jd = djerk;
+        break;
+      case 1:
+        if (!(ajerk > 0) || ajerk > 100) { exerr = static_cast<std::int8_t>(is + 7); return Err::ParameterOutOfRange; }
+        if (!(djerk > 0) || djerk > 100) { exerr = static_cast<std::int8_t>(is + 8); return Err::ParameterOutOfRange; }
+        if (!(cfg.max_decel_jerk > 0)) return Err::ZeroMaxDecelJerk;
+        if (!(cfg.max_accel_jerk > 0)) { exerr = static_cast<std::int8_t>(is + 7); return Err::ParameterOutOfRange; }
+        d.lim.ja = ajerk / 100.0 * cfg.max_accel_jerk;
+        d.lim.jd = djerk / 100.0 * cfg.max_decel_jerk;
+        break;
+      case 2: {
+        if (!(ajerk >= 0) || ajerk > 100) { exerr = static_cast<std::int8_t>(is + 7); return Err::ParameterOutOfRange; }
+        if (!(djerk >= 0) || djerk > 100) { exerr = static_cast<std::int8_t>(is + 8); return Err::ParameterOutOfRange; }
+        d.jerk_pct_a = ajerk; d.jerk_pct_d = djerk;
+        // [RM002H p.447]: a zero-speed S-curve uses the previous non-zero speed.
+        const double v = d.speed > 0 ? d.speed : last_speed;
+        d.lim.ja = jerk_from_percent_of_time(d.lim.a, v, ajerk);
+        d.lim.jd = jerk_from_percent_of_time(d.lim.d, v, djerk);
+        break;
+      }
+      default:
+        exerr = static_cast<std::int8_t>(is + 9);
+        return Err::ParameterOutOfRange;
+    }
+  }
+  return Err::None;
+}
+
+}  // namespace
+
+Planner::Planner(double cycle_period) noexcept : T_(cycle_period > 0 ? cycle_period : 0.001) { (void)idx(); }
+
+bool Planner::configure_axis(AxisId id, const AxisConfig& cfg) noexcept {
+  if (id >= kMaxAxes) return false;
+  if (!(cfg.conversion_constant > 0) || (cfg.rotary && !(cfg.unwind > 0)) || cfg.max_speed < 0 ||
+      cfg.max_accel < 0 || cfg.max_decel < 0 || cfg.max_accel_jerk < 0 || cfg.max_decel_jerk < 0 ||
+      cfg.position_error_tolerance < 0 || cfg.group >= kMaxGroups)
+    return false;
+  AxisRt& a = axes_[id];
+  a = AxisRt{};
+  a.cfg = cfg;
+  a.present = true;
+  axis_count_ = std::max<std::size_t>(axis_count_, static_cast<std::size_t>(id) + 1);
+  update_status(a);
+  return true;
+}
+
+// ------------------------------------------------------------------ helpers
+ControlTag* Planner::owner_tag(ControlId id, std::uint32_t gen) noexcept {
+  if (id >= kMaxControlTags) return nullptr;
+  ControlTag& c = controls_[id];
+  return c.generation == gen ? &c : nullptr;  // the tag was re-executed: not ours any more
+}
+
+Kin Planner::slot_kin(const AxisRt& a, Slot s) const noexcept {
+  if (auto* g = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(s)])) return g->k;
+  return Kin{};
+}
+
+double Planner::user_command(const AxisRt& a) const noexcept { return a.cmd.p + a.frame_offset; }
+
+bool Planner::any_stopping(const AxisRt& a) const noexcept {
+  for (const auto& g : a.gen)
+    if (auto* p = std::get_if<ProfileGen>(&g); p && p->role == GenRole::Stop) return true;
+  return false;
+}
+
+void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
+  auto& slot = a.gen[static_cast<std::size_t>(s)];
+  if (auto* g = std::get_if<ProfileGen>(&slot)) {
+    a.base += g->k.p;
+    if (clear_owner_ip) {
+      if (ControlTag* c = owner_tag(g->owner, g->owner_gen)) {
+        c->set(flag::IP, false);
+        c->set(flag::ACCEL, false);
+        c->set(flag::DECEL, false);
+      }
+    }
+  }
+  slot = std::monostate{};
+}
+
+void Planner::abort_all(AxisRt& a) noexcept {
+  for (std::size_t s = 0; s < kSlots; ++s) fold(a, static_cast<Slot>(s), true);
+  a.cmd.v = 0;
+  a.cmd.a = 0;
+  a.cmd.p = a.base;
+}
+
+void Planner::servo_off(AxisRt& a) noexcept {
+  abort_all(a);
+  a.servo = false;
+  a.enable_req = false;
+  if (a.homing) {
+    a.homing = false;
+    if (ControlTag* c = owner_tag(a.mah, a.mah_gen)) c->set(flag::IP, false);
+  }
+}
+
+void Planner::do_shutdown(AxisRt& a) noexcept {
+  servo_off(a);
+  a.shutdown = true;
+}
+
+bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, ControlId owner,
+                         std::uint8_t post_stop) noexcept {
+  const std::uint32_t all = (1u << kSlots) - 1u;
+  const std::uint32_t gen_owner = owner < kMaxControlTags ? controls_[owner].generation : 0;
+  if ((mask & all) == all) {
+    Kin tot{};
+    bool any = false;
+    for (std::size_t s = 0; s < kSlots; ++s) {
+      if (auto* g = std::get_if<ProfileGen>(&a.gen[s])) {
+        tot.v += g->k.v;
+        tot.a += g->k.a;
+        any = true;
+      }
+      fold(a, static_cast<Slot>(s), true);
+    }
+    if (!any || (tot.v == 0 && tot.a == 0)) return false;
+    ProfileGen g;
+    g.role = GenRole::Stop;
+    if (!plan_stop(g.prof, Kin{0, tot.v, tot.a}, d, jd)) return false;
+    g.t0_cycle = cycle_;
+    g.k = Kin{0, tot.v, tot.a};
+    g.owner = owner;
+    g.owner_gen = gen_owner;
+    g.post_stop = post_stop;
+    g.scurve = !std::isinf(jd);
+    a.gen[static_cast<std::size_t>(Slot::StopAll)] = g;
+    return true;
+  }
+  bool any = false;
+  for (std::size_t s = 0; s < kSlots; ++s) {
+    if (!(mask & (1u << s))) continue;
+    auto* g = std::get_if<ProfileGen>(&a.gen[s]);
+    if (!g) continue;
+    const Kin k = g->k;
+    fold(a, static_cast<Slot>(s), true);
+    if (k.v == 0 && k.a == 0) continue;
+    ProfileGen st;
+    st.role = GenRole::Stop;
+    if (!plan_stop(st.prof, Kin{0, k.v, k.a}, d, jd)) continue;
+    st.t0_cycle = cycle_;
+    st.k = Kin{0, k.v, k.a};
+    st.owner = owner;
+    st.owner_gen = gen_owner;
+    st.post_stop = post_stop;
+    st.scurve = !std::isinf(jd);
+    a.gen[s] = st;
+    any = true;
+  }
+  return any;
+}
+
+Err Planner::common_checks(const AxisRt& a, bool need_servo) const noexcept {
+  if (!a.present || !a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  if (a.shutdown) return Err::ShutdownState;
+  if (a.faulted) return Err::AxisInFaultedState;
+  if (need_servo && !a.servo) return Err::ServoOffState;
+  return Err::None;
+}
+
+// ------------------------------------------------------------------ execute
+Err Planner::execute(const Request& r) noexcept {
+  if (r.control >= kMaxControlTags) return Err::ParameterOutOfRange;
+  ControlTag& c = controls_[r.control];
+  c.begin_execution();
+  const InstrSig& sig = signature(r.instr);
+  std::int8_t exerr = 0;
+  Err e = Err::None;
+  if (r.count != sig.operands.size()) {
+    exerr = static_cast<std::int8_t>(std::min<std::size_t>(r.count, sig.operands.size()));
+    e = Err::ParameterOutOfRange;
+  } else if (!sig.executable) {
+    e = Err::InstructionNotSupported;
+  } else {
+    // reference operands
+    for (std::size_t i = 0; i < sig.operands.size() && e == Err::None; ++i) {
+      const auto k = sig.operands[i].kind;
+      const auto ref = r.op[i].ref;
+      if (k == OperandKind::Axis && (ref >= kMaxAxes || !axes_[ref].present)) e = Err::AxisNotConfigured;
+      if (k == OperandKind::Group && ref >= kMaxGroups) e = Err::AxisNotConfigured;
+    }
+    if (e == Err::None) {
+      std::array<double, kMaxOperands> vals{};
+      for (std::size_t i = 0; i < kMaxOperands; ++i) vals[i] = r.op[i].value;
+      const OperandCheck oc = check_operands(r.instr, std::span<const double>(vals.data(), sig.operands.size()));
+      if (!oc.ok) {
+        e = Err::ParameterOutOfRange;
+        exerr = static_cast<std::int8_t>(oc.index);
+      }
+    }
+  }
+  if (e == Err::None) {
+    const AxisId ax = r.op[0].ref;
+    switch (r.instr) {
+      case Instr::MSO: e = start_mso(r, axes_[ax]); break;
+      case Instr::MSF: e = start_msf(r, axes_[ax]); break;
+      case Instr::MASD: e = start_masd(r, axes_[ax]); break;
+      case Instr::MASR: e = start_masr(r, axes_[ax]); break;
+      case Instr::MAFR: e = start_mafr(r, axes_[ax]); break;
+      case Instr::MAS: e = start_mas(r, axes_[ax], exerr); break;
+      case Instr::MAH: e = start_mah(r, axes_[ax]); break;
+      case Instr::MAJ: e = start_maj(r, axes_[ax], exerr); break;
+      case Instr::MAM: e = start_mam(r, axes_[ax], exerr); break;
+      case Instr::MCD: e = start_mcd(r, axes_[ax], exerr); break;
+      case Instr::MRP: e = start_mrp(r, axes_[ax]); break;
+      case Instr::MGS:
+      case Instr::MGSD:
+      case Instr::MGSR: e = start_group(r, exerr); break;
+      default: e = Err::InstructionNotSupported; break;
+    }
+  }
+  if (e != Err::None) {
+    c.reject(e, exerr);
+  }
+  for (std::size_t i = 0; i < axis_count_; ++i) update_status(axes_[i]);
+  return e;
+}
+
+// --- MSO / MSF / MASD / MASR / MAFR
+Err Planner::start_mso(const Request& r, AxisRt& a) noexcept {
+  if (Err e = common_checks(a, false); e != Err::None) return e;
+  ControlTag& c = controls_[r.control];
+  if (a.servo) {
+    c.set(flag::DN, true);
+    return Err::None;
+  }
+  a.enable_req = true;
+  if (a.cfg.type == AxisType::Virtual) {
+    a.servo = true;
+    c.set(flag::DN, true);
+    return Err::None;
+  }
+  // CIP: DN when the drive reports Operation Enabled (STATE 0 request, 1 waiting).
+  a.mso = r.control;
+  a.mso_gen = c.generation;
+  a.mso_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+  c.state = 0;
+  return Err::None;
+}
+
+Err Planner::start_msf(const Request& r, AxisRt& a) noexcept {
+  if (!a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  if (a.shutdown) return Err::ShutdownState;
+  ControlTag& c = controls_[r.control];
+  const bool was_enabled = a.cfg.type == AxisType::CipDrive && a.fb.drive == DriveState::Enabled;
+  servo_off(a);
+  if (a.mso != kNoControl) {  // cancel a pending MSO
+    if (ControlTag* m = owner_tag(a.mso, a.mso_gen)) m->reject(Err::ServoMessageFailure, 15);
+    a.mso = kNoControl;
+  }
+  if (!was_enabled) {
+    c.set(flag::DN, true);
+  } else {
+    a.msf = r.control;
+    a.msf_gen = c.generation;
+    a.mso_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+  }
+  return Err::None;
+}
+
+Err Planner::start_masd(const Request& r, AxisRt& a) noexcept {
+  if (!a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  do_shutdown(a);
+  controls_[r.control].set(flag::DN, true);
+  return Err::None;
+}
+
+Err Planner::start_masr(const Request& r, AxisRt& a) noexcept {
+  if (!a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  a.shutdown = false;
+  a.faulted = false;
+  a.tag.exception_faults = 0;
+  a.tag.motion_fault_status = 0;
+  a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
+  controls_[r.control].set(flag::DN, true);
+  return Err::None;
+}
+
+Err Planner::start_mafr(const Request& r, AxisRt& a) noexcept {
+  if (!a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  a.faulted = false;
+  a.tag.exception_faults = 0;
+  a.tag.motion_fault_status = 0;
+  a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
+  controls_[r.control].set(flag::DN, true);
+  return Err::None;
+}
+
+// --- MAS
+Err Planner::start_mas(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+  if (!a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  const Idx& I = idx();
+  const auto type = static_cast<StopType>(ival(r, I.mas_type));
+  std::uint32_t mask = 0;
+  switch (type) {
+    case StopType::All: mask = (1u << kSlots) - 1u; break;
+    case StopType::Jog: mask = 1u << static_cast<unsigned>(Slot::Jog); break;
+    case StopType::Move: mask = 1u << static_cast<unsigned>(Slot::Move); break;
+    case StopType::Gear: mask = 1u << static_cast<unsigned>(Slot::Gear); break;
+    case StopType::TimeCam: mask = 1u << static_cast<unsigned>(Slot::TimeCam); break;
+    case StopType::PositionCam: mask = 1u << static_cast<unsigned>(Slot::PositionCam); break;
+    case StopType::MasterOffsetMove: mask = 1u << static_cast<unsigned>(Slot::MasterOffset); break;
+    default: mask = 0; break;  // home / tune / test / direct control: no planner generator
+  }
+  // decel
+  double d = a.cfg.max_decel;
+  if (ival(r, I.mas_chg_decel) == 1) {
+    const double rate = dval(r, I.mas_decel);
+    if (!(rate > 0)) { exerr = static_cast<std::int8_t>(I.mas_decel); return Err::ParameterOutOfRange; }
+    d = ival(r, I.mas_decel_units) == 1 ? rate / 100.0 * a.cfg.max_decel : rate;
+  }
+  if (!(d > 0)) return Err::ZeroMaxDecel;
+  // S-curve stop if any motion being stopped is S-curve
+  bool scurve = false;
+  double speed = 0.0;
+  for (std::size_t s = 0; s < kSlots; ++s) {
+    if (!(mask & (1u << s))) continue;
+    if (auto* g = std::get_if<ProfileGen>(&a.gen[s])) {
+      scurve = scurve || g->scurve;
+      speed += g->k.v;
+    }
+  }
+  speed = std::fabs(speed);
+  double jd = a.cfg.max_decel_jerk;
+  if (ival(r, I.mas_chg_jerk) == 1) {
+    const double j = dval(r, I.mas_jerk);
+    const int ju = ival(r, I.mas_jerk_units);
+    if (ju == 2) {
+      if (!(j >= 0) || j > 100) { exerr = static_cast<std::int8_t>(I.mas_jerk); return Err::ParameterOutOfRange; }
+      jd = jerk_from_percent_of_time(d, speed, j);
+    } else {
+      if (!(j > 0) || (ju == 1 && j > 100)) { exerr = static_cast<std::int8_t>(I.mas_jerk); return Err::ParameterOutOfRange; }
+      jd = ju == 1 ? j / 100.0 * a.cfg.max_decel_jerk : j;
+    }
+  }
+  if (scurve && !(jd > 0)) return Err::ZeroMaxDecelJerk;
+  if (!scurve) jd = kInf;
+
+  ControlTag& c = controls_[r.control];
+  c.set(flag::DN, true);
+  if (type == StopType::All || type == StopType::Home) {
+    if (a.homing) {
+      a.homing = false;
+      if (ControlTag* h = owner_tag(a.mah, a.mah_gen)) h->set(flag::IP, false);
+      if (a.cfg.type == AxisType::CipDrive) a.base = a.fb_pos;
+    }
+  }
+  const bool ramping = a.servo && mask != 0 && stop_slots(a, mask, d, jd, r.control, 0);
+  if (ramping) c.set(flag::IP, true);
+  else c.set(flag::PC, true);
+  return Err::None;
+}
+
+// --- MAH
+Err Planner::start_mah(const Request& r, AxisRt& a) noexcept {
+  if (Err e = common_checks(a, false); e != Err::None) return e;
+  if (a.homing) return Err::HomeInProcess;
+  const HomingConfig& h = a.cfg.homing;
+  if (a.cfg.rotary && (h.home_position < 0 || h.home_position >= a.cfg.unwind)) return Err::IllegalHomingConfig;
+  if (h.mode == HomingConfig::Mode::Absolute && h.sequence != HomingConfig::Sequence::Immediate)
+    return Err::IllegalHomingConfig;
+  if (h.mode == HomingConfig::Mode::Absolute && a.servo) return Err::ServoOnState;
+  if (h.mode == HomingConfig::Mode::Active && !a.servo) return Err::ServoOffState;
+  const bool immediate = h.sequence == HomingConfig::Sequence::Immediate || a.cfg.type == AxisType::Virtual;
+  if (!immediate && h.mode == HomingConfig::Mode::Passive) return Err::IllegalHomingConfig;
+  ControlTag& c = controls_[r.control];
+  if (h.mode == HomingConfig::Mode::Active) abort_all(a);  // active homing cancels other motion
+  c.set(flag::DN, true);
+  if (immediate) {
+    const double ref = h.mode == HomingConfig::Mode::Active ? user_command(a) : a.fb_pos + a.frame_offset;
+    const double delta = h.home_position - (a.cfg.rotary ? unwind_position(ref, a.cfg.unwind) : ref);
+    a.frame_offset += delta;
+    a.homed = true;
+    c.set(flag::PC, true);
+    return Err::None;
+  }
+  // CIP drive homing, CiA 402 mode 6 with 0x6098/0x6099/0x609A from configuration
+  a.homing = true;
+  a.homing_started = false;
+  a.homed = false;
+  a.mah = r.control;
+  a.mah_gen = c.generation;
+  c.set(flag::IP, true);
+  return Err::None;
+}
+
+// --- MAJ
+Err Planner::start_maj(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+  if (Err e = common_checks(a, true); e != Err::None) return e;
+  if (a.homing) return Err::HomeInProcess;
+  if (any_stopping(a)) return Err::NotAllowedWhileStopping;
+  const Idx& I = idx();
+  Dyn dy;
+  if (Err e = decode_dynamics(r, I.maj_speed, a.cfg, a.last_speed, dy, exerr); e != Err::None) return e;
+  if (dy.seconds) { exerr = static_cast<std::int8_t>(I.maj_speed + 1); return Err::ParameterOutOfRange; }
+  const double dir = ival(r, I.maj_dir) == 1 ? -1.0 : 1.0;
+  if (dir > 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitPositive & 1u)) return Err::OvertravelCondition;
+  if (dir < 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitNegative & 1u)) return Err::OvertravelCondition;
+  Kin start{};
+  auto* old = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Jog)]);
+  if (dy.merge) start = Kin{0, a.cmd.v, a.cmd.a};
+  else if (old) start = Kin{0, old->k.v, old->k.a};
+  double V = dy.speed;
+  if (dy.merge && dy.merge_current && std::fabs(start.v) > 0) V = std::fabs(start.v);
+  if (dy.scurve && dy.jerk_units == 2) {
+    // [UM003F p.258]: decel jerk uses max(Speed, |StartSpeed - Speed|)
+    const double vref = V > 0 ? V : a.last_speed;
+    dy.lim.ja = jerk_from_percent_of_time(dy.lim.a, vref, dy.jerk_pct_a);
+    dy.lim.jd = jerk_from_percent_of_time(dy.lim.d, std::max(vref, std::fabs(std::fabs(start.v) - V)), dy.jerk_pct_d);
+  }
+  ProfileGen g;
+  g.role = GenRole::Jog;
+  g.lim = dy.lim;
+  g.lim.v = V > 0 ? V : 1.0;
+  if (!plan_velocity(g.prof, start, dir * V, g.lim)) {
+    exerr = static_cast<std::int8_t>(I.maj_speed);
+    return Err::ParameterOutOfRange;
+  }
+  // commit
+  if (dy.merge) {
+    for (std::size_t s = 0; s < kSlots; ++s) fold(a, static_cast<Slot>(s), true);
+  } else {
+    fold(a, Slot::Jog, true);
+  }
+  ControlTag& c = controls_[r.control];
+  g.t0_cycle = cycle_;
+  g.k = start;
+  g.scurve = dy.scurve;
+  g.speed = V;
+  g.jog_velocity = dir * V;
+  g.owner = r.control;
+  g.owner_gen = c.generation;
+  a.gen[static_cast<std::size_t>(Slot::Jog)] = g;
+  if (V > 0) a.last_speed = V;
+  c.set(flag::DN, true);
+  c.set(flag::IP, true);
+  return Err::None;
+}
+
+// --- MAM
+Err Planner::start_mam(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+  if (Err e = common_checks(a, true); e != Err::None) return e;
+  if (a.homing) return Err::HomeInProcess;
+  if (any_stopping(a)) return Err::NotAllowedWhileStopping;
+  const Idx& I = idx();
+  Dyn dy;
+  if (Err e = decode_dynamics(r, I.mam_speed, a.cfg, a.last_speed, dy, exerr); e != Err::None) return e;
+  const auto mt = static_cast<MoveType>(ival(r, I.mam_type));
+  const double pos = dval(r, I.mam_pos);
+  if (mt == MoveType::AbsoluteMasterOffset || mt == MoveType::IncrementalMasterOffset)
+    return Err::FeatureNotSupported;  // runs with gearing/camming (issue 5)
+  const bool rot_type = mt == MoveType::RotaryShortest || mt == MoveType::RotaryPositive || mt == MoveType::RotaryNegative;
+  if (rot_type) {
+    if (!a.cfg.rotary) return Err::AxisModeNotRotary;
+    if (pos < 0 || pos >= a.cfg.unwind) { exerr = static_cast<std::int8_t>(I.mam_pos); return Err::ParameterOutOfRange; }
+  }
+  auto* old = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Move)]);
+  if (old && old->role != GenRole::Move) old = nullptr;
+  Kin start{};
+  if (dy.merge) start = Kin{0, a.cmd.v, a.cmd.a};
+  else if (old) start = Kin{0, old->k.v, old->k.a};
+  if (dy.seconds && (a.cmd.v != 0 || a.cmd.a != 0)) return Err::AxisNotAtRest;
+  // distance
+  const double cur = user_command(a);
+  const double U = a.cfg.unwind;
+  double L = 0;
+  switch (mt) {
+    case MoveType::Absolute: L = pos - (a.cfg.rotary ? unwind_position(cur, U) : cur); break;
+    case MoveType::Incremental:
+      L = pos;
+      if (old && old->move_type == MoveType::Incremental) L += old->total - old->k.p;  // added to the previous target
+      break;
+    case MoveType::RotaryShortest: {
+      L = pos - unwind_position(cur, U);
+      L -= U * std::floor(L / U + 0.5);
+      if (L >= U / 2) L -= U;
+      break;
+    }
+    case MoveType::RotaryPositive:
+      L = pos - unwind_position(cur, U);
+      if (L < 0) L += U;
+      break;
+    case MoveType::RotaryNegative:
+      L = pos - unwind_position(cur, U);
+      if (L > 0) L -= U;
+      break;
+    default: break;
+  }
+  if (L > 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitPositive & 1u)) return Err::OvertravelCondition;
+  if (L < 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitNegative & 1u)) return Err::OvertravelCondition;
+  ProfileGen g;
+  g.role = GenRole::Move;
+  if (dy.seconds) {
+    const double Ld = std::fabs(L);
+    const double V = Ld / (dy.t_total - dy.t_acc / 2 - dy.t_dec / 2);
+    if (Ld == 0 || !(V > 0) || !std::isfinite(V)) {
+      g.lim = Limits{1, 1, 1, kInf, kInf};
+    } else {
+      g.lim.v = V;
+      g.lim.a = V / (dy.t_acc - dy.tj_acc);
+      g.lim.d = V / (dy.t_dec - dy.tj_dec);
+      g.lim.ja = dy.scurve && dy.tj_acc > 0 ? g.lim.a / dy.tj_acc : kInf;
+      g.lim.jd = dy.scurve && dy.tj_dec > 0 ? g.lim.d / dy.tj_dec : kInf;
+      if (!std::isfinite(g.lim.a) || !std::isfinite(g.lim.d)) {  // zero accel/decel time: as fast as possible
+        g.lim.a = std::isfinite(g.lim.a) ? g.lim.a : 1e12;
+        g.lim.d = std::isfinite(g.lim.d) ? g.lim.d : 1e12;
+      }
+    }
+    g.speed = g.lim.v;
+    g.seconds = true;
+  } else {
+    double V = dy.speed;
+    if (dy.merge && dy.merge_current && std::fabs(start.v) > 0) V = std::fabs(start.v);
+    g.lim = dy.lim;
+    g.lim.v = V;
+    g.speed = V;
+    if (dy.scurve && dy.jerk_units == 2 && V > 0) {
+      g.lim.ja = jerk_from_percent_of_time(g.lim.a, V, dy.jerk_pct_a);
+      g.lim.jd = jerk_from_percent_of_time(g.lim.d, V, dy.jerk_pct_d);
+    }
+  }
+  bool ok;
+  if (g.speed > 0) {
+    ok = plan_move(g.prof, start, L, g.lim, Overshoot::Reverse);
+  } else {  // zero speed: ramp to a halt and wait for MCD
+    Limits l = g.lim;
+    l.v = 1.0;
+    ok = plan_velocity(g.prof, start, 0.0, l);
+  }
+  if (!ok) {
+    exerr = static_cast<std::int8_t>(I.mam_speed);
+    return Err::ParameterOutOfRange;
+  }
+  // commit: nothing above changed the axis
+  if (dy.merge) {
+    for (std::size_t s = 0; s < kSlots; ++s) fold(a, static_cast<Slot>(s), true);
+  } else {
+    fold(a, Slot::Move, true);
+  }
+  ControlTag& c = controls_[r.control];
+  g.t0_cycle = cycle_;
+  g.k = start;
+  g.total = L;
+  g.target_user = pos;
+  g.exact_target = mt == MoveType::Absolute && !a.cfg.rotary;
+  g.move_type = mt;
+  g.scurve = dy.scurve;
+  g.owner = r.control;
+  g.owner_gen = c.generation;
+  a.gen[static_cast<std::size_t>(Slot::Move)] = g;
+  if (g.speed > 0) a.last_speed = g.speed;
+  c.set(flag::DN, true);
+  c.set(flag::IP, true);
+  return Err::None;
+}
+
+// --- MCD
+Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+  if (Err e = common_checks(a, true); e != Err::None) return e;
+  const Idx& I = idx();
+  const bool jog = ival(r, I.mcd_type) == 0;
+  const bool chs = ival(r, I.mcd_chg_speed) == 1, cha = ival(r, I.mcd_chg_accel) == 1,
+             chd = ival(r, I.mcd_chg_decel) == 1, chja = ival(r, I.mcd_chg_ajerk) == 1,
+             chjd = ival(r, I.mcd_chg_djerk) == 1;
+  const int su = ival(r, I.mcd_speed_units), au = ival(r, I.mcd_accel_units), du = ival(r, I.mcd_decel_units),
+            ju = ival(r, I.mcd_jerk_units);
+  const bool md = (chs && su == 4) || (cha && au == 4) || (chd && du == 4) || ((chja || chjd) && is_md_jerk(ju));
+  const bool td = (chs && su != 4) || (cha && au != 4) || (chd && du != 4) || ((chja || chjd) && !is_md_jerk(ju));
+  if (md && td) return Err::MdscUnitsConflict;
+  if (md) return Err::MdscNotActivated;
+  ControlTag& c = controls_[r.control];
+  auto* g = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(jog ? Slot::Jog : Slot::Move)]);
+  if (!g || g->role != (jog ? GenRole::Jog : GenRole::Move)) {
+    c.set(flag::DN, true);  // nothing to change
+    return Err::None;
+  }
+  if (g->seconds) return Err::IllegalDynamicChange;
+  Limits lim = g->lim;
+  double V = g->speed;
+  if (chs) V = su == 1 ? dval(r, I.mcd_speed) / 100.0 * a.cfg.max_speed : dval(r, I.mcd_speed);
+  if (cha) {
+    const double v = dval(r, I.mcd_accel);
+    if (!(v > 0)) { exerr = static_cast<std::int8_t>(I.mcd_accel); return Err::ParameterOutOfRange; }
+    lim.a = au == 1 ? v / 100.0 * a.cfg.max_accel : v;
+  }
+  if (chd) {
+    const double v = dval(r, I.mcd_decel);
+    if (!(v > 0)) { exerr = static_cast<std::int8_t>(I.mcd_decel); return Err::ParameterOutOfRange; }
+    if (du == 1 && !(a.cfg.max_decel > 0)) return Err::ZeroMaxDecel;
+    lim.d = du == 1 ? v / 100.0 * a.cfg.max_decel : v;
+  }
+  if (g->scurve && (chja || chjd)) {
+    const double vref = V > 0 ? V : a.last_speed;
+    auto conv = [&](double v, bool accel, int index, double& out) noexcept -> Err {
+      if (ju == 2) {
+        if (!(v >= 0) || v > 100) { exerr = static_cast<std::int8_t>(index); return Err::ParameterOutOfRange; }
+        out = jerk_from_percent_of_time(accel ? lim.a : lim.d, vref, v);
+      } else {
+        if (!(v > 0) || (ju == 1 && v > 100)) { exerr = static_cast<std::int8_t>(index); return Err::ParameterOutOfRange; }
+        out = ju == 1 ? v / 100.0 * (accel ? a.cfg.max_accel_jerk : a.cfg.max_decel_jerk) : v;
+        if (!(out > 0)) return accel ? Err::ParameterOutOfRange : Err::ZeroMaxDecelJerk;
+      }
+      return Err::None;
+    };
+    if (chja) if (Err e = conv(dval(r, I.mcd_ajerk), true, I.mcd_ajerk, lim.ja); e != Err::None) return e;
+    if (chjd) if (Err e = conv(dval(r, I.mcd_djerk), false, I.mcd_djerk, lim.jd); e != Err::None) return e;
+  }
+  Profile prof;
+  bool ok;
+  Limits l = lim;
+  l.v = V > 0 ? V : 1.0;
+  if (jog) {
+    ok = plan_velocity(prof, g->k, (g->jog_velocity < 0 ? -1.0 : 1.0) * V, l);
+  } else if (V > 0) {
+    // Limits dropped mid-move: stop exactly on target, never past it (README).
+    ok = plan_move(prof, g->k, g->total - g->k.p, l, Overshoot::StopAtTarget);
+  } else {
+    ok = plan_velocity(prof, g->k, 0.0, l);  // speed 0: pause
+  }
+  if (!ok) { exerr = static_cast<std::int8_t>(I.mcd_speed); return Err::ParameterOutOfRange; }
+  g->prof = prof;
+  g->hint = 0;
+  g->t0_cycle = cycle_;
+  g->lim = l;
+  g->speed = V;
+  if (jog) g->jog_velocity = (g->jog_velocity < 0 ? -1.0 : 1.0) * V;
+  if (V > 0) a.last_speed = V;
+  c.set(flag::DN, true);
+  return Err::None;
+}
+
+// --- MRP
+Err Planner::start_mrp(const Request& r, AxisRt& a) noexcept {
+  if (!a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  if (a.homing) return Err::HomeInProcess;
+  const Idx& I = idx();
+  const bool relative = ival(r, I.mrp_type) == 1;
+  const bool command = ival(r, I.mrp_select) == 1;
+  const double p = dval(r, I.mrp_pos);
+  double delta = p;
+  if (!relative) {
+    double sel = command ? user_command(a) : (a.cfg.type == AxisType::Virtual ? user_command(a) : a.fb_pos + a.frame_offset);
+    if (a.cfg.rotary) sel = unwind_position(sel, a.cfg.unwind);
+    delta = p - sel;
+  }
+  a.frame_offset += delta;  // both command and actual shift: the following error is kept
+  controls_[r.control].set(flag::DN, true);
+  return Err::None;
+}
+
+// --- MGS / MGSD / MGSR
+Err Planner::start_group(const Request& r, std::int8_t& exerr) noexcept {
+  const std::uint8_t grp = static_cast<std::uint8_t>(r.op[0].ref);
+  ControlTag& c = controls_[r.control];
+  (void)exerr;
+  if (r.instr == Instr::MGSD || r.instr == Instr::MGSR) {
+    for (std::size_t i = 0; i < axis_count_; ++i) {
+      AxisRt& a = axes_[i];
+      if (!a.present || a.cfg.group != grp || !a.cfg.configured || a.cfg.inhibited) continue;
+      if (r.instr == Instr::MGSD) {
+        do_shutdown(a);
+      } else {
+        a.shutdown = false;
+        a.faulted = false;
+        a.tag.exception_faults = 0;
+        a.tag.motion_fault_status = 0;
+        a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
+      }
+    }
+    c.set(flag::DN, true);
+    return Err::None;
+  }
+  const auto mode = static_cast<GroupStopMode>(ival(r, idx().mgs_mode));
+  bool ramping = false;
+  for (std::size_t i = 0; i < axis_count_; ++i) {
+    AxisRt& a = axes_[i];
+    if (!a.present || a.cfg.group != grp || !a.cfg.configured || a.cfg.inhibited) continue;
+    ProgrammedStopMode m = mode == GroupStopMode::FastStop      ? ProgrammedStopMode::FastStop
+                           : mode == GroupStopMode::FastDisable ? ProgrammedStopMode::FastDisable
+                                                                : a.cfg.programmed_stop_mode;
+    if (a.homing) {
+      a.homing = false;
+      if (ControlTag* h = owner_tag(a.mah, a.mah_gen)) h->set(flag::IP, false);
+    }
+    if (m == ProgrammedStopMode::HardDisable) { servo_off(a); continue; }
+    if (m == ProgrammedStopMode::HardShutdown) { do_shutdown(a); continue; }
+    const std::uint8_t post = m == ProgrammedStopMode::FastDisable ? 1 : (m == ProgrammedStopMode::FastShutdown ? 2 : 0);
+    bool scurve = false;
+    for (const auto& g : a.gen)
+      if (auto* p = std::get_if<ProfileGen>(&g)) scurve = scurve || p->scurve;
+    const double d = a.cfg.max_decel > 0 ? a.cfg.max_decel : 1e12;
+    const double jd = scurve && a.cfg.max_decel_jerk > 0 ? a.cfg.max_decel_jerk : kInf;
+    const bool r_ax = a.servo && stop_slots(a, (1u << kSlots) - 1u, d, jd, r.control, post);
+    ramping = ramping || r_ax;
+    if (!r_ax) {
+      if (post == 1) servo_off(a);
+      if (post == 2) do_shutdown(a);
+    }
+  }
+  c.set(flag::DN, true);
+  if (ramping) {
+    c.set(flag::IP, true);
+    groups_[grp] = GroupOp{r.control, c.generation, grp, true};
+  } else {
+    c.set(flag::PC, true);
+  }
+  return Err::None;
+}
+
+// ------------------------------------------------------------------- cycle
+void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcept {
+  if (a.cfg.type != AxisType::CipDrive) return;
+  if (fb) {
+    a.fb = *fb;
+    a.fb_pos = fb->position;
+    a.fb_vel = fb->velocity;
+  }
+  // pending MSO
+  if (a.mso != kNoControl) {
+    ControlTag* c = owner_tag(a.mso, a.mso_gen);
+    if (!c) {
+      a.mso = kNoControl;
+    } else if (a.fb.drive == DriveState::Enabled) {
+      a.servo = true;
+      a.base = a.fb_pos;  // close the loop at the present position
+      a.cmd = Kin{a.fb_pos, 0, 0};
+      c->state = 1;
+      c->set(flag::DN, true);
+      a.mso = kNoControl;
+    } else if (a.fb.drive == DriveState::Fault || cycle_ >= a.mso_deadline) {
+      c->reject(Err::ServoMessageFailure, 16);
+      a.enable_req = false;
+      a.mso = kNoControl;
+    } else {
+      c->state = 1;  // waiting for drive enable and servo action
+    }
+  }
+  if (a.msf != kNoControl) {
+    ControlTag* c = owner_tag(a.msf, a.msf_gen);
+    if (!c) {
+      a.msf = kNoControl;
+    } else if (a.fb.drive != DriveState::Enabled) {
+      c->set(flag::DN, true);
+      a.msf = kNoControl;
+    } else if (cycle_ >= a.mso_deadline) {
+      c->reject(Err::ServoMessageFailure, 16);
+      a.msf = kNoControl;
+    }
+  }
+  // drive homing
+  if (a.homing) {
+    ControlTag* c = owner_tag(a.mah, a.mah_gen);
+    if (a.fb.homing_attained && a.homing_started) {
+      a.frame_offset = a.cfg.homing.home_position - a.fb_pos;
+      a.homed = true;
+      a.homing = false;
+      a.base = a.fb_pos;
+      a.cmd = Kin{a.fb_pos, 0, 0};
+      if (c) { c->set(flag::IP, false); c->set(flag::PC, true); }
+    } else if (a.fb.homing_error) {
+      a.homing = false;
+      a.base = a.fb_pos;
+      if (c) { c->set(flag::IP, false); c->reject(Err::ServoMessageFailure, 16); }
+    }
+  }
+  // servo off or homing: the command follows the actual position
+  if (!a.servo || a.homing) {
+    a.base = a.fb_pos;
+    a.cmd = Kin{a.fb_pos, 0, 0};
+  }
+  // a drive that dropped out of Operation Enabled switches the servo off
+  if (a.servo && a.fb.drive != DriveState::Enabled) servo_off(a);
+}
+
+void Planner::handle_exceptions(AxisRt& a) noexcept {
+  std::uint32_t active = 0;
+  auto bit = [](ExceptionKind k) { return 1u << static_cast<unsigned>(k); };
+  if (a.cfg.type == AxisType::CipDrive) {
+    if (a.fb.drive_fault || a.fb.drive == DriveState::Fault) active |= bit(ExceptionKind::DriveFault);
+    if (a.fb.node_lost) active |= bit(ExceptionKind::NodeLost);
+    if (a.fb.bus_off) active |= bit(ExceptionKind::BusOff);
+    if (a.servo && a.cfg.position_error_tolerance > 0 &&
+        std::fabs(a.cmd.p - a.fb_pos) > a.cfg.position_error_tolerance)
+      active |= bit(ExceptionKind::PositionError);
+  }
+  if (a.cfg.soft_limits_enabled && !a.cfg.rotary) {
+    const double p = user_command(a);
+    if (p > a.cfg.soft_limit_pos) active |= bit(ExceptionKind::SoftOvertravelPos);
+    if (p < a.cfg.soft_limit_neg) active |= bit(ExceptionKind::SoftOvertravelNeg);
+  }
+  std::uint32_t alarms = 0, faults = 0;
+  for (unsigned k = 0; k < static_cast<unsigned>(ExceptionKind::Count); ++k) {
+    if (!(active & (1u << k))) continue;
+    const ExceptionAction act = a.cfg.action(static_cast<ExceptionKind>(k));
+    if (act == ExceptionAction::Alarm) alarms |= 1u << k;
+    if (act >= ExceptionAction::FaultStatusOnly) faults |= 1u << k;
+  }
+  a.tag.exception_alarms = alarms;
+  const std::uint32_t fresh = faults & ~a.tag.exception_faults;
+  a.tag.exception_faults |= faults;
+  // the most severe action of the new faults wins
+  ExceptionAction worst = ExceptionAction::Ignore;
+  for (unsigned k = 0; k < static_cast<unsigned>(ExceptionKind::Count); ++k)
+    if (fresh & (1u << k)) worst = most_severe(worst, a.cfg.action(static_cast<ExceptionKind>(k)));
+  if (fresh & bit(ExceptionKind::SoftOvertravelPos)) a.tag.motion_fault_status |= 1u << motion_fault::SoftTravelLimitPositive;
+  if (fresh & bit(ExceptionKind::SoftOvertravelNeg)) a.tag.motion_fault_status |= 1u << motion_fault::SoftTravelLimitNegative;
+  a.tag.motion_alarm_status = 0;
+  if (alarms & bit(ExceptionKind::SoftOvertravelPos)) a.tag.motion_alarm_status |= 1u << motion_fault::SoftTravelLimitPositive;
+  if (alarms & bit(ExceptionKind::SoftOvertravelNeg)) a.tag.motion_alarm_status |= 1u << motion_fault::SoftTravelLimitNegative;
+  switch (worst) {
+    case ExceptionAction::StopPlanner: {
+      if (a.servo) {
+        bool scurve = false;
+        for (const auto& g : a.gen)
+          if (auto* p = std::get_if<ProfileGen>(&g)) scurve = scurve || p->scurve;
+        const double d = a.cfg.max_decel > 0 ? a.cfg.max_decel : 1e12;
+        const double jd = scurve && a.cfg.max_decel_jerk > 0 ? a.cfg.max_decel_jerk : kInf;
+        stop_slots(a, (1u << kSlots) - 1u, d, jd, kNoControl, 0);
+      }
+      break;
+    }
+    case ExceptionAction::StopDrive:
+      servo_off(a);
+      a.faulted = true;
+      break;
+    case ExceptionAction::Shutdown:
+      do_shutdown(a);
+      a.faulted = true;
+      break;
+    default:
+      break;
+  }
+  // AxisFault summary bits
+  std::uint32_t af = 0;
+  const std::uint32_t f = a.tag.exception_faults;
+  if (f & (bit(ExceptionKind::DriveFault) | bit(ExceptionKind::PositionError))) af |= 1u << axis_fault::PhysicalAxisFault;
+  if (f & (bit(ExceptionKind::NodeLost) | bit(ExceptionKind::BusOff))) af |= 1u << axis_fault::ModuleFault;
+  if (f & (bit(ExceptionKind::SoftOvertravelPos) | bit(ExceptionKind::SoftOvertravelNeg))) af |= 1u << axis_fault::MotionFault;
+  a.tag.axis_fault = af;
+}
+
+void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
+  double sum_p = 0, sum_v = 0, sum_a = 0;
+  for (std::size_t s = 0; s < kSlots; ++s) {
+    auto* g = std::get_if<ProfileGen>(&a.gen[s]);
+    if (!g) continue;
+    const double t = static_cast<double>(cycle_ - g->t0_cycle) * T_;
+    g->k = g->prof.sample(t, g->hint);
+    const bool done = g->role != GenRole::Jog && g->prof.finite() && t >= g->prof.duration();
+    ControlTag* c = owner_tag(g->owner, g->owner_gen);
+    if (done) {
+      if (g->role == GenRole::Move) {
+        bool alone = true;
+        for (std::size_t o = 0; o < kSlots; ++o)
+          if (o != s && !std::holds_alternative<std::monostate>(a.gen[o])) alone = false;
+        g->k = Kin{g->total, 0, 0};
+        if (alone && g->exact_target) {
+          a.base = g->target_user - a.frame_offset;  // ends exactly on the programmed target
+          g->k.p = 0;
+        }
+      }
+      const std::uint8_t post = g->post_stop;
+      // ramps of an MGS: the MGS gets PC when every axis of its group stopped
+      bool group_owned = false;
+      for (const auto& go : groups_)
+        if (go.active && go.ctl == g->owner && go.gen == g->owner_gen) group_owned = true;
+      if (c && !group_owned) {
+        c->set(flag::PC, true);
+        c->set(flag::ACCEL, false);
+        c->set(flag::DECEL, false);
+      }
+      fold(a, static_cast<Slot>(s), !group_owned);
+      if (post == 1) servo_off(a);
+      if (post == 2) do_shutdown(a);
+      continue;
+    }
+    if (c) {
+      c->set(flag::ACCEL, g->k.v * g->k.a > 0 || (g->k.v == 0 && g->k.a != 0));
+      c->set(flag::DECEL, g->k.v * g->k.a < 0);
+    }
+    sum_p += g->k.p;
+    sum_v += g->k.v;
+    sum_a += g->k.a;
+  }
+  a.cmd = Kin{a.base + sum_p, sum_v, sum_a};
+  if (out) {
+    out->position = a.cmd.p;
+    out->velocity = a.cmd.v;
+    out->acceleration = a.cmd.a;
+    out->torque = 0;
+    out->enable = a.enable_req && !a.shutdown;
+    out->shutdown = a.shutdown;
+    out->fault_reset = a.fault_reset_pulse;
+    out->mode = a.homing ? DriveMode::Homing : DriveMode::CyclicPosition;
+    out->homing_start = a.homing;
+    if (a.homing) {
+      const HomingConfig& h = a.cfg.homing;
+      out->homing = HomingRequest{h.cia_method, h.speed_search, h.speed_zero, h.accel};
+      a.homing_started = true;
+    }
+  }
+  a.fault_reset_pulse = false;
+}
+
+void Planner::update_status(AxisRt& a) noexcept {
+  using namespace motion_status;
+  AxisTag& t = a.tag;
+  std::uint32_t ms = 0;
+  auto setb = [&](unsigned b, bool on) { if (on) ms |= 1u << b; };
+  const auto* mv = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Move)]);
+  const auto* jg = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Jog)]);
+  setb(MoveStatus, mv && mv->role == GenRole::Move);
+  setb(JogStatus, jg && jg->role == GenRole::Jog);
+  setb(StoppingStatus, any_stopping(a));
+  setb(HomingStatus, a.homing);
+  setb(AxisHomedStatus, a.homed);
+  setb(AccelStatus, a.cmd.v * a.cmd.a > 0 || (a.cmd.v == 0 && a.cmd.a != 0));
+  setb(DecelStatus, a.cmd.v * a.cmd.a < 0);
+  setb(MaximumSpeedExceeded, a.cfg.max_speed > 0 && std::fabs(a.cmd.v) > a.cfg.max_speed * (1 + 1e-9));
+  t.motion_status = ms;
+  std::uint32_t as = 0;
+  if (a.servo) as |= (1u << axis_status::ServoActionStatus) | (1u << axis_status::DriveEnableStatus);
+  if (a.shutdown) as |= 1u << axis_status::ShutdownStatus;
+  if (a.cfg.inhibited) as |= 1u << axis_status::InhibitStatus;
+  as |= 1u << axis_status::AxisUpdateStatus;
+  t.axis_status = as;
+  if (!a.cfg.configured) t.state = AxisState::Ungrouped;
+  else if (a.cfg.inhibited) t.state = AxisState::Inhibited;
+  else if (a.shutdown) t.state = AxisState::Shutdown;
+  else if (a.faulted) t.state = AxisState::Faulted;
+  else if (a.servo) t.state = AxisState::ServoControl;
+  else t.state = AxisState::Ready;
+  if (a.cfg.inhibited) t.cip_state = CipAxisState::AxisInhibited;
+  else if (a.shutdown) t.cip_state = CipAxisState::Shutdown;
+  else if (a.faulted) t.cip_state = CipAxisState::MajorFaulted;
+  else if (a.servo) t.cip_state = any_stopping(a) ? CipAxisState::Stopping : CipAxisState::Running;
+  else if (a.enable_req) t.cip_state = CipAxisState::Starting;
+  else t.cip_state = CipAxisState::Stopped;
+  // tags in the user frame
+  const double act = a.cfg.type == AxisType::Virtual ? a.cmd.p : a.fb_pos;
+  const double actv = a.cfg.type == AxisType::Virtual ? a.cmd.v : a.fb_vel;
+  t.command_position = a.cmd.p + a.frame_offset;
+  t.actual_position = act + a.frame_offset;
+  if (a.cfg.rotary) {
+    t.command_position = unwind_position(t.command_position, a.cfg.unwind);
+    t.actual_position = unwind_position(t.actual_position, a.cfg.unwind);
+  }
+  t.command_velocity = a.cmd.v;
+  t.command_acceleration = a.cmd.a;
+  t.actual_velocity = actv;
+  t.position_error = a.cmd.p - act;
+}
+
+Result Planner::update(const Input& in, Output& out) noexcept {
+  if (started_ && in.cycle <= cycle_) return Result::ErrorCycleNotIncreasing;
+  // 1. feedback and exceptions (against last cycle's command)
+  for (std::size_t i = 0; i < axis_count_; ++i) {
+    AxisRt& a = axes_[i];
+    if (!a.present) continue;
+    handle_feedback(static_cast<AxisId>(i), a, i < in.feedback.size() ? &in.feedback[i] : nullptr);
+    handle_exceptions(a);
+  }
+  // 2. requests in program order; generators started now have their time
+  //    origin at the last stepped cycle, so they continue from its state.
+  for (const Request& r : in.requests) execute(r);
+  // 3. step axes (index order; masters before slaves once gearing exists)
+  cycle_ = in.cycle;
+  started_ = true;
+  for (std::size_t i = 0; i < axis_count_; ++i) {
+    AxisRt& a = axes_[i];
+    if (!a.present) continue;
+    step_axis(a, i < out.axes.size() ? &out.axes[i] : nullptr);
+    update_status(a);
+  }
+  // 4. group stops: PC when no ramp owned by the MGS is left
+  for (auto& g : groups_) {
+    if (!g.active) continue;
+    bool any = false;
+    for (std::size_t i = 0; i < axis_count_ && !any; ++i)
+      for (const auto& s : axes_[i].gen)
+        if (auto* p = std::get_if<ProfileGen>(&s); p && p->owner == g.ctl && p->owner_gen == g.gen) any = true;
+    if (!any) {
+      if (ControlTag* c = owner_tag(g.ctl, g.gen)) { c->set(flag::IP, false); c->set(flag::PC, true); }
+      g.active = false;
+    }
+  }
+  return Result::Ok;
+}
+
+}  // namespace canmotion::motion

@@ -1,0 +1,256 @@
+#pragma once
+/// \file motion/planner.hpp
+/// The motion planner: fixed-capacity axes, control tags and generators, the
+/// Logix instruction model, and the one-call-per-cycle API for the runtime:
+///
+///     Planner p(cycle_period);                 // non-RT: construct, configure
+///     p.configure_axis(0, cfg);
+///     ... every cycle (RT):
+///     Input in{cycle_index, feedback, requests};
+///     p.update(in, out);                       // noexcept, no allocation
+///
+/// See motion/README.md for the full contract.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <variant>
+
+#include "motion/axis.hpp"
+#include "motion/control_tag.hpp"
+#include "motion/profile.hpp"
+#include "motion/signatures.hpp"
+#include "motion/types.hpp"
+
+namespace canmotion::motion {
+
+// ----------------------------------------------------------------- requests
+/// One operand value of a request: a number (immediates and numeric tags,
+/// enumerations as their number) or a reference (axis, group, cam, ...) id.
+struct Operand {
+  double value = 0.0;
+  std::uint16_t ref = 0xFFFF;  ///< id for Axis/Group/Cam/... operands
+};
+
+/// One instruction execution (= one false-to-true rung transition), with its
+/// operands in ST order. Produced by bind_call() (motion/st_parser.hpp) or
+/// built directly. Trivially copyable: fits an SPSC ring.
+struct Request {
+  Instr instr = Instr::MSO;
+  ControlId control = kNoControl;
+  std::uint8_t count = 0;  ///< number of operands given
+  std::array<Operand, kMaxOperands> op{};
+};
+
+// ------------------------------------------------------------ cycle I/O
+/// Drive state as the runtime reports it for an AXIS_CIP_DRIVE (from the CiA
+/// 402 statusword).
+enum class DriveState : std::uint8_t {
+  NotReady = 0,  ///< not ready / switch on disabled / ready to switch on
+  SwitchedOn = 1,
+  Enabled = 2,   ///< operation enabled
+  Fault = 3,     ///< fault or fault reaction active
+};
+
+/// CiA 402 mode the drive should run (0x6060).
+enum class DriveMode : std::int8_t { Homing = 6, CyclicPosition = 8, CyclicVelocity = 9, CyclicTorque = 10 };
+
+/// Per-axis feedback for one cycle (CIP axes; ignored for virtual axes).
+struct AxisFeedback {
+  double position = 0.0;   ///< actual position in user units = counts / conversion constant (drive frame)
+  double velocity = 0.0;   ///< user units/s
+  DriveState drive = DriveState::NotReady;
+  bool drive_fault = false;   ///< fault bit or EMCY error seen this cycle
+  std::uint16_t emcy_code = 0;
+  bool node_lost = false;     ///< heartbeat / cyclic data lost
+  bool bus_off = false;       ///< the CAN interface is bus-off
+  bool homing_attained = false;  ///< statusword bit 12 in homing mode
+  bool homing_error = false;     ///< statusword bit 13 in homing mode
+};
+
+/// Homing parameters to write before starting drive homing (mode 6).
+struct HomingRequest {
+  std::int8_t method = 0;     ///< 0x6098
+  double speed_search = 0.0;  ///< 0x6099:01, user units/s
+  double speed_zero = 0.0;    ///< 0x6099:02, user units/s
+  double accel = 0.0;         ///< 0x609A, user units/s^2
+};
+
+/// Per-axis output for one cycle.
+struct AxisOutput {
+  double position = 0.0;      ///< command position, drive frame, user units (x conversion constant = counts)
+  double velocity = 0.0;      ///< command velocity, user units/s (feed-forward / CSV target)
+  double acceleration = 0.0;
+  double torque = 0.0;        ///< CST target (MDS torque mode, issue 5)
+  DriveMode mode = DriveMode::CyclicPosition;
+  bool enable = false;        ///< the drive should be in Operation Enabled
+  bool fault_reset = false;   ///< pulse a CiA 402 fault reset this cycle
+  bool homing_start = false;  ///< mode 6: set controlword bit 4 (homing operation start)
+  HomingRequest homing{};     ///< valid while mode == Homing
+  bool shutdown = false;      ///< the axis is in the Logix Shutdown state
+};
+
+/// Inputs of one cycle. Spans are owned by the caller (fixed arrays).
+struct Input {
+  std::uint64_t cycle = 0;                   ///< cycle index; time = cycle * period
+  std::span<const AxisFeedback> feedback{};  ///< indexed by AxisId (may be shorter: missing = no feedback)
+  std::span<const Request> requests{};       ///< executions in program order
+};
+
+/// Outputs of one cycle.
+struct Output {
+  std::span<AxisOutput> axes{};  ///< indexed by AxisId; entries past the span are not written
+};
+
+/// Result of update(): >= 0 ok, < 0 caller error (ruckig style).
+enum class Result : std::int8_t {
+  Ok = 0,
+  ErrorCycleNotIncreasing = -1,  ///< input.cycle <= previous cycle
+};
+
+// --------------------------------------------------------------- generators
+/// What a profile generator is doing.
+enum class GenRole : std::uint8_t { Move, Jog, Stop };
+
+/// State of a profile-driven instruction (MAM, MAJ, and the ramps of MAS/MGS
+/// and exception stops). O(1) step: one Profile::sample.
+struct ProfileGen {
+  GenRole role = GenRole::Move;
+  Profile prof{};
+  int hint = 0;
+  std::uint64_t t0_cycle = 0;  ///< profile time = (cycle - t0_cycle) * period
+  Kin k{};                     ///< last sample (offset of this generator)
+  double total = 0.0;          ///< move: distance from the generator origin to the target
+  double target_user = 0.0;    ///< move: programmed absolute target (user frame)
+  bool exact_target = false;   ///< move: absolute linear target can be set exactly at the end
+  MoveType move_type = MoveType::Absolute;
+  Limits lim{};
+  bool scurve = false;
+  bool seconds = false;        ///< programmed in seconds (MCD not allowed: ERR 23)
+  double speed = 0.0;          ///< programmed speed (0 = paused until MCD)
+  double jog_velocity = 0.0;   ///< jog: signed programmed velocity
+  ControlId owner = kNoControl;
+  std::uint32_t owner_gen = 0;
+  std::uint8_t post_stop = 0;  ///< stop ramps of MGS: 0 none, 1 disable, 2 shutdown
+};
+
+/// Per-axis generator slots. Generators superpose: the command position is
+/// base + the sum of the slot offsets. Bound: one slot per kind of motion
+/// Logix can run at the same time on one axis (move, jog, gear, time cam,
+/// position cam, master offset move) plus one for a stop of all motion.
+enum class Slot : std::uint8_t { Move = 0, Jog, Gear, TimeCam, PositionCam, MasterOffset, StopAll, Count };
+inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
+
+/// The closed set of generator states. Issue 5 adds gear/cam/direct states here.
+using Generator = std::variant<std::monostate, ProfileGen>;
+
+// ------------------------------------------------------------------ planner
+/// The planner. All state is inside (fixed arrays); update() is noexcept,
+/// allocation-free and realtime-safe. Configuration calls are not RT.
+class Planner {
+ public:
+  /// cycle_period in seconds (> 0), e.g. 0.001.
+  explicit Planner(double cycle_period) noexcept;
+
+  /// Configure (or reconfigure) an axis. Not realtime (call before the
+  /// cyclic loop). Returns false if the id is out of range or the config is
+  /// invalid (non-positive conversion constant, unwind, negative limits).
+  bool configure_axis(AxisId id, const AxisConfig& cfg) noexcept;
+  /// Number of configured axes (ids 0..axis_count()-1).
+  std::size_t axis_count() const noexcept { return axis_count_; }
+
+  /// Run one cycle: feedback, exceptions, requests (in order), generators,
+  /// outputs. Realtime-safe.
+  Result update(const Input& in, Output& out) noexcept;
+
+  /// Execute one request right now (as part of the current cycle). update()
+  /// calls this for every input request; exposed for tests. Returns the ERR
+  /// (Err::None on success), also written to the control tag. Realtime-safe.
+  Err execute(const Request& r) noexcept;
+
+  /// Axis tag (status) of an axis. Realtime-safe.
+  const AxisTag& axis(AxisId id) const noexcept { return axes_[id].tag; }
+  const AxisConfig& config(AxisId id) const noexcept { return axes_[id].cfg; }
+  /// Control tag. Realtime-safe.
+  const ControlTag& control(ControlId id) const noexcept { return controls_[id]; }
+  /// Clear a control tag (prescan). Realtime-safe.
+  void reset_control(ControlId id) noexcept { controls_[id] = ControlTag{}; }
+  double period() const noexcept { return T_; }
+  std::uint64_t cycle() const noexcept { return cycle_; }
+
+ private:
+  struct AxisRt {
+    AxisConfig cfg{};
+    AxisTag tag{};
+    bool present = false;
+    double base = 0.0;          ///< drive-frame position with all finished motion folded in
+    double frame_offset = 0.0;  ///< user = drive + frame_offset (MRP, homing)
+    Kin cmd{};                  ///< total command (drive frame)
+    double fb_pos = 0.0, fb_vel = 0.0;
+    AxisFeedback fb{};
+    bool servo = false;         ///< servo loop active
+    bool enable_req = false;    ///< drive enable requested
+    bool shutdown = false;
+    bool faulted = false;       ///< StopDrive/Shutdown fault latched: ERR 20 until MAFR/MASR
+    bool homed = false;
+    bool fault_reset_pulse = false;
+    std::array<Generator, kSlots> gen{};
+    double last_speed = 0.0;    ///< last non-zero programmed speed (zero-speed S-curve rule)
+    // multi-cycle state instructions
+    ControlId mso = kNoControl, msf = kNoControl;
+    std::uint32_t mso_gen = 0, msf_gen = 0;
+    std::uint64_t mso_deadline = 0;
+    ControlId mah = kNoControl;
+    std::uint32_t mah_gen = 0;
+    bool homing = false;        ///< drive homing (mode 6) in progress
+    bool homing_started = false;
+    std::uint32_t exc_prev = 0;  ///< exceptions active last cycle
+  };
+  struct GroupOp {  ///< MGS in progress
+    ControlId ctl = kNoControl;
+    std::uint32_t gen = 0;
+    std::uint8_t group = 0;
+    bool active = false;
+  };
+
+  // instruction start functions (validate + plan; an error changes nothing)
+  Err start_mso(const Request&, AxisRt&) noexcept;
+  Err start_msf(const Request&, AxisRt&) noexcept;
+  Err start_masd(const Request&, AxisRt&) noexcept;
+  Err start_masr(const Request&, AxisRt&) noexcept;
+  Err start_mafr(const Request&, AxisRt&) noexcept;
+  Err start_mas(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mah(const Request&, AxisRt&) noexcept;
+  Err start_maj(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mam(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mcd(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mrp(const Request&, AxisRt&) noexcept;
+  Err start_group(const Request&, std::int8_t& exerr) noexcept;
+
+  // helpers
+  Err common_checks(const AxisRt& a, bool need_servo) const noexcept;
+  void step_axis(AxisRt& a, AxisOutput* out) noexcept;
+  void handle_feedback(AxisId id, AxisRt& a, const AxisFeedback* fb) noexcept;
+  void handle_exceptions(AxisRt& a) noexcept;
+  void fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept;
+  void abort_all(AxisRt& a) noexcept;  ///< cancel every generator at once (no ramp)
+  bool stop_slots(AxisRt& a, std::uint32_t slot_mask, double d, double jd, ControlId owner,
+                  std::uint8_t post_stop) noexcept;
+  void servo_off(AxisRt& a) noexcept;
+  void do_shutdown(AxisRt& a) noexcept;
+  void update_status(AxisRt& a) noexcept;
+  Kin slot_kin(const AxisRt& a, Slot s) const noexcept;
+  double user_command(const AxisRt& a) const noexcept;
+  ControlTag* owner_tag(ControlId id, std::uint32_t gen) noexcept;
+  bool any_stopping(const AxisRt& a) const noexcept;
+
+  double T_;
+  std::uint64_t cycle_ = 0;
+  bool started_ = false;
+  std::size_t axis_count_ = 0;
+  std::array<AxisRt, kMaxAxes> axes_{};
+  std::array<ControlTag, kMaxControlTags> controls_{};
+  std::array<GroupOp, kMaxGroups> groups_{};
+};
+
+}  // namespace canmotion::motion

@@ -1,0 +1,163 @@
+// sd_notify readiness and the cycle watchdog: the decision logic, the thread
+// with a fake sink, and real sd_notify datagrams on a $NOTIFY_SOCKET.
+#include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rt/systemd_notify.hpp"
+
+using namespace canmotion::rt;
+
+TEST(RtWatchdog, LogicPingsOnlyWhileTheCounterAdvances) {
+  CycleWatchdog w;
+  using V = CycleWatchdog::Verdict;
+  EXPECT_EQ(w.check(0), V::ping) << "first check pings";
+  EXPECT_EQ(w.check(10), V::ping);
+  EXPECT_EQ(w.check(10), V::stalled);
+  EXPECT_EQ(w.check(10), V::still_stalled);
+  EXPECT_EQ(w.check(10), V::still_stalled);
+  EXPECT_EQ(w.check(11), V::ping) << "recovers";
+  EXPECT_EQ(w.check(11), V::stalled) << "a new stall is reported again";
+  EXPECT_EQ(w.last_count(), 11u);
+}
+
+TEST(RtWatchdog, ThreadStopsPingingWhenTheCycleStalls) {
+  std::atomic<std::uint64_t> counter{0};
+  std::mutex m;
+  std::vector<std::string> sent;
+  WatchdogThread wd([&] { return counter.load(); }, Nanos{2'000'000}, [&](std::string_view s) {
+    std::lock_guard lock(m);
+    sent.emplace_back(s);
+    return 1;
+  });
+  wd.start();
+  // Advance the "cycle" until a few pings went out.
+  while (wd.pings() < 5) {
+    counter.fetch_add(1);
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  // Stall: wait until the watchdog notices, then for a few more checks. (A
+  // descheduled test thread may already have caused a stall: count from here.)
+  const std::uint64_t stalls_before = wd.stalls();
+  while (wd.stalls() == stalls_before) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const std::uint64_t pings_at_stall = wd.pings();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(wd.pings(), pings_at_stall) << "no ping while stalled";
+  EXPECT_EQ(wd.stalls(), stalls_before + 1);
+  wd.stop();
+  std::lock_guard lock(m);
+  std::size_t status_lines = 0;
+  for (const auto& s : sent) {
+    if (s.rfind("STATUS=", 0) == 0) {
+      ++status_lines;
+      EXPECT_NE(s.find("stalled at cycle"), std::string::npos) << s;
+    } else {
+      EXPECT_EQ(s, "WATCHDOG=1");
+    }
+  }
+  EXPECT_EQ(status_lines, wd.stalls()) << "one STATUS line per stall";
+}
+
+namespace {
+// A datagram socket standing in for systemd's notify socket.
+class FakeSystemd {
+ public:
+  FakeSystemd() {
+    path_ = "/tmp/canmotion-notify-" + std::to_string(getpid()) + ".sock";
+    ::unlink(path_.c_str());
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    path_.copy(addr.sun_path, sizeof(addr.sun_path) - 1);
+    ok_ = fd_ >= 0 && ::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0;
+    timeval tv{2, 0};
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    ::setenv("NOTIFY_SOCKET", path_.c_str(), 1);
+  }
+  ~FakeSystemd() {
+    ::unsetenv("NOTIFY_SOCKET");
+    ::unsetenv("WATCHDOG_USEC");
+    ::unsetenv("WATCHDOG_PID");
+    if (fd_ >= 0) ::close(fd_);
+    ::unlink(path_.c_str());
+  }
+  bool ok() const { return ok_; }
+  std::string receive() {
+    char buf[512];
+    const ssize_t n = ::recv(fd_, buf, sizeof(buf), 0);
+    return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string("<nothing>");
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  bool ok_ = false;
+};
+}  // namespace
+
+TEST(RtSdNotify, SendsReadyWatchdogAndStatusToNotifySocket) {
+  if (!SdNotifier::compiled_in()) {
+    EXPECT_EQ(SdNotifier::ready(), -ENOSYS);
+    GTEST_SKIP() << "built without libsystemd: sd_notify is compiled out";
+  }
+  FakeSystemd systemd;
+  ASSERT_TRUE(systemd.ok());
+  EXPECT_GT(SdNotifier::ready(), 0);
+  EXPECT_EQ(systemd.receive(), "READY=1");
+  EXPECT_GT(SdNotifier::status("running, cycle 1 ms"), 0);
+  EXPECT_EQ(systemd.receive(), "STATUS=running, cycle 1 ms");
+  EXPECT_GT(SdNotifier::watchdog(), 0);
+  EXPECT_EQ(systemd.receive(), "WATCHDOG=1");
+  EXPECT_GT(SdNotifier::stopping(), 0);
+  EXPECT_EQ(systemd.receive(), "STOPPING=1");
+}
+
+TEST(RtSdNotify, WatchdogIntervalComesFromTheEnvironment) {
+  if (!SdNotifier::compiled_in()) {
+    GTEST_SKIP() << "built without libsystemd";
+  }
+  ::unsetenv("WATCHDOG_USEC");
+  EXPECT_FALSE(SdNotifier::watchdog_interval().has_value());
+  ::setenv("WATCHDOG_USEC", "2000000", 1);
+  ::setenv("WATCHDOG_PID", std::to_string(getpid()).c_str(), 1);
+  const auto interval = SdNotifier::watchdog_interval();
+  ASSERT_TRUE(interval.has_value());
+  EXPECT_EQ(*interval, Nanos{2'000'000'000});
+  ::unsetenv("WATCHDOG_USEC");
+  ::unsetenv("WATCHDOG_PID");
+}
+
+TEST(RtSdNotify, NotRunBySystemdIsANoOp) {
+  ::unsetenv("NOTIFY_SOCKET");
+  const int r = SdNotifier::ready();
+  if (SdNotifier::compiled_in()) {
+    EXPECT_EQ(r, 0);
+  } else {
+    EXPECT_EQ(r, -ENOSYS);
+  }
+}
+
+TEST(RtWatchdog, ThreadRealSdNotifyPings) {
+  if (!SdNotifier::compiled_in()) {
+    GTEST_SKIP() << "built without libsystemd";
+  }
+  FakeSystemd systemd;
+  ASSERT_TRUE(systemd.ok());
+  std::atomic<std::uint64_t> counter{1};
+  WatchdogThread wd([&] { return counter.fetch_add(1); }, Nanos{5'000'000});
+  wd.start();
+  EXPECT_EQ(systemd.receive(), "WATCHDOG=1");
+  EXPECT_EQ(systemd.receive(), "WATCHDOG=1");
+  wd.stop();
+}
