@@ -4,7 +4,7 @@
 
 #include <map>
 
-#include "rt/script/script.hpp"
+#include "rt/controller/script.hpp"
 
 namespace canmotion::rt::script {
 namespace {

@@ -1,4 +1,4 @@
-#include "rt/script/script.hpp"
+#include "rt/controller/script.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -1,0 +1,313 @@
+#include "rt/controller/controller.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace canmotion::rt {
+
+motion::DriveState drive_state_of(cia402::State s, bool operational) noexcept {
+  using S = cia402::State;
+  switch (s) {
+    case S::kFault:
+    case S::kFaultReactionActive: return motion::DriveState::Fault;
+    case S::kOperationEnabled: return operational ? motion::DriveState::Enabled : motion::DriveState::SwitchedOn;
+    case S::kSwitchedOn: return motion::DriveState::SwitchedOn;
+    default: return motion::DriveState::NotReady;
+  }
+}
+
+/// Sends through the bus's transport and records each sent frame for the trace.
+class Controller::RecordingSink final : public canopen::FrameSink {
+ public:
+  RecordingSink(Controller& c, std::uint8_t bus) noexcept : c_(c), bus_(bus) {}
+  bool send(const can::Frame& f) noexcept override {
+    BusRt& b = c_.buses_[bus_];
+    const bool ok = b.transport->send(f) == can::SendResult::kOk;
+    if (!ok) {
+      ++b.rejected;
+      return false;
+    }
+    c_.record(bus_, can::TimedFrame{f, now_ns}, true);
+    return true;
+  }
+  std::int64_t now_ns = 0;
+
+ private:
+  Controller& c_;
+  std::uint8_t bus_;
+};
+
+Controller::Controller(ControllerSpec spec)
+    : spec_(std::move(spec)),
+      planner_(static_cast<double>(spec_.period_ns) * 1e-9),
+      snapshot_(std::make_unique<SnapshotBuffer<Status>>()) {
+  if (spec_.period_ns <= 0) throw std::invalid_argument("controller period must be > 0");
+  if (spec_.buses.size() > kMaxBuses)
+    throw std::invalid_argument("at most " + std::to_string(kMaxBuses) + " buses, got " +
+                                std::to_string(spec_.buses.size()));
+  if (spec_.axes.size() > motion::kMaxAxes)
+    throw std::invalid_argument("at most " + std::to_string(motion::kMaxAxes) + " axes, got " +
+                                std::to_string(spec_.axes.size()));
+  buses_.resize(spec_.buses.size());
+  for (std::size_t b = 0; b < spec_.buses.size(); ++b) {
+    if (spec_.buses[b].transport == nullptr)
+      throw std::invalid_argument("bus '" + spec_.buses[b].name + "' has no transport");
+    buses_[b].transport = spec_.buses[b].transport;
+    buses_[b].network = std::make_unique<cia402::DriveNetwork>(spec_.buses[b].network);
+    buses_[b].sink = std::make_unique<RecordingSink>(*this, static_cast<std::uint8_t>(b));
+  }
+  axes_.resize(spec_.axes.size());
+  for (std::size_t a = 0; a < spec_.axes.size(); ++a) {
+    AxisSpec& s = spec_.axes[a];
+    if (!planner_.configure_axis(static_cast<motion::AxisId>(a), s.config))
+      throw std::invalid_argument("axis '" + s.name + "': the planner rejected its configuration");
+    axes_[a].conv = s.config.conversion_constant;
+    if (s.config.type == motion::AxisType::CipDrive) {
+      if (s.bus < 0 || static_cast<std::size_t>(s.bus) >= buses_.size())
+        throw std::invalid_argument("axis '" + s.name + "' (AXIS_CIP_DRIVE) has no valid bus");
+      s.drive.cycle_ns = spec_.period_ns;
+      axes_[a].bus = s.bus;
+      axes_[a].proxy = &buses_[static_cast<std::size_t>(s.bus)].network->add_drive(s.drive);
+    }
+  }
+}
+
+std::optional<motion::AxisId> Controller::axis_id(std::string_view name) const {
+  for (std::size_t a = 0; a < spec_.axes.size(); ++a)
+    if (spec_.axes[a].name == name) return static_cast<motion::AxisId>(a);
+  return std::nullopt;
+}
+
+std::optional<motion::ControlId> Controller::control_id(std::string_view name) {
+  std::lock_guard lock(names_mu_);
+  if (auto it = control_names_.find(name); it != control_names_.end()) return it->second;
+  if (control_names_.size() >= motion::kMaxControlTags) return std::nullopt;
+  const auto id = static_cast<motion::ControlId>(control_names_.size());
+  control_names_.emplace(std::string(name), id);
+  return id;
+}
+
+std::optional<motion::ControlId> Controller::find_control(std::string_view name) const {
+  std::lock_guard lock(names_mu_);
+  if (auto it = control_names_.find(name); it != control_names_.end()) return it->second;
+  return std::nullopt;
+}
+
+std::vector<std::pair<std::string, motion::ControlId>> Controller::controls() const {
+  std::lock_guard lock(names_mu_);
+  return {control_names_.begin(), control_names_.end()};
+}
+
+std::uint64_t Controller::submit(Command c) {
+  std::lock_guard lock(names_mu_);
+  c.seq = next_seq_;
+  if (!commands_.try_push(c)) return 0;
+  return next_seq_++;
+}
+
+void Controller::record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noexcept {
+  if (!trace_on_.load(std::memory_order_relaxed)) return;
+  if (!trace_.try_push(TraceRecord{f, bus, tx})) ++trace_dropped_;
+}
+
+void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
+
+void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
+  BusRt& bus = buses_[b];
+  // Bus events first: a bus-off reported now applies to this cycle's feedback.
+  std::array<can::BusEvent, 16> ev{};
+  for (std::size_t n; (n = bus.transport->poll_events(ev)) > 0;) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (ev[i].kind == can::BusEvent::Kind::kStateChanged || ev[i].kind == can::BusEvent::Kind::kRestarted) {
+        Event e;
+        e.kind = Event::Kind::kBusState;
+        e.bus = static_cast<std::uint8_t>(b);
+        e.bus_state = ev[i].state;
+        e.cycle = cycle_index_;
+        emit(e);
+      }
+    }
+    if (n < ev.size()) break;
+  }
+  bus.bus_off = bus.transport->state() == can::BusState::kBusOff;
+  for (std::size_t n; (n = bus.transport->receive(rx_)) > 0;) {
+    for (std::size_t i = 0; i < n; ++i) {
+      record(static_cast<std::uint8_t>(b), rx_[i], false);
+      bus.network->on_frame(rx_[i]);
+    }
+    if (n < rx_.size()) break;
+  }
+  (void)now_ns;
+}
+
+void Controller::feedback(std::size_t a) noexcept {
+  AxisRt& ax = axes_[a];
+  motion::AxisFeedback& f = fb_[a];
+  if (ax.proxy == nullptr) return;  // virtual axis: the planner ignores feedback
+  const cia402::DriveProxy& p = *ax.proxy;
+  const cia402::Feedback& d = p.feedback();
+  const bool operational = p.phase() == cia402::Phase::kOperational;
+  f.position = static_cast<double>(d.position) / ax.conv;
+  const bool vel_mapped = p.pdos().tpdo_count > 1;
+  if (vel_mapped) {
+    f.velocity = static_cast<double>(d.velocity) / ax.conv;
+  } else if (ax.have_prev) {  // differentiate when 0x606C is not mapped
+    f.velocity = static_cast<double>(d.position - ax.prev_counts) / ax.conv / period_s();
+  }
+  ax.prev_counts = d.position;
+  ax.have_prev = d.tpdo_count > 0;
+  f.drive = drive_state_of(p.state(), operational);
+  f.drive_fault = f.drive == motion::DriveState::Fault;
+  f.emcy_code = p.last_emcy_code();
+  f.node_lost = p.failure().kind == cia402::FailureKind::kHeartbeatLost;
+  f.bus_off = buses_[static_cast<std::size_t>(ax.bus)].bus_off;
+  f.homing_attained = (d.statusword & (1u << 12)) != 0 && d.mode_display == 6;
+  f.homing_error = (d.statusword & (1u << 13)) != 0 && d.mode_display == 6;
+  if (p.failed() && !ax.failure_reported) {
+    Event e;
+    e.kind = Event::Kind::kDriveFailed;
+    e.bus = static_cast<std::uint8_t>(ax.bus);
+    e.axis = static_cast<std::int16_t>(a);
+    e.failure = p.failure();
+    e.cycle = cycle_index_;
+    emit(e);
+  }
+  ax.failure_reported = p.failed();
+}
+
+void Controller::apply(std::size_t a, const motion::AxisOutput& out) noexcept {
+  AxisRt& ax = axes_[a];
+  if (ax.proxy == nullptr) return;
+  cia402::DriveProxy& p = *ax.proxy;
+  if (out.fault_reset) p.fault_reset();
+  const bool wants_enabled = p.wanted() == cia402::State::kOperationEnabled;
+  if (out.enable && !wants_enabled && !p.failed()) p.enable();
+  if (!out.enable && wants_enabled) p.disable();
+  const auto mode = static_cast<cia402::Mode>(static_cast<std::int8_t>(out.mode));
+  if (mode != p.mode() && (mode == cia402::Mode::kCsp || mode == cia402::Mode::kCsv || mode == cia402::Mode::kCst))
+    (void)p.set_mode(mode);
+  // Targets in drive units, saturated to the object's range.
+  auto sat32 = [](double v) noexcept -> std::int32_t {
+    if (!(v == v)) return 0;
+    v = std::round(v);
+    if (v > std::numeric_limits<std::int32_t>::max()) return std::numeric_limits<std::int32_t>::max();
+    if (v < std::numeric_limits<std::int32_t>::min()) return std::numeric_limits<std::int32_t>::min();
+    return static_cast<std::int32_t>(v);
+  };
+  p.set_target_position(sat32(out.position * ax.conv));
+  p.set_target_velocity(sat32(out.velocity * ax.conv));
+  const double t = std::round(out.torque);
+  p.set_target_torque(static_cast<std::int16_t>(t > 32767 ? 32767 : (t < -32768 ? -32768 : t)));
+}
+
+void Controller::cycle(std::int64_t now_ns) noexcept {
+  // 2. Drain received frames on every bus.
+  for (std::size_t b = 0; b < buses_.size(); ++b) receive(b, now_ns);
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    canopen::NodeEvent ne;
+    while (buses_[b].network->poll_event(ne)) {
+      Event e;
+      e.kind = Event::Kind::kNode;
+      e.bus = static_cast<std::uint8_t>(b);
+      e.node = ne;
+      e.cycle = cycle_index_;
+      emit(e);
+    }
+  }
+  // 3. Feedback in position units.
+  for (std::size_t a = 0; a < axes_.size(); ++a) feedback(a);
+  // 4. Pending commands (at most kMaxRequestsPerCycle instructions).
+  std::size_t nreq = 0;
+  bool deferred = false;
+  for (;;) {
+    Command c;
+    if (held_) {
+      c = *held_;
+      held_.reset();
+    } else if (!commands_.try_pop(c)) {
+      break;
+    }
+    if (c.kind == Command::Kind::kInstruction) {
+      if (nreq == requests_.size()) {
+        held_ = c;
+        deferred = true;
+        break;
+      }
+      requests_[nreq++] = c.request;
+    } else if (c.kind == Command::Kind::kResetControl) {
+      planner_.reset_control(c.control);
+    } else if (c.kind == Command::Kind::kEnableDrives) {
+      for (auto& b : buses_) b.network->enable_all();
+    }
+    done_seq_ = c.seq;
+  }
+  if (deferred) ++deferred_;
+  // 5. Plan.
+  motion::Input in;
+  in.cycle = cycle_index_;
+  in.feedback = std::span<const motion::AxisFeedback>(fb_.data(), axes_.size());
+  in.requests = std::span<const motion::Request>(requests_.data(), nreq);
+  motion::Output out;
+  out.axes = std::span<motion::AxisOutput>(out_.data(), axes_.size());
+  (void)planner_.update(in, out);
+  // 6 + 7. Drive state machines and RPDOs, then SYNC, per bus.
+  for (std::size_t a = 0; a < axes_.size(); ++a) apply(a, out_[a]);
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    auto& sink = static_cast<RecordingSink&>(*buses_[b].sink);
+    sink.now_ns = now_ns;
+    buses_[b].network->cycle(now_ns, sink);
+  }
+  // 8. Publish.
+  publish(now_ns);
+  ++cycle_index_;
+  cycle_.store(cycle_index_, std::memory_order_release);
+}
+
+void Controller::publish(std::int64_t now_ns) noexcept {
+  (void)now_ns;
+  Status& s = snapshot_->write_slot();
+  s.cycle = cycle_index_;
+  s.time_ns = static_cast<std::int64_t>(cycle_index_) * spec_.period_ns;
+  s.done_seq = done_seq_;
+  s.axis_count = static_cast<std::uint16_t>(axes_.size());
+  s.bus_count = static_cast<std::uint8_t>(buses_.size());
+  const bool tele = telemetry_on_.load(std::memory_order_relaxed);
+  for (std::size_t a = 0; a < axes_.size(); ++a) {
+    AxisSnapshot& x = s.axes[a];
+    x.tag = planner_.axis(static_cast<motion::AxisId>(a));
+    const double err = std::abs(x.tag.position_error);
+    if (err > max_err_[a]) max_err_[a] = err;
+    x.max_abs_position_error = max_err_[a];
+    if (const cia402::DriveProxy* p = axes_[a].proxy) {
+      x.phase = p->phase();
+      x.drive_state = p->state();
+      x.statusword = p->feedback().statusword;
+      x.controlword = p->controlword();
+      x.target_counts = p->target_position();
+      x.actual_counts = p->feedback().position;
+      x.mode_display = p->feedback().mode_display;
+      x.last_emcy = p->last_emcy_code();
+      x.tpdo_missed = p->feedback().tpdo_missed;
+      x.failure = p->failure();
+    }
+    if (tele) {
+      const Sample smp{cycle_index_,         static_cast<std::uint16_t>(a), x.tag.command_position,
+                       x.tag.actual_position, x.tag.command_velocity,      x.tag.actual_velocity,
+                       x.tag.motion_status,   x.tag.axis_status};
+      if (!telemetry_.try_push(smp)) ++telemetry_dropped_;
+    }
+  }
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    s.buses[b].state = buses_[b].transport->state();
+    s.buses[b].counters = buses_[b].transport->counters();
+    s.buses[b].send_rejected = buses_[b].rejected;
+  }
+  for (std::size_t c = 0; c < s.controls.size(); ++c) s.controls[c] = planner_.control(static_cast<motion::ControlId>(c));
+  s.trace_dropped = trace_dropped_;
+  s.telemetry_dropped = telemetry_dropped_;
+  s.commands_deferred = deferred_;
+  snapshot_->commit();
+}
+
+}  // namespace canmotion::rt

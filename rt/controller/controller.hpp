@@ -1,0 +1,273 @@
+#pragma once
+/// \file
+/// The Controller: one cycle of canmotion, joining the motion planner and the
+/// CANopen drive networks (DESIGN.md, "One cycle"):
+///
+///   2. drain received frames on every bus (TPDOs, EMCY, heartbeats, SDO)
+///   3. convert drive feedback from counts to position units
+///   4. take pending instruction requests from the command ring
+///   5. plan: Planner::update (masters before slaves, inside the planner)
+///   6. step each drive's CiA 402 state machine and pack its RPDOs
+///   7. send the RPDOs, then SYNC, in one burst
+///   8. publish a status snapshot; queue trace and telemetry records
+///
+/// cycle() is realtime-safe: no allocation, no locks, no logging, no
+/// exceptions. Everything it shares with other threads goes through SPSC
+/// rings (commands in; events, trace and telemetry out) and a snapshot
+/// buffer (status out); the RT thread never waits on them. Construction and
+/// the name-lookup functions are not realtime.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fieldbus/can/transport.hpp"
+#include "fieldbus/cia402/drive_proxy.hpp"
+#include "motion/planner.hpp"
+#include "rt/snapshot.hpp"
+#include "rt/spsc_ring.hpp"
+
+namespace canmotion::rt {
+
+/// Buses one controller drives. Bound: CAN interfaces on a controller board
+/// (typically 1-4); 8 leaves room.
+inline constexpr std::size_t kMaxBuses = 8;
+/// Instruction requests taken per cycle; more wait for the next cycle. Bound:
+/// a script or client issues a handful per cycle; 64 covers a burst of one
+/// per axis on a full 64-axis controller.
+inline constexpr std::size_t kMaxRequestsPerCycle = 64;
+/// Frames read per bus per receive() call. Bound: per cycle a bus carries at
+/// most ~2 TPDOs per node plus heartbeats, EMCY and SDO: 256 covers a full
+/// 127-node bus at one TPDO each; more are read by further calls.
+inline constexpr std::size_t kRxBatch = 256;
+
+/// One bus: a transport (owned by the caller, who opened it) and its CANopen
+/// master settings.
+struct BusSpec {
+  std::string name;
+  can::Transport* transport = nullptr;
+  cia402::NetworkConfig network{};
+};
+
+/// One axis. `bus` indexes ControllerSpec::buses for AXIS_CIP_DRIVE, -1 for
+/// AXIS_VIRTUAL.
+struct AxisSpec {
+  std::string name;
+  motion::AxisConfig config{};
+  int bus = -1;
+  cia402::DriveConfig drive{};
+};
+
+/// Everything a Controller is built from (config::build_spec makes it from a file).
+struct ControllerSpec {
+  std::int64_t period_ns = 1'000'000;
+  std::vector<BusSpec> buses;
+  std::vector<AxisSpec> axes;
+};
+
+/// A command to the RT thread. Trivially copyable (lives in an SPSC ring).
+struct Command {
+  enum class Kind : std::uint8_t {
+    kInstruction,   ///< execute `request` (one rung transition)
+    kResetControl,  ///< clear control tag `control` (prescan)
+    kEnableDrives,  ///< ask every drive to enable (outside the planner; tests, bring-up)
+  };
+  Kind kind = Kind::kInstruction;
+  motion::Request request{};
+  motion::ControlId control = motion::kNoControl;
+  std::uint64_t seq = 0;  ///< set by submit(); echoed as Status::done_seq
+};
+
+/// Something the RT thread reports. Trivially copyable.
+struct Event {
+  enum class Kind : std::uint8_t {
+    kNode,         ///< a CANopen node event (boot-up, heartbeat lost/recovered, EMCY, NMT state)
+    kDriveFailed,  ///< a drive proxy recorded a failure (see Status axes[].failure)
+    kBusState,     ///< a bus changed error state
+    kRingOverflow, ///< the trace or telemetry ring was full; `value` records were lost
+  };
+  Kind kind = Kind::kNode;
+  std::uint8_t bus = 0;
+  std::int16_t axis = -1;
+  canopen::NodeEvent node{};
+  cia402::Failure failure{};
+  can::BusState bus_state = can::BusState::kErrorActive;
+  std::uint64_t value = 0;
+  std::uint64_t cycle = 0;
+};
+
+/// One frame on one bus, for the candump trace.
+struct TraceRecord {
+  can::TimedFrame frame{};
+  std::uint8_t bus = 0;
+  bool tx = false;
+};
+
+/// One axis in one cycle, for the CSV telemetry.
+struct Sample {
+  std::uint64_t cycle = 0;
+  std::uint16_t axis = 0;
+  double cmd_pos = 0, act_pos = 0, cmd_vel = 0, act_vel = 0;
+  std::uint32_t motion_status = 0, axis_status = 0;
+};
+
+/// Per-axis status published each cycle.
+struct AxisSnapshot {
+  motion::AxisTag tag{};
+  // CIP drive axes only:
+  cia402::Phase phase = cia402::Phase::kWaitBoot;
+  cia402::State drive_state = cia402::State::kUnknown;
+  std::uint16_t statusword = 0;
+  std::uint16_t controlword = 0;
+  std::int32_t target_counts = 0;
+  std::int32_t actual_counts = 0;
+  std::int8_t mode_display = 0;
+  std::uint16_t last_emcy = 0;
+  std::uint64_t tpdo_missed = 0;
+  cia402::Failure failure{};
+  double max_abs_position_error = 0;  ///< since start, user units
+};
+
+/// Per-bus status.
+struct BusSnapshot {
+  can::BusState state = can::BusState::kErrorActive;
+  can::BusCounters counters{};
+  std::uint64_t send_rejected = 0;
+};
+
+/// The status snapshot (step 8). Plain data, copied by readers.
+struct Status {
+  std::uint64_t cycle = 0;
+  std::int64_t time_ns = 0;        ///< cycle * period
+  std::uint64_t done_seq = 0;      ///< every command with seq <= done_seq has been executed
+  std::uint16_t axis_count = 0;
+  std::uint8_t bus_count = 0;
+  std::array<AxisSnapshot, motion::kMaxAxes> axes{};
+  std::array<BusSnapshot, kMaxBuses> buses{};
+  std::array<motion::ControlTag, motion::kMaxControlTags> controls{};
+  std::uint64_t trace_dropped = 0;
+  std::uint64_t telemetry_dropped = 0;
+  std::uint64_t commands_deferred = 0;  ///< cycles in which requests had to wait for the next cycle
+};
+
+class Controller {
+ public:
+  static constexpr std::size_t kCommandCapacity = 256;
+  static constexpr std::size_t kEventCapacity = 1024;
+  /// Trace records between two drains by the writer (10 ms at 1 ms on a
+  /// full bus is < 3000 frames; 16384 leaves room for SDO bursts at boot).
+  static constexpr std::size_t kTraceCapacity = 16384;
+  /// Telemetry samples between two drains (64 axes x 100 cycles).
+  static constexpr std::size_t kTelemetryCapacity = 8192;
+
+  /// Build planner, masters and drive proxies. Throws std::invalid_argument
+  /// naming the axis or bus when the spec is inconsistent. Not realtime.
+  explicit Controller(ControllerSpec spec);
+  Controller(const Controller&) = delete;
+  Controller& operator=(const Controller&) = delete;
+
+  /// Run one cycle at controller time `now_ns` (monotonic or virtual).
+  /// Realtime-safe.
+  void cycle(std::int64_t now_ns) noexcept;
+
+  // ---- non-RT side ----------------------------------------------------------
+  /// Queue a command; returns its sequence number, or 0 when the ring is
+  /// full. Thread-safe among producers (a producer-side mutex; the RT side
+  /// never takes it).
+  std::uint64_t submit(Command c);
+  /// Newest status (copy). Any non-RT thread.
+  /// Returns false before the first cycle.
+  bool read_status(Status& out) const { return snapshot_->read(out) != 0; }
+  /// Drain rings (one consumer thread each).
+  bool pop_event(Event& e) noexcept { return events_.try_pop(e); }
+  bool pop_trace(TraceRecord& r) noexcept { return trace_.try_pop(r); }
+  bool pop_sample(Sample& s) noexcept { return telemetry_.try_pop(s); }
+  /// Turn trace/telemetry recording on or off (before or while running).
+  void set_trace(bool on) noexcept { trace_on_.store(on, std::memory_order_relaxed); }
+  void set_telemetry(bool on) noexcept { telemetry_on_.store(on, std::memory_order_relaxed); }
+
+  /// Name lookups (not realtime).
+  [[nodiscard]] std::optional<motion::AxisId> axis_id(std::string_view name) const;
+  [[nodiscard]] const std::string& axis_name(motion::AxisId id) const { return spec_.axes.at(id).name; }
+  [[nodiscard]] std::size_t axis_count() const noexcept { return spec_.axes.size(); }
+  [[nodiscard]] const AxisSpec& axis_spec(motion::AxisId id) const { return spec_.axes.at(id); }
+  [[nodiscard]] const ControllerSpec& spec() const noexcept { return spec_; }
+  /// The control tag called `name`, created on first use. nullopt when all
+  /// kMaxControlTags are taken.
+  std::optional<motion::ControlId> control_id(std::string_view name);
+  [[nodiscard]] std::optional<motion::ControlId> find_control(std::string_view name) const;
+  [[nodiscard]] std::vector<std::pair<std::string, motion::ControlId>> controls() const;
+  [[nodiscard]] double period_s() const noexcept { return static_cast<double>(spec_.period_ns) * 1e-9; }
+  [[nodiscard]] std::uint64_t cycles() const noexcept { return cycle_.load(std::memory_order_acquire); }
+
+  /// The planner, for set-up before the loop runs (e.g. cams) and for tests
+  /// on the loop thread. Not for other threads while running.
+  motion::Planner& planner() noexcept { return planner_; }
+  cia402::DriveNetwork& network(std::size_t bus) noexcept { return *buses_[bus].network; }
+
+ private:
+  struct BusRt {
+    can::Transport* transport = nullptr;
+    std::unique_ptr<cia402::DriveNetwork> network;
+    std::unique_ptr<canopen::FrameSink> sink;
+    bool bus_off = false;
+    std::uint64_t rejected = 0;
+  };
+  struct AxisRt {
+    int bus = -1;
+    cia402::DriveProxy* proxy = nullptr;
+    double conv = 1.0;
+    bool have_prev = false;
+    std::int32_t prev_counts = 0;
+    bool failure_reported = false;
+  };
+  class RecordingSink;
+
+  void receive(std::size_t b, std::int64_t now_ns) noexcept;
+  void feedback(std::size_t a) noexcept;
+  void apply(std::size_t a, const motion::AxisOutput& out) noexcept;
+  void publish(std::int64_t now_ns) noexcept;
+  void record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noexcept;
+  void emit(const Event& e) noexcept;
+
+  ControllerSpec spec_;
+  motion::Planner planner_;
+  std::vector<BusRt> buses_;
+  std::vector<AxisRt> axes_;
+  std::array<motion::AxisFeedback, motion::kMaxAxes> fb_{};
+  std::array<motion::AxisOutput, motion::kMaxAxes> out_{};
+  std::array<motion::Request, kMaxRequestsPerCycle> requests_{};
+  std::array<can::TimedFrame, kRxBatch> rx_{};
+  std::array<double, motion::kMaxAxes> max_err_{};
+  std::optional<Command> held_;  ///< a command popped but deferred to the next cycle
+  std::uint64_t done_seq_ = 0;
+  std::uint64_t deferred_ = 0;
+  std::uint64_t trace_dropped_ = 0;
+  std::uint64_t telemetry_dropped_ = 0;
+  std::uint64_t cycle_index_ = 0;
+  std::atomic<std::uint64_t> cycle_{0};
+  std::atomic<bool> trace_on_{false};
+  std::atomic<bool> telemetry_on_{false};
+
+  SpscRing<Command, kCommandCapacity> commands_;
+  SpscRing<Event, kEventCapacity> events_;
+  SpscRing<TraceRecord, kTraceCapacity> trace_;
+  SpscRing<Sample, kTelemetryCapacity> telemetry_;
+  std::unique_ptr<SnapshotBuffer<Status>> snapshot_;  ///< heap: three Status copies are large
+
+  mutable std::mutex names_mu_;  ///< non-RT only: control names and the producer side of commands_
+  std::map<std::string, motion::ControlId, std::less<>> control_names_;
+  std::uint64_t next_seq_ = 1;
+};
+
+/// Map a CiA 402 state to the planner's view of the drive. Realtime-safe.
+[[nodiscard]] motion::DriveState drive_state_of(cia402::State s, bool operational) noexcept;
+
+}  // namespace canmotion::rt
