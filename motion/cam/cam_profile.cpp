@@ -13,6 +13,7 @@ CamProfile::CamProfile(std::size_t capacity) {
                                 " elements, got " + std::to_string(capacity));
   }
   elems_.resize(capacity);
+  masters_.assign(capacity, 0.0);
   scratch_.assign(4 * capacity, 0.0);
 }
 
@@ -36,36 +37,36 @@ void CamProfile::write_status(std::int32_t status) noexcept { elems_[0].status =
 
 std::size_t CamProfile::find_segment(double master) const noexcept {
   // Largest i in [0, count_-2] with M_i <= master (0 if master < M_0).
-  std::size_t lo = 0;
-  std::size_t hi = count_ - 1;  // segments are [0, count_-2]; hi is exclusive
-  while (hi - lo > 1) {
-    const std::size_t mid = lo + (hi - lo) / 2;
-    if (elems_[mid].master <= master) {
-      lo = mid;
-    } else {
-      hi = mid;
-    }
+  // Branch-light lower-bound style search on the contiguous master copy.
+  const double* m = masters_.data();
+  std::size_t base = 0;
+  std::size_t len = count_ - 1;  // candidate segments [base, base + len)
+  while (len > 1) {
+    const std::size_t half = len / 2;
+    base = m[base + half] <= master ? base + half : base;
+    len -= half;
   }
-  return lo;
+  return base;
 }
 
 std::size_t CamProfile::find_segment(double master, CamCursor& cursor) const noexcept {
+  const double* m = masters_.data();
   const std::size_t last = count_ - 2;  // last segment index
   std::size_t s = cursor.segment <= last ? cursor.segment : last;
   // Step a few segments in the direction of travel, then give up and bisect.
   constexpr int kMaxSteps = 4;
   for (int i = 0; i < kMaxSteps; ++i) {
-    if (master < elems_[s].master) {
+    if (master < m[s]) {
       if (s == 0) break;
       --s;
-    } else if (s < last && master >= elems_[s + 1].master) {
+    } else if (s < last && master >= m[s + 1]) {
       ++s;
     } else {
       cursor.segment = s;
       return s;
     }
   }
-  if (s == 0 && master < elems_[0].master) {
+  if (s == 0 && master < m[0]) {
     cursor.segment = 0;
     return 0;
   }
@@ -193,6 +194,7 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
   el[0].status = profile_status::kCalculating;
   for (std::size_t i = 0; i < n; ++i) {
     el[i].master = pts[i].master;
+    profile.masters_[i] = pts[i].master;
     el[i].slave = pts[i].slave;
     el[i].type = i + 1 < n ? pts[i].segment_type : kSegmentLinear;
   }

@@ -207,6 +207,10 @@ class CamProfile {
   [[nodiscard]] CamSample eval_outside(double master, EndBehaviour end) const noexcept;
 
   std::vector<CamProfileElement> elems_;  // size == capacity, never resized
+  // Copy of the knot masters (size == capacity): the binary search touches
+  // 8 bytes per probe instead of a 56-byte element, so a 10000-point
+  // profile's search array (80 KB) stays in L2.
+  std::vector<double> masters_;
   std::size_t count_ = 0;                 // points of the last successful MCCP
   // Tridiagonal spline system scratch, 4 * capacity doubles: sub-, main and
   // super-diagonal, right-hand side / solution, seen by MCCP as Eigen::Map

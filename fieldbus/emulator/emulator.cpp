@@ -1,0 +1,747 @@
+#include "fieldbus/emulator/emulator.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "fieldbus/canopen/cob_id.hpp"
+#include "fieldbus/canopen/emcy.hpp"
+
+namespace canmotion::emulator {
+
+using canopen::SdoAbort;
+using cia402::State;
+namespace obj = cia402::obj;
+
+namespace {
+constexpr std::uint16_t kFaultInjection = 0x2000;
+bool is_rpdo_comm(std::uint16_t i) { return i >= 0x1400 && i <= 0x1403; }
+bool is_rpdo_map(std::uint16_t i) { return i >= 0x1600 && i <= 0x1603; }
+bool is_tpdo_comm(std::uint16_t i) { return i >= 0x1800 && i <= 0x1803; }
+bool is_tpdo_map(std::uint16_t i) { return i >= 0x1A00 && i <= 0x1A03; }
+
+std::uint8_t error_register_for(std::uint16_t code) {
+  std::uint8_t r = canopen::kErrGeneric;
+  switch (code >> 12) {
+    case 0x2: r |= canopen::kErrCurrent; break;
+    case 0x3: r |= canopen::kErrVoltage; break;
+    case 0x4: r |= canopen::kErrTemperature; break;
+    case 0x8:
+      if ((code >> 8) == 0x81 || (code >> 8) == 0x82) {
+        r |= canopen::kErrCommunication;
+      } else {
+        r |= canopen::kErrDeviceProfile;
+      }
+      break;
+    case 0xF: r |= canopen::kErrManufacturer; break;
+    default: break;
+  }
+  return r;
+}
+}  // namespace
+
+Emulator::Emulator(const EmulatorConfig& cfg)
+    : cfg_(cfg),
+      device_name_(cfg.device_name),
+      hw_version_("emulated 1.0"),
+      sw_version_("canmotion 0.1"),
+      sdo_(cfg.node, *this) {
+  cfg_.lag_cycles = std::min<std::uint32_t>(cfg_.lag_cycles, kMaxLag);
+  build_dictionary();
+  pos_ = cfg_.initial_position;
+}
+
+// ============================================================================
+// Object dictionary
+// ============================================================================
+void Emulator::add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, const std::string* text) {
+  const canopen::ObjectInfo* info = canopen::object_info(index, sub);
+  Entry e{key(index, sub),
+          info ? info->type : canopen::DataType::kUnsigned32,
+          info ? info->access : canopen::Access::kRw,
+          info ? info->pdo : canopen::PdoMappable::kNo,
+          value,
+          value,
+          text};
+  od_.push_back(e);
+}
+
+void Emulator::build_dictionary() {
+  const std::uint8_t n = cfg_.node;
+  od_.clear();
+  add(0x1000, 0, 0x00020192);  // CiA 402, servo drive
+  add(0x1001, 0, 0);
+  add(0x1003, 0, 0);
+  for (std::uint8_t s = 1; s <= 8; ++s) add(0x1003, s, 0);
+  add(0x1005, 0, 0x80);
+  add(0x1006, 0, 0);
+  add(0x1007, 0, 0);
+  add(0x1008, 0, 0, &device_name_);
+  add(0x1009, 0, 0, &hw_version_);
+  add(0x100A, 0, 0, &sw_version_);
+  add(0x1014, 0, canopen::cob::emcy(n));
+  add(0x1015, 0, 0);
+  add(0x1016, 0, 4);
+  for (std::uint8_t s = 1; s <= 4; ++s) add(0x1016, s, 0);
+  add(0x1017, 0, 0);
+  add(0x1018, 0, 4);
+  add(0x1018, 1, cfg_.vendor_id);
+  add(0x1018, 2, cfg_.product_code);
+  add(0x1018, 3, cfg_.revision);
+  add(0x1018, 4, n);
+  add(0x1019, 0, 0);
+  add(0x1200, 0, 2);
+  add(0x1200, 1, canopen::cob::sdo_rx(n));
+  add(0x1200, 2, canopen::cob::sdo_tx(n));
+  for (std::uint8_t p = 0; p < 4; ++p) {
+    const auto pn = static_cast<std::uint8_t>(p + 1);
+    const std::uint32_t inval = p == 0 ? 0 : canopen::kPdoInvalid;
+    add(static_cast<std::uint16_t>(0x1400 + p), 0, 2);
+    add(static_cast<std::uint16_t>(0x1400 + p), 1, canopen::cob::rpdo(pn, n) | inval);
+    add(static_cast<std::uint16_t>(0x1400 + p), 2, 1);
+    add(static_cast<std::uint16_t>(0x1600 + p), 0, p == 0 ? 2 : 0);
+    for (std::uint8_t s = 1; s <= 8; ++s) {
+      std::uint32_t v = 0;
+      if (p == 0 && s == 1) v = 0x60400010;
+      if (p == 0 && s == 2) v = 0x607A0020;
+      add(static_cast<std::uint16_t>(0x1600 + p), s, v);
+    }
+    add(static_cast<std::uint16_t>(0x1800 + p), 0, 6);
+    add(static_cast<std::uint16_t>(0x1800 + p), 1, canopen::cob::tpdo(pn, n) | inval);
+    add(static_cast<std::uint16_t>(0x1800 + p), 2, 1);
+    add(static_cast<std::uint16_t>(0x1800 + p), 3, 0);
+    add(static_cast<std::uint16_t>(0x1800 + p), 5, 0);
+    add(static_cast<std::uint16_t>(0x1800 + p), 6, 0);
+    add(static_cast<std::uint16_t>(0x1A00 + p), 0, p == 0 ? 2 : 0);
+    for (std::uint8_t s = 1; s <= 8; ++s) {
+      std::uint32_t v = 0;
+      if (p == 0 && s == 1) v = 0x60410010;
+      if (p == 0 && s == 2) v = 0x60640020;
+      add(static_cast<std::uint16_t>(0x1A00 + p), s, v);
+    }
+  }
+  add(kFaultInjection, 0, 0);
+  add(obj::kErrorCode, 0, 0);
+  add(obj::kControlword, 0, 0);
+  add(obj::kStatusword, 0, 0);
+  add(obj::kQuickStopOptionCode, 0, 2);
+  add(obj::kShutdownOptionCode, 0, 0);
+  add(obj::kDisableOperationOptionCode, 0, 1);
+  add(obj::kHaltOptionCode, 0, 1);
+  add(obj::kFaultReactionOptionCode, 0, 2);
+  add(obj::kModesOfOperation, 0, 8);
+  add(obj::kModesOfOperationDisplay, 0, 8);
+  add(obj::kPositionDemandValue, 0, 0);
+  add(obj::kPositionActualInternalValue, 0, 0);
+  add(obj::kPositionActualValue, 0, 0);
+  add(obj::kFollowingErrorWindow, 0, cfg_.following_error_window);
+  add(obj::kFollowingErrorTimeOut, 0, 0);
+  add(obj::kPositionWindow, 0, 100);
+  add(obj::kPositionWindowTime, 0, 0);
+  add(obj::kVelocityDemandValue, 0, 0);
+  add(obj::kVelocityActualValue, 0, 0);
+  add(obj::kTargetTorque, 0, 0);
+  add(obj::kMaxTorque, 0, 3000);
+  add(0x6074, 0, 0);
+  add(0x6076, 0, 1000);
+  add(obj::kTorqueActualValue, 0, 0);
+  add(obj::kTargetPosition, 0, 0);
+  add(obj::kHomeOffset, 0, 0);
+  add(obj::kSoftwarePositionLimit, 0, 2);
+  add(obj::kSoftwarePositionLimit, 1, 0x80000000u);
+  add(obj::kSoftwarePositionLimit, 2, 0x7FFFFFFFu);
+  add(obj::kMaxProfileVelocity, 0, static_cast<std::uint32_t>(cfg_.max_velocity));
+  add(obj::kProfileVelocity, 0, 100000);
+  add(obj::kProfileAcceleration, 0, 1000000);
+  add(obj::kProfileDeceleration, 0, 1000000);
+  add(obj::kQuickStopDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
+  add(obj::kHomingMethod, 0, 35);
+  add(obj::kHomingSpeeds, 0, 2);
+  add(obj::kHomingSpeeds, 1, 100000);
+  add(obj::kHomingSpeeds, 2, 10000);
+  add(obj::kHomingAcceleration, 0, 1000000);
+  add(obj::kPositionOffset, 0, 0);
+  add(obj::kVelocityOffset, 0, 0);
+  add(obj::kTorqueOffset, 0, 0);
+  add(obj::kInterpolationTimePeriod, 0, 2);
+  add(obj::kInterpolationTimePeriod, 1, 1);
+  add(obj::kInterpolationTimePeriod, 2, static_cast<std::uint8_t>(std::int8_t{-3}));
+  add(obj::kFollowingErrorActualValue, 0, 0);
+  add(obj::kDigitalInputs, 0, 0);
+  add(obj::kTargetVelocity, 0, 0);
+  add(obj::kSupportedDriveModes, 0,
+      cia402::supported_mode_bit(cia402::Mode::kHoming) | cia402::supported_mode_bit(cia402::Mode::kCsp) |
+          cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst));
+  std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
+  rebuild_pdos();
+}
+
+Emulator::Entry* Emulator::find(std::uint16_t index, std::uint8_t sub) noexcept {
+  const std::uint32_t k = key(index, sub);
+  auto it = std::lower_bound(od_.begin(), od_.end(), k, [](const Entry& e, std::uint32_t kk) { return e.key < kk; });
+  return (it != od_.end() && it->key == k) ? &*it : nullptr;
+}
+const Emulator::Entry* Emulator::find(std::uint16_t index, std::uint8_t sub) const noexcept {
+  return const_cast<Emulator*>(this)->find(index, sub);
+}
+bool Emulator::index_exists(std::uint16_t index) const noexcept {
+  const std::uint32_t k = key(index, 0);
+  auto it = std::lower_bound(od_.begin(), od_.end(), k, [](const Entry& e, std::uint32_t kk) { return e.key < kk; });
+  return it != od_.end() && (it->key >> 8) == index;
+}
+std::uint64_t Emulator::get(std::uint16_t index, std::uint8_t sub) const noexcept {
+  const Entry* e = find(index, sub);
+  return e ? e->value : 0;
+}
+std::int64_t Emulator::get_signed(std::uint16_t index, std::uint8_t sub) const noexcept {
+  const Entry* e = find(index, sub);
+  if (!e) return 0;
+  const auto bits = static_cast<unsigned>(canopen::data_type_size(e->type) * 8);
+  return canopen::data_type_signed(e->type) ? canopen::sign_extend(e->value, bits) : static_cast<std::int64_t>(e->value);
+}
+void Emulator::set(std::uint16_t index, std::uint8_t sub, std::uint64_t v) noexcept {
+  if (Entry* e = find(index, sub)) {
+    const std::size_t n = canopen::data_type_size(e->type);
+    e->value = n >= 8 || n == 0 ? v : (v & ((std::uint64_t{1} << (8 * n)) - 1));
+  }
+}
+std::int64_t Emulator::read_int(std::uint16_t index, std::uint8_t sub) const noexcept {
+  if (index == obj::kStatusword && sub == 0) return statusword();
+  return get_signed(index, sub);
+}
+
+void Emulator::reset_dictionary(bool communication_only) noexcept {
+  for (Entry& e : od_) {
+    const auto index = static_cast<std::uint16_t>(e.key >> 8);
+    if (communication_only && (index < 0x1000 || index > 0x1FFF)) continue;
+    e.value = e.default_value;
+  }
+  rebuild_pdos();
+  consumers_ = {};
+}
+
+void Emulator::rebuild_pdos() noexcept {
+  for (std::uint8_t p = 0; p < 4; ++p) {
+    for (int dir = 0; dir < 2; ++dir) {
+      const bool rx = dir == 0;
+      const auto comm = static_cast<std::uint16_t>((rx ? 0x1400 : 0x1800) + p);
+      const auto map = static_cast<std::uint16_t>((rx ? 0x1600 : 0x1A00) + p);
+      canopen::PdoMap m;
+      m.dir = rx ? canopen::PdoDir::kRpdo : canopen::PdoDir::kTpdo;
+      m.number = static_cast<std::uint8_t>(p + 1);
+      const auto cob = static_cast<std::uint32_t>(get(comm, 1));
+      m.cob_id = cob & 0x7FFu;
+      m.transmission_type = static_cast<std::uint8_t>(get(comm, 2));
+      const auto count = static_cast<std::uint8_t>(get(map, 0));
+      for (std::uint8_t s = 1; s <= count && s <= 8; ++s) {
+        const auto e = canopen::decode_mapping_entry(static_cast<std::uint32_t>(get(map, s)));
+        m.add(e.index, e.sub, e.bits);
+      }
+      const bool ok = m.finalize();
+      const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0;
+      if (rx) {
+        rpdo_[p] = m;
+        rpdo_valid_[p] = valid;
+      } else {
+        tpdo_[p] = m;
+        tpdo_valid_[p] = valid;
+        tpdo_sync_count_[p] = 0;
+      }
+    }
+  }
+}
+
+SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::uint64_t v) const noexcept {
+  if (is_rpdo_comm(index) || is_tpdo_comm(index)) {
+    if (sub == 1) {
+      const auto cur = static_cast<std::uint32_t>(get(index, 1));
+      const auto nv = static_cast<std::uint32_t>(v);
+      if ((nv & 0x20000000u) != 0) return SdoAbort::kInvalidValue;  // 29-bit IDs not supported
+      const bool cur_valid = (cur & canopen::kPdoInvalid) == 0;
+      const bool new_valid = (nv & canopen::kPdoInvalid) == 0;
+      // CiA 301: the CAN-ID may only change while the PDO is invalid.
+      if (cur_valid && new_valid && (cur & 0x7FFu) != (nv & 0x7FFu)) return SdoAbort::kInvalidValue;
+      if (new_valid && (nv & 0x7FFu) == 0) return SdoAbort::kInvalidValue;
+    }
+    if (sub == 2 && v >= 241 && v <= 251) return SdoAbort::kInvalidValue;
+    return SdoAbort::kNone;
+  }
+  const bool rx = is_rpdo_map(index);
+  const auto comm = static_cast<std::uint16_t>(index - 0x200);
+  if ((get(comm, 1) & canopen::kPdoInvalid) == 0) return SdoAbort::kDeviceState;  // PDO must be invalid first
+  if (sub == 0) {
+    if (v > 8) return SdoAbort::kPdoLength;
+    unsigned bits = 0;
+    for (std::uint8_t s = 1; s <= v; ++s) {
+      const auto e = canopen::decode_mapping_entry(static_cast<std::uint32_t>(get(index, s)));
+      if (e.index == 0) return SdoAbort::kParameterIncompatible;
+      bits += e.bits;
+    }
+    if (bits > 64) return SdoAbort::kPdoLength;
+    return SdoAbort::kNone;
+  }
+  if (get(index, 0) != 0) return SdoAbort::kDeviceState;  // sub0 must be 0 while entries change
+  if (v == 0) return SdoAbort::kNone;
+  const auto e = canopen::decode_mapping_entry(static_cast<std::uint32_t>(v));
+  const Entry* target = find(e.index, e.sub);
+  if (target == nullptr) return index_exists(e.index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
+  const bool mappable = rx ? (target->pdo == canopen::PdoMappable::kRpdo || target->pdo == canopen::PdoMappable::kBoth)
+                           : (target->pdo == canopen::PdoMappable::kTpdo || target->pdo == canopen::PdoMappable::kBoth);
+  if (!mappable) return SdoAbort::kNotMappable;
+  if (e.bits != canopen::data_type_size(target->type) * 8) return SdoAbort::kParameterIncompatible;
+  return SdoAbort::kNone;
+}
+
+SdoAbort Emulator::sdo_read(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> out, std::size_t& len) noexcept {
+  const Entry* e = find(index, sub);
+  if (e == nullptr) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
+  if (e->access == canopen::Access::kWo) return SdoAbort::kWriteOnly;
+  if (e->text != nullptr) {
+    len = std::min(e->text->size(), out.size());
+    std::copy_n(e->text->begin(), len, out.begin());
+    return SdoAbort::kNone;
+  }
+  std::uint64_t v = e->value;
+  if (index == obj::kStatusword && sub == 0) v = statusword();
+  len = std::min(canopen::data_type_size(e->type), out.size());
+  for (std::size_t i = 0; i < len; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
+  return SdoAbort::kNone;
+}
+
+SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data) noexcept {
+  Entry* e = find(index, sub);
+  if (e == nullptr) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
+  if (e->access == canopen::Access::kRo || e->access == canopen::Access::kConst) return SdoAbort::kReadOnly;
+  const std::size_t n = canopen::data_type_size(e->type);
+  if (data.size() > n) return SdoAbort::kLengthTooHigh;
+  if (data.size() < n) return SdoAbort::kLengthTooLow;
+  std::uint64_t v = 0;
+  for (std::size_t i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(data[i]) << (8 * i);
+  const bool pdo_obj = is_rpdo_comm(index) || is_tpdo_comm(index) || is_rpdo_map(index) || is_tpdo_map(index);
+  if (pdo_obj) {
+    const SdoAbort a = check_pdo_write(index, sub, v);
+    if (a != SdoAbort::kNone) return a;
+  }
+  if (index == obj::kModesOfOperation) {
+    const auto m = static_cast<std::int8_t>(v);
+    if (m != 0 && m != 6 && m != 8 && m != 9 && m != 10) return SdoAbort::kInvalidValue;
+  }
+  if (index == obj::kInterpolationTimePeriod && sub == 1 && v == 0) return SdoAbort::kInvalidValue;
+  if (index == obj::kInterpolationTimePeriod && sub == 2) {
+    const auto i = static_cast<std::int8_t>(v);
+    if (i < -9) return SdoAbort::kValueTooLow;
+    if (i > 0) return SdoAbort::kValueTooHigh;
+  }
+  if (index == 0x1003 && sub == 0) {
+    if (v != 0) return SdoAbort::kInvalidValue;
+    for (std::uint8_t s = 1; s <= 8; ++s) set(0x1003, s, 0);
+  }
+  if (index == 0x1016 && sub >= 1) {
+    const auto ms = v & 0xFFFF;
+    const auto id = (v >> 16) & 0xFF;
+    if ((v >> 24) != 0) return SdoAbort::kInvalidValue;
+    if (ms != 0 && (id == 0 || id > 127)) return SdoAbort::kInvalidValue;
+  }
+  set(index, sub, v);
+  if (pdo_obj) rebuild_pdos();
+  if (index == 0x1017) next_heartbeat_ns_ = now_ns_ + static_cast<std::int64_t>(v) * 1'000'000;
+  if (index == 0x1016) consumers_[static_cast<std::size_t>(std::min<std::uint8_t>(sub, 4) - 1)] = Consumer{};
+  if (index == kFaultInjection && v != 0) inject_fault(static_cast<std::uint16_t>(v));
+  if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled) mode_display_ = static_cast<std::int8_t>(v);
+  if (index == obj::kControlword && out_ != nullptr) apply_controlword(static_cast<std::uint16_t>(v), *out_);
+  return SdoAbort::kNone;
+}
+
+// ============================================================================
+// Communication
+// ============================================================================
+void Emulator::send_emcy(std::uint16_t code, canopen::FrameSink& out) noexcept {
+  if (nmt_ == canopen::NmtState::kStopped) return;
+  const auto cob = static_cast<std::uint32_t>(get(0x1014, 0));
+  if ((cob & canopen::kPdoInvalid) != 0) return;
+  canopen::Emcy e;
+  e.node = cfg_.node;
+  e.code = code;
+  e.error_register = static_cast<std::uint8_t>(get(0x1001, 0));
+  can::Frame f = canopen::make_emcy_frame(e);
+  f.id = cob & 0x7FFu;
+  out.send(f);
+  ++counters_.emcys;
+}
+
+void Emulator::power_on(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
+  now_ns_ = now_ns;
+  powered_ = true;
+  reset_dictionary(false);
+  sdo_.reset();
+  state_ = State::kNotReadyToSwitchOn;  // transition 0
+  state_ = State::kSwitchOnDisabled;    // transition 1: initialisation is instantaneous
+  last_cw_ = 0;
+  active_fault_ = pending_fault_ = 0;
+  following_error_ = false;
+  vel_ = acc_ = 0;
+  mode_display_ = static_cast<std::int8_t>(get(obj::kModesOfOperation));
+  set(obj::kPositionActualValue, 0, static_cast<std::uint32_t>(position()));
+  set(obj::kTargetPosition, 0, static_cast<std::uint32_t>(position()));
+  nmt_ = canopen::NmtState::kPreOperational;
+  out.send(canopen::make_heartbeat_frame(cfg_.node, canopen::NmtState::kBootUp));
+  ++counters_.boot_ups;
+  next_heartbeat_ns_ = now_ns;
+}
+
+void Emulator::handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::FrameSink& out) noexcept {
+  const auto nmt = canopen::decode_nmt(f);
+  if (!nmt || (nmt->node != 0 && nmt->node != cfg_.node)) return;
+  switch (nmt->command) {
+    case 0x01: nmt_ = canopen::NmtState::kOperational; break;
+    case 0x02: nmt_ = canopen::NmtState::kStopped; break;
+    case 0x80: nmt_ = canopen::NmtState::kPreOperational; break;
+    case 0x81: power_on(now_ns, out); break;
+    case 0x82:
+      reset_dictionary(true);
+      sdo_.reset();
+      nmt_ = canopen::NmtState::kPreOperational;
+      out.send(canopen::make_heartbeat_frame(cfg_.node, canopen::NmtState::kBootUp));
+      ++counters_.boot_ups;
+      next_heartbeat_ns_ = now_ns;
+      break;
+    default: break;
+  }
+}
+
+void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noexcept {
+  const can::Frame& f = tf.frame;
+  if (!powered_ || f.extended() || f.error()) return;
+  out_ = &out;
+  const canopen::CobInfo c = canopen::classify(f.id);
+  if (f.id == canopen::cob::kNmt) {
+    handle_nmt(f, now_ns_, out);
+  } else if (f.id == (get(0x1005, 0) & 0x7FFu)) {
+    if (nmt_ == canopen::NmtState::kOperational || nmt_ == canopen::NmtState::kPreOperational) handle_sync(now_ns_, out);
+  } else if (c.kind == canopen::FrameKind::kSdoRx && c.node == cfg_.node) {
+    if (nmt_ != canopen::NmtState::kStopped && !f.remote()) {
+      ++counters_.sdo_requests;
+      sdo_.on_frame(f, now_ns_, out);
+    }
+  } else if (c.kind == canopen::FrameKind::kHeartbeat) {
+    for (std::uint8_t s = 1; s <= 4; ++s) {
+      const auto v = get(0x1016, s);
+      if ((v & 0xFFFF) != 0 && ((v >> 16) & 0xFF) == c.node) {
+        Consumer& k = consumers_[s - 1];
+        k.armed = true;
+        k.lost = false;
+        k.last_ns = now_ns_;
+      }
+    }
+  } else if (nmt_ == canopen::NmtState::kOperational && !f.remote()) {
+    for (std::size_t p = 0; p < 4; ++p) {
+      if (!rpdo_valid_[p] || f.id != rpdo_[p].cob_id) continue;
+      if (f.len < rpdo_[p].size_bytes) {
+        ++counters_.rpdo_length_errors;
+        send_emcy(canopen::emcy_code::kPdoLength, out);
+      } else {
+        rpdo_latch_[p] = f;
+        rpdo_pending_[p] = true;
+        ++counters_.rpdos;
+      }
+    }
+  }
+  out_ = nullptr;
+}
+
+void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
+  now_ns_ = now_ns;
+  if (!powered_) return;
+  out_ = &out;
+  const auto hb_ms = static_cast<std::int64_t>(get(0x1017, 0));
+  if (hb_ms > 0 && now_ns >= next_heartbeat_ns_) {
+    out.send(canopen::make_heartbeat_frame(cfg_.node, nmt_));
+    ++counters_.heartbeats;
+    next_heartbeat_ns_ = std::max(next_heartbeat_ns_ + hb_ms * 1'000'000, now_ns + 1);
+  }
+  for (std::uint8_t s = 1; s <= 4; ++s) {
+    Consumer& k = consumers_[s - 1];
+    const auto v = get(0x1016, s);
+    const auto ms = static_cast<std::int64_t>(v & 0xFFFF);
+    if (!k.armed || k.lost || ms == 0) continue;
+    if (now_ns - k.last_ns > ms * 1'000'000) {
+      k.lost = true;
+      set(0x1001, 0, get(0x1001, 0) | canopen::kErrCommunication);
+      switch (cfg_.heartbeat_loss_reaction) {
+        case HeartbeatLossReaction::kFault: enter_fault(canopen::emcy_code::kHeartbeatError, out); break;
+        case HeartbeatLossReaction::kQuickStop:
+          if (state_ == State::kOperationEnabled) state_ = State::kQuickStopActive;
+          send_emcy(canopen::emcy_code::kHeartbeatError, out);
+          break;
+        case HeartbeatLossReaction::kNone: send_emcy(canopen::emcy_code::kHeartbeatError, out); break;
+      }
+    }
+  }
+  sdo_.step(now_ns, out);
+  out_ = nullptr;
+}
+
+void Emulator::service(can::Transport& bus, std::int64_t now_ns) noexcept {
+  canopen::TransportSink sink(bus);
+  now_ns_ = now_ns;
+  std::array<can::TimedFrame, 64> buf;
+  for (;;) {
+    const std::size_t n = bus.receive(buf);
+    for (std::size_t i = 0; i < n; ++i) on_frame(buf[i], sink);
+    if (n < buf.size()) break;
+  }
+  step(now_ns, sink);
+}
+
+// ============================================================================
+// CiA 402
+// ============================================================================
+std::uint16_t Emulator::statusword() const noexcept {
+  std::uint16_t sw = cia402::state_bits(state_);
+  sw |= cia402::sw::kRemote;
+  switch (state_) {
+    case State::kReadyToSwitchOn:
+    case State::kSwitchedOn:
+    case State::kOperationEnabled:
+    case State::kQuickStopActive:
+    case State::kFaultReactionActive: sw |= cia402::sw::kVoltageEnabled; break;
+    default: break;
+  }
+  if (state_ == State::kSwitchOnDisabled || state_ == State::kFault) sw |= cia402::sw::kQuickStop;
+  const auto mode = static_cast<cia402::Mode>(mode_display_);
+  if (state_ == State::kOperationEnabled) {
+    if (cia402::is_cyclic(mode)) sw |= cia402::sw::kFollowsCommand;
+    if (mode == cia402::Mode::kHoming) {
+      if (homing_done_) sw |= cia402::sw::kHomingAttained | cia402::sw::kTargetReached;
+      if (!homing_active_ && !homing_done_) sw |= cia402::sw::kTargetReached;  // interrupted / not started
+    }
+  }
+  if (following_error_ && mode == cia402::Mode::kCsp) sw |= cia402::sw::kFollowingError;
+  return sw;
+}
+
+std::int32_t Emulator::position() const noexcept {
+  const double p = std::round(pos_);
+  return static_cast<std::int32_t>(std::clamp(p, -2147483648.0, 2147483647.0));
+}
+
+void Emulator::enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept {
+  active_fault_ = code;
+  set(obj::kErrorCode, 0, code);
+  set(0x1001, 0, get(0x1001, 0) | error_register_for(code));
+  for (std::uint8_t s = 8; s > 1; --s) set(0x1003, s, get(0x1003, static_cast<std::uint8_t>(s - 1)));
+  set(0x1003, 1, code);
+  set(0x1003, 0, std::min<std::uint64_t>(get(0x1003, 0) + 1, 8));
+  if (state_ != State::kFault) state_ = State::kFaultReactionActive;  // transition 13
+  send_emcy(code, out);
+}
+
+void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept {
+  const auto qs = static_cast<std::int16_t>(get_signed(obj::kQuickStopOptionCode));
+  std::uint16_t prev = last_cw_;
+  for (int i = 0; i < 2; ++i) {
+    const cia402::StepResult r = cia402::apply_controlword(state_, prev, cw, qs);
+    if (r.transition == cia402::kNoTransition) break;
+    if (r.transition == 15) {
+      active_fault_ = 0;
+      following_error_ = false;
+      following_error_cycles_ = 0;
+      set(obj::kErrorCode, 0, 0);
+      set(0x1001, 0, 0);
+      for (auto& k : consumers_) k.lost = false;
+      send_emcy(canopen::emcy_code::kNoError, out);  // error reset
+    }
+    if (r.next == State::kOperationEnabled) {
+      // Enabling never jumps: the delay line starts at the present target.
+      const Setpoint sp{static_cast<std::int32_t>(get_signed(obj::kTargetPosition)),
+                        static_cast<std::int32_t>(get_signed(obj::kTargetVelocity)),
+                        static_cast<std::int16_t>(get_signed(obj::kTargetTorque))};
+      delay_.fill(sp);
+      prev_demand_ = sp.position;
+      mode_display_ = static_cast<std::int8_t>(get_signed(obj::kModesOfOperation));
+    }
+    state_ = r.next;
+    prev = cw;
+  }
+  // Homing start: rising edge of bit 4 in Operation enabled, mode 6.
+  if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kHoming) &&
+      (cw & cia402::cw::kHomingStart) != 0 && (last_cw_ & cia402::cw::kHomingStart) == 0) {
+    homing_active_ = true;
+    homing_done_ = false;
+  }
+  if ((cw & cia402::cw::kHomingStart) == 0) homing_active_ = false;
+  last_cw_ = cw;
+}
+
+void Emulator::advance_motor(double dt) noexcept {
+  const Setpoint now_sp{static_cast<std::int32_t>(get_signed(obj::kTargetPosition) + get_signed(obj::kPositionOffset)),
+                        static_cast<std::int32_t>(get_signed(obj::kTargetVelocity) + get_signed(obj::kVelocityOffset)),
+                        static_cast<std::int16_t>(get_signed(obj::kTargetTorque) + get_signed(obj::kTorqueOffset))};
+  // Delay line: the setpoint used now is the one received lag_cycles SYNCs ago.
+  const std::size_t len = cfg_.lag_cycles + 1;
+  delay_[delay_head_] = now_sp;
+  const Setpoint sp = delay_[(delay_head_ + len - cfg_.lag_cycles) % len];
+  delay_head_ = (delay_head_ + 1) % len;
+
+  const double vmax = std::min(cfg_.max_velocity, static_cast<double>(get(obj::kMaxProfileVelocity)));
+  double amax = cfg_.max_acceleration;
+  double v_des = 0;
+  const auto mode = static_cast<cia402::Mode>(mode_display_);
+  double torque = 0;
+  bool stop_immediately = false;
+  if (state_ == State::kOperationEnabled) {
+    switch (mode) {
+      case cia402::Mode::kCsp: {
+        const double demand = sp.position;
+        // Feed-forward of the demand's change plus a proportional correction
+        // of the error left from the previous SYNC: a ramp is followed exactly
+        // (the only following error is the lag), a step settles geometrically.
+        const double v_ff = (demand - prev_demand_) / dt;
+        v_des = v_ff + cfg_.position_gain * (prev_demand_ - pos_) / dt;
+        prev_demand_ = demand;
+        set(obj::kPositionDemandValue, 0, static_cast<std::uint32_t>(sp.position));
+        break;
+      }
+      case cia402::Mode::kCsv: v_des = sp.velocity; break;
+      case cia402::Mode::kCst: {
+        const double tmax = static_cast<double>(get(obj::kMaxTorque));
+        torque = std::clamp(static_cast<double>(sp.torque), -tmax, tmax);
+        v_des = vel_ + torque / 1000.0 * amax * dt;
+        break;
+      }
+      case cia402::Mode::kHoming:
+        if (homing_active_ && !homing_done_) {
+          const auto method = static_cast<std::int8_t>(get_signed(obj::kHomingMethod));
+          if (method == 35 || method == 37 || std::abs(pos_) < 1.0) {
+            pos_ = static_cast<double>(get_signed(obj::kHomeOffset));
+            homing_done_ = true;
+            homing_active_ = false;
+            stop_immediately = true;
+          } else {
+            // Search the home switch at position 0 with the switch-search speed.
+            const double speed = static_cast<double>(get(obj::kHomingSpeeds, 1));
+            const double step = std::min(speed * dt, std::abs(pos_));
+            v_des = (pos_ > 0 ? -step : step) / dt;
+            amax = std::max(amax, std::abs(v_des - vel_) / dt);
+          }
+        }
+        break;
+      default: break;
+    }
+  } else if (state_ == State::kQuickStopActive) {
+    amax = static_cast<double>(get(obj::kQuickStopDeceleration));
+    v_des = 0;
+  } else {
+    stop_immediately = true;  // power stage off: the model stops (brake)
+  }
+  if (stop_immediately) {
+    acc_ = 0;
+    vel_ = 0;
+  } else {
+    v_des = std::clamp(v_des, -vmax, vmax);
+    const double dv = std::clamp(v_des - vel_, -amax * dt, amax * dt);
+    acc_ = dv / dt;
+    vel_ += dv;
+    pos_ += vel_ * dt;
+  }
+  const double trq = mode == cia402::Mode::kCst && state_ == State::kOperationEnabled ? torque : acc_ / cfg_.max_acceleration * 1000.0;
+  set(obj::kTorqueActualValue, 0, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(std::round(trq), -32768.0, 32767.0))));
+  if (state_ == State::kQuickStopActive && vel_ == 0.0 && !cia402::quick_stop_stays(static_cast<std::int16_t>(get_signed(obj::kQuickStopOptionCode)))) {
+    state_ = State::kSwitchOnDisabled;  // transition 12 (quick stop completed)
+  }
+}
+
+void Emulator::update_outputs() noexcept {
+  const std::int32_t p = position();
+  set(obj::kPositionActualValue, 0, static_cast<std::uint32_t>(p));
+  set(obj::kPositionActualInternalValue, 0, static_cast<std::uint32_t>(p));
+  set(obj::kVelocityActualValue, 0, static_cast<std::uint32_t>(static_cast<std::int32_t>(std::round(vel_))));
+  set(obj::kFollowingErrorActualValue, 0, static_cast<std::uint32_t>(static_cast<std::int32_t>(get_signed(obj::kTargetPosition) - p)));
+  set(obj::kModesOfOperationDisplay, 0, static_cast<std::uint8_t>(mode_display_));
+  set(obj::kStatusword, 0, statusword());
+}
+
+void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
+  for (std::size_t p = 0; p < 4; ++p) {
+    if (!tpdo_valid_[p]) continue;
+    const canopen::PdoMap& m = tpdo_[p];
+    const std::uint8_t t = m.transmission_type;
+    if (t >= 241 && t <= 253) continue;  // RTR-only / reserved: not sent on SYNC
+    ++tpdo_sync_count_[p];
+    if (t >= 1 && t <= 240 && tpdo_sync_count_[p] % t != 0) continue;
+    can::Frame f;
+    f.id = m.cob_id;
+    f.len = m.size_bytes;
+    std::span<std::uint8_t> payload(f.data.data(), f.len);
+    for (std::uint8_t i = 0; i < m.count; ++i) {
+      const canopen::PdoEntry& e = m.entries[i];
+      const std::uint64_t v = (e.index == obj::kStatusword && e.sub == 0) ? statusword() : get(e.index, e.sub);
+      canopen::pack_bits(payload, e.bit_offset, e.bits, v);
+    }
+    out.send(f);
+    ++counters_.tpdos;
+  }
+}
+
+void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noexcept {
+  ++counters_.syncs;
+  const bool operational = nmt_ == canopen::NmtState::kOperational;
+  // RPDOs received since the last SYNC take effect now.
+  if (operational) {
+    bool cw_written = false;
+    for (std::size_t p = 0; p < 4; ++p) {
+      if (!rpdo_pending_[p]) continue;
+      rpdo_pending_[p] = false;
+      const canopen::PdoMap& m = rpdo_[p];
+      const auto payload = rpdo_latch_[p].payload();
+      for (std::uint8_t i = 0; i < m.count; ++i) {
+        const canopen::PdoEntry& e = m.entries[i];
+        set(e.index, e.sub, canopen::unpack_bits(payload, e.bit_offset, e.bits));
+        if (e.index == obj::kControlword) cw_written = true;
+      }
+    }
+    if (cw_written) apply_controlword(static_cast<std::uint16_t>(get(obj::kControlword)), out);
+    if (state_ != State::kOperationEnabled) mode_display_ = static_cast<std::int8_t>(get_signed(obj::kModesOfOperation));
+    else if (static_cast<std::int8_t>(get_signed(obj::kModesOfOperation)) != mode_display_) {
+      // Mode switch while enabled: the new mode starts from the present state.
+      mode_display_ = static_cast<std::int8_t>(get_signed(obj::kModesOfOperation));
+      prev_demand_ = pos_;
+      delay_.fill(Setpoint{position(), static_cast<std::int32_t>(get_signed(obj::kTargetVelocity)),
+                           static_cast<std::int16_t>(get_signed(obj::kTargetTorque))});
+    }
+  }
+  if (cfg_.fail_after_syncs != 0 && counters_.syncs == cfg_.fail_after_syncs) pending_fault_ = cfg_.fail_emcy_code;
+  if (state_ == State::kFaultReactionActive) state_ = State::kFault;  // transition 14: reaction done
+  if (pending_fault_ != 0) {
+    const std::uint16_t code = pending_fault_;
+    pending_fault_ = 0;
+    enter_fault(code, out);
+  }
+  // Motor: advances by the interpolation period 0x60C2, only here.
+  const cia402::InterpolationPeriod ip{static_cast<std::uint8_t>(get(obj::kInterpolationTimePeriod, 1)),
+                                        static_cast<std::int8_t>(get_signed(obj::kInterpolationTimePeriod, 2))};
+  std::int64_t period_ns = cia402::interpolation_period_ns(ip);
+  if (period_ns <= 0) period_ns = 1'000'000;
+  advance_motor(static_cast<double>(period_ns) / 1e9);
+  // Following error monitoring (CSP, Operation enabled).
+  const auto window = static_cast<std::uint32_t>(get(obj::kFollowingErrorWindow));
+  if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kCsp) &&
+      window != 0xFFFFFFFFu) {
+    const double fe = std::abs(static_cast<double>(get_signed(obj::kTargetPosition)) - pos_);
+    if (fe > window) {
+      following_error_ = true;
+      ++following_error_cycles_;
+      const auto timeout_ms = static_cast<double>(get(obj::kFollowingErrorTimeOut));
+      if (static_cast<double>(following_error_cycles_) * static_cast<double>(period_ns) / 1e6 >= timeout_ms) {
+        enter_fault(canopen::emcy_code::kFollowingError, out);
+      }
+    } else {
+      following_error_ = false;
+      following_error_cycles_ = 0;
+    }
+  }
+  update_outputs();
+  if (operational) send_tpdos(out);
+}
+
+}  // namespace canmotion::emulator

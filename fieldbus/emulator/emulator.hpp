@@ -1,0 +1,201 @@
+#pragma once
+/// \file
+/// An emulated CiA 402 servo drive (CANopen slave), used by tests, the demo
+/// and tools/cia402-emu. It has an object dictionary with the CiA 301
+/// communication objects and the CiA 402 objects the master uses, an SDO
+/// server with the right abort codes, an NMT slave with boot-up and heartbeat,
+/// PDO mapping changeable only over SDO as CiA 301 says, RPDOs applied at the
+/// next SYNC, TPDOs sent on each SYNC, the CiA 402 state machine (modes 6, 8,
+/// 9, 10) from the shared cia402.hpp, and a motor model that advances only on
+/// SYNC (by the 0x60C2 period) with limited velocity/acceleration and a lag.
+///
+/// Faults: following error beyond 0x6065 -> Fault + EMCY 0x8611; master
+/// heartbeat lost (0x1016) -> the configured reaction + EMCY 0x8130; writing
+/// an EMCY code to 0x2000 injects that fault; fail_after_syncs injects one
+/// after N SYNCs.
+///
+/// The emulator is sans-IO like the master: it is given frames and the time
+/// and emits frames through a FrameSink, so the same class runs on the SimBus
+/// (in-process, virtual time) and on SocketCAN (tools/cia402-emu).
+/// Not used on the master's RT path; its member functions do not allocate
+/// after construction.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fieldbus/can/frame.hpp"
+#include "fieldbus/can/transport.hpp"
+#include "fieldbus/canopen/frame_sink.hpp"
+#include "fieldbus/canopen/nmt.hpp"
+#include "fieldbus/canopen/object_names.hpp"
+#include "fieldbus/canopen/pdo.hpp"
+#include "fieldbus/canopen/sdo_server.hpp"
+#include "fieldbus/cia402/cia402.hpp"
+
+namespace canmotion::emulator {
+
+/// What the drive does when the master's heartbeat is lost.
+enum class HeartbeatLossReaction : std::uint8_t {
+  kFault,      ///< Fault (via Fault reaction active), EMCY 0x8130 (default)
+  kQuickStop,  ///< quick stop (if operation enabled), EMCY 0x8130
+  kNone,       ///< only the EMCY 0x8130
+};
+
+struct EmulatorConfig {
+  std::uint8_t node = 2;
+  std::string device_name = "canmotion cia402-emu: emulated CiA 402 servo drive";  ///< 0x1008 (segmented SDO)
+  std::uint32_t vendor_id = 0x00000000;  ///< 0x1018:1 (0: unassigned)
+  std::uint32_t product_code = 0x00000402;
+  std::uint32_t revision = 0x00010000;
+  // Motor model (drive units: counts, counts/s, counts/s^2).
+  double max_velocity = 2'000'000.0;       ///< 0x607F default
+  double max_acceleration = 50'000'000.0;  ///< limit of the model
+  std::uint32_t lag_cycles = 2;            ///< targets take effect this many SYNCs late
+  double position_gain = 0.5;              ///< fraction of the position error corrected per SYNC (0..1]
+  std::uint32_t following_error_window = 100'000;  ///< 0x6065 default
+  std::int32_t initial_position = 0;
+  // Fault injection.
+  std::uint64_t fail_after_syncs = 0;      ///< 0 = never
+  std::uint16_t fail_emcy_code = 0x2310;   ///< code used by fail_after_syncs
+  HeartbeatLossReaction heartbeat_loss_reaction = HeartbeatLossReaction::kFault;
+};
+
+/// Running totals, for tests and the tool's status line.
+struct EmulatorCounters {
+  std::uint64_t syncs = 0;
+  std::uint64_t rpdos = 0;
+  std::uint64_t tpdos = 0;
+  std::uint64_t sdo_requests = 0;
+  std::uint64_t emcys = 0;
+  std::uint64_t heartbeats = 0;
+  std::uint64_t boot_ups = 0;
+  std::uint64_t rpdo_length_errors = 0;
+};
+
+class Emulator final : public canopen::SdoServerBackend {
+ public:
+  explicit Emulator(const EmulatorConfig& cfg);
+
+  /// Power on (or reset node): dictionary to defaults, boot-up message,
+  /// NMT pre-operational.
+  void power_on(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  /// Handle one received frame (NMT, SYNC, SDO request, RPDO, heartbeats).
+  void on_frame(const can::TimedFrame& f, canopen::FrameSink& out) noexcept;
+  /// Time-driven duties: heartbeat producer, heartbeat consumer, SDO server
+  /// timeout. The motor never advances here, only on SYNC.
+  void step(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  /// Drain `bus`, handle every frame, then step(now_ns); replies go to `bus`.
+  /// This is how the emulator attaches to a SimBus endpoint or a SocketCanBus.
+  void service(can::Transport& bus, std::int64_t now_ns) noexcept;
+
+  /// Inject a fault with EMCY `code` (as writing 0x2000 does).
+  void inject_fault(std::uint16_t code) noexcept { pending_fault_ = code; }
+
+  // ---- observation --------------------------------------------------------
+  [[nodiscard]] std::uint8_t node() const noexcept { return cfg_.node; }
+  [[nodiscard]] canopen::NmtState nmt_state() const noexcept { return nmt_; }
+  [[nodiscard]] cia402::State state() const noexcept { return state_; }
+  [[nodiscard]] std::uint16_t statusword() const noexcept;
+  [[nodiscard]] std::int32_t position() const noexcept;
+  [[nodiscard]] double position_exact() const noexcept { return pos_; }
+  [[nodiscard]] double velocity() const noexcept { return vel_; }
+  [[nodiscard]] std::int8_t mode_display() const noexcept { return mode_display_; }
+  [[nodiscard]] const EmulatorCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] const EmulatorConfig& config() const noexcept { return cfg_; }
+  /// Read an integer object (testing aid); 0 if absent.
+  [[nodiscard]] std::int64_t read_int(std::uint16_t index, std::uint8_t sub = 0) const noexcept;
+
+  // ---- SdoServerBackend -----------------------------------------------------
+  canopen::SdoAbort sdo_read(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> out,
+                             std::size_t& len) noexcept override;
+  canopen::SdoAbort sdo_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data) noexcept override;
+
+ private:
+  struct Entry {
+    std::uint32_t key;  // index << 8 | sub
+    canopen::DataType type;
+    canopen::Access access;
+    canopen::PdoMappable pdo;
+    std::uint64_t value;      // raw little-endian bits
+    std::uint64_t default_value;
+    const std::string* text;  // strings (0x1008...)
+  };
+  static constexpr std::uint32_t key(std::uint16_t index, std::uint8_t sub) noexcept {
+    return (static_cast<std::uint32_t>(index) << 8) | sub;
+  }
+  void build_dictionary();
+  void add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, const std::string* text = nullptr);
+  Entry* find(std::uint16_t index, std::uint8_t sub) noexcept;
+  const Entry* find(std::uint16_t index, std::uint8_t sub) const noexcept;
+  bool index_exists(std::uint16_t index) const noexcept;
+  std::uint64_t get(std::uint16_t index, std::uint8_t sub = 0) const noexcept;
+  std::int64_t get_signed(std::uint16_t index, std::uint8_t sub = 0) const noexcept;
+  void set(std::uint16_t index, std::uint8_t sub, std::uint64_t v) noexcept;
+  void reset_dictionary(bool communication_only) noexcept;
+  canopen::SdoAbort check_pdo_write(std::uint16_t index, std::uint8_t sub, std::uint64_t v) const noexcept;
+  void rebuild_pdos() noexcept;
+
+  void handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  void handle_sync(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  void apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept;
+  void enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept;
+  void send_emcy(std::uint16_t code, canopen::FrameSink& out) noexcept;
+  void advance_motor(double dt) noexcept;
+  void update_outputs() noexcept;
+  void send_tpdos(canopen::FrameSink& out) noexcept;
+
+  EmulatorConfig cfg_;
+  std::vector<Entry> od_;
+  std::string device_name_, hw_version_, sw_version_;
+  canopen::SdoServer sdo_;
+  canopen::NmtState nmt_ = canopen::NmtState::kBootUp;
+  bool powered_ = false;
+  std::int64_t now_ns_ = 0;
+  std::int64_t next_heartbeat_ns_ = 0;
+  // Heartbeat consumer (0x1016:1..4).
+  struct Consumer {
+    bool armed = false;
+    bool lost = false;
+    std::int64_t last_ns = 0;
+  };
+  std::array<Consumer, 4> consumers_{};
+
+  // PDOs as currently mapped (rebuilt when the mapping becomes valid).
+  std::array<canopen::PdoMap, 4> rpdo_{};
+  std::array<bool, 4> rpdo_valid_{};
+  std::array<canopen::PdoMap, 4> tpdo_{};
+  std::array<bool, 4> tpdo_valid_{};
+  std::array<can::Frame, 4> rpdo_latch_{};
+  std::array<bool, 4> rpdo_pending_{};
+  std::array<std::uint32_t, 4> tpdo_sync_count_{};
+
+  // CiA 402.
+  cia402::State state_ = cia402::State::kNotReadyToSwitchOn;
+  std::uint16_t last_cw_ = 0;
+  std::int8_t mode_display_ = 0;
+  std::uint16_t pending_fault_ = 0;
+  std::uint16_t active_fault_ = 0;
+  bool following_error_ = false;
+  std::uint32_t following_error_cycles_ = 0;
+  bool homing_done_ = false;
+  bool homing_active_ = false;
+  // Motor.
+  double pos_ = 0;
+  double vel_ = 0;
+  double acc_ = 0;
+  double prev_demand_ = 0;
+  static constexpr std::size_t kMaxLag = 64;  // bound of lag_cycles
+  struct Setpoint {
+    std::int32_t position;
+    std::int32_t velocity;
+    std::int16_t torque;
+  };
+  std::array<Setpoint, kMaxLag + 1> delay_{};
+  std::size_t delay_head_ = 0;
+  EmulatorCounters counters_{};
+  canopen::FrameSink* out_ = nullptr;  // sink of the frame being handled (SDO writes of 0x6040)
+};
+
+}  // namespace canmotion::emulator

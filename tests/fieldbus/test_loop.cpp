@@ -1,0 +1,173 @@
+// Deterministic master + emulated drives on the SimBus with a virtual clock.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fieldbus/canopen/cob_id.hpp"
+#include "fieldbus/emulator/sim_rig.hpp"
+
+using namespace canmotion;
+using cia402::State;
+using emulator::SimRig;
+using emulator::SimRigConfig;
+
+namespace {
+constexpr std::uint8_t kNodes[] = {2, 3, 4};
+SimRigConfig rig_config() {
+  SimRigConfig c;
+  c.nodes = {2, 3, 4};
+  return c;
+}
+
+void boot_and_enable(SimRig& rig) {
+  rig.power_on();
+  ASSERT_TRUE(rig.run_until([&] { return rig.network().all_operational() || rig.network().any_failed(); }, 2000))
+      << "boot did not finish";
+  ASSERT_FALSE(rig.network().any_failed()) << rig.network().at(0).failure().to_string();
+  rig.network().enable_all();
+  ASSERT_TRUE(rig.run_until([&] { return rig.network().all_enabled() || rig.network().any_failed(); }, 2000));
+  ASSERT_FALSE(rig.network().any_failed()) << rig.network().at(0).failure().to_string();
+}
+}  // namespace
+
+TEST(Loop, BootConfigureEnable) {
+  SimRig rig(rig_config());
+  boot_and_enable(rig);
+  for (std::uint8_t n : kNodes) {
+    auto& emu = rig.emulator(n);
+    EXPECT_EQ(emu.nmt_state(), canopen::NmtState::kOperational);
+    EXPECT_EQ(emu.state(), State::kOperationEnabled);
+    EXPECT_EQ(emu.read_int(0x6060), 8);
+    EXPECT_EQ(emu.read_int(0x60C2, 1), 1);
+    EXPECT_EQ(emu.read_int(0x60C2, 2), -3);
+    EXPECT_EQ(emu.read_int(0x1017), 100);
+    EXPECT_EQ(emu.read_int(0x1016, 1), (127 << 16) | 300);
+    EXPECT_EQ(emu.read_int(0x1A00, 2), 0x60640020);
+    EXPECT_EQ(emu.read_int(0x1801, 1) & 0x80000000LL, 0x80000000LL);  // unused TPDO2 disabled
+    EXPECT_EQ(rig.drive(n).feedback().statusword & 0x6F, 0x27);
+  }
+  // Enabling never moved anything.
+  EXPECT_EQ(rig.emulator(2).position(), 0);
+}
+
+TEST(Loop, CspRampFollowedWithinLag) {
+  SimRigConfig cfg = rig_config();
+  cfg.emulator.lag_cycles = 2;
+  cfg.emulator.initial_position = 12345;
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  EXPECT_EQ(d.target_position(), 12345);  // target followed actual until enabled
+  const double v = 100'000.0;              // counts/s
+  const std::int32_t start = d.feedback().position;
+  double max_err = 0;
+  for (int k = 1; k <= 2000; ++k) {
+    const auto target = static_cast<std::int32_t>(start + v * k * 1e-3);
+    for (std::uint8_t n : kNodes) rig.drive(n).set_target_position(target);
+    rig.step();
+    if (k > 200) max_err = std::max(max_err, std::abs(static_cast<double>(d.target_position() - d.feedback().position)));
+  }
+  // Expected lag at steady state: (lag SYNCs + 1 cycle TPDO latency) x v x T
+  // (the RPDO and the SYNC go out in the same cycle).
+  const double expected = (2 + 1) * v * 1e-3;
+  EXPECT_GE(max_err, expected - 1.0);
+  EXPECT_LE(max_err, expected + 1.0);
+  EXPECT_EQ(d.feedback().tpdo_missed, 0u);
+  EXPECT_FALSE(rig.network().any_failed());
+}
+
+TEST(Loop, InjectedFaultEmcyResetReenable) {
+  SimRig rig(rig_config());
+  boot_and_enable(rig);
+  // Inject over SDO: write 0x2310 to 0x2000 of node 3.
+  auto& sdo = rig.network().master().sdo(3);
+  ASSERT_TRUE(sdo.download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
+  auto& d = rig.drive(3);
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 100));
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kDriveFault);
+  EXPECT_TRUE(d.has_emcy());
+  EXPECT_EQ(d.last_emcy_code(), 0x2310);
+  EXPECT_NE(d.failure().to_string().find("0x2310"), std::string::npos) << d.failure().to_string();
+  EXPECT_EQ(rig.emulator(3).read_int(0x603F), 0x2310);
+  // Other drives unaffected.
+  EXPECT_TRUE(rig.drive(2).enabled());
+  d.fault_reset();
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kSwitchOnDisabled; }, 100));
+  EXPECT_FALSE(d.failed());
+  EXPECT_EQ(rig.emulator(3).read_int(0x603F), 0);
+  d.enable();
+  ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 100));
+}
+
+TEST(Loop, FollowingErrorFaultsWith8611) {
+  SimRigConfig cfg = rig_config();
+  cfg.emulator.following_error_window = 1000;
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  d.set_target_position(d.feedback().position + 50'000);  // a step far beyond the window
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 50));
+  EXPECT_EQ(d.last_emcy_code(), 0x8611);
+}
+
+TEST(Loop, LostHeartbeatGivesNodeLost) {
+  SimRig rig(rig_config());
+  boot_and_enable(rig);
+  rig.disconnect(4);
+  bool lost = false;
+  canopen::NodeEvent e;
+  for (int i = 0; i < 400 && !lost; ++i) {
+    rig.step();
+    while (rig.network().poll_event(e))
+      if (e.kind == canopen::NodeEvent::Kind::kHeartbeatLost && e.node == 4) lost = true;
+  }
+  EXPECT_TRUE(lost);
+  EXPECT_EQ(rig.drive(4).failure().kind, cia402::FailureKind::kHeartbeatLost);
+  EXPECT_FALSE(rig.drive(2).failed());
+}
+
+TEST(Loop, MasterHeartbeatLostFaultsDrive) {
+  SimRigConfig cfg = rig_config();
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  // CiA 301: a consumer starts monitoring at the first heartbeat it receives,
+  // so let one master heartbeat (100 ms period) through first.
+  for (int i = 0; i < 150; ++i) rig.step();
+  ASSERT_TRUE(rig.drive(2).enabled());
+  // Drop the master's heartbeat from now on: drives notice after 0x1016 (300 ms).
+  rig.bus().add_fault(can::SimFault{0x77F, can::SimFault::Action::kDrop, 0, 0});
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 600));
+  EXPECT_EQ(d.last_emcy_code(), 0x8130);
+}
+
+TEST(Loop, DroppedTpdoCounted) {
+  SimRig rig(rig_config());
+  boot_and_enable(rig);
+  rig.bus().add_fault(can::SimFault{canopen::cob::tpdo(1, 3), can::SimFault::Action::kDrop, 5, 3});
+  for (int i = 0; i < 50; ++i) rig.step();
+  EXPECT_EQ(rig.drive(3).feedback().tpdo_missed, 3u);
+  EXPECT_EQ(rig.drive(2).feedback().tpdo_missed, 0u);
+  EXPECT_EQ(rig.bus().counters().dropped, 3u);
+}
+
+TEST(Loop, Deterministic) {
+  auto run = [] {
+    SimRig rig(rig_config());
+    std::uint64_t hash = 1469598103934665603ull;
+    rig.bus().set_tap([&](const can::TimedFrame& f, std::string_view) {
+      hash = (hash ^ f.frame.id) * 1099511628211ull;
+      for (auto b : f.frame.payload()) hash = (hash ^ b) * 1099511628211ull;
+      hash = (hash ^ static_cast<std::uint64_t>(f.t_ns)) * 1099511628211ull;
+    });
+    rig.power_on();
+    rig.network().enable_all();
+    for (int i = 0; i < 500; ++i) {
+      for (std::uint8_t n : kNodes)
+        if (rig.drive(n).enabled()) rig.drive(n).set_target_position(rig.drive(n).target_position() + 10);
+      rig.step();
+    }
+    return hash;
+  };
+  EXPECT_EQ(run(), run());
+}

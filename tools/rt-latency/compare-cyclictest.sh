@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# Side-by-side wake-up latency of canmotion's cyclic executive (rt-latency)
+# and cyclictest (rt-tests) at the same period and priority, in one run.
+# Prints p50/p99/p99.9/max of both and the ratio rt-latency / cyclictest.
+set -euo pipefail
+
+usage() {
+  cat <<'USAGE'
+Usage: compare-cyclictest.sh [OPTIONS]
+
+Runs cyclictest and rt-latency with the same period, priority and cycle
+count, and prints a table of p50, p99, p99.9 and max wake-up latency with
+their ratios (rt-latency / cyclictest). Run as root for SCHED_FIFO.
+
+Options:
+  -i US          period in microseconds (default 1000)
+  -p PRIO        SCHED_FIFO priority (default 80)
+  -l LOOPS       cycles per program (default 20000)
+  -m MODE        parallel (both at once, same load; default) or sequential
+  -b PATH        rt-latency binary (default: build*/tools/rt-latency/rt-latency)
+  -o DIR         keep the raw outputs in DIR (default: a temporary folder)
+  -h             this help
+
+Example:
+  sudo tools/rt-latency/compare-cyclictest.sh -i 1000 -p 80 -l 20000
+
+cyclictest reports whole microseconds (truncated); rt-latency reports the
+upper edge of its log-linear bucket (at most 1/64 above the exact value).
+USAGE
+}
+
+interval=1000 prio=80 loops=20000 mode=parallel bin="" outdir=""
+while getopts "i:p:l:m:b:o:h" opt; do
+  case $opt in
+    i) interval=$OPTARG ;; p) prio=$OPTARG ;; l) loops=$OPTARG ;; m) mode=$OPTARG ;;
+    b) bin=$OPTARG ;; o) outdir=$OPTARG ;; h) usage; exit 0 ;; *) usage >&2; exit 1 ;;
+  esac
+done
+here=$(cd "$(dirname "$0")" && pwd)
+if [[ -z $bin ]]; then
+  bin=$(ls -t "$here"/../../build*/tools/rt-latency/rt-latency 2>/dev/null | head -1 || true)
+fi
+[[ -x $bin ]] || { echo "compare-cyclictest.sh: rt-latency not found (build it, or pass -b PATH)" >&2; exit 1; }
+command -v cyclictest >/dev/null || { echo "compare-cyclictest.sh: cyclictest not found (apt install rt-tests)" >&2; exit 1; }
+[[ $mode == parallel || $mode == sequential ]] || { echo "compare-cyclictest.sh: -m parallel|sequential" >&2; exit 1; }
+if [[ -z $outdir ]]; then outdir=$(mktemp -d); fi
+mkdir -p "$outdir"
+
+histmax=$(( interval * 20 ))  # cyclictest histogram range in us; beyond it counts as overflow
+ct_cmd=(cyclictest -m -p "$prio" -i "$interval" -l "$loops" -q -h "$histmax")
+rl_cmd=("$bin" -q -p "$prio" -i "$interval" -l "$loops" --histogram "$outdir/rt-latency.hist")
+echo "# $(date -u +%FT%TZ) $(uname -r), $(nproc) CPUs, mode $mode"
+echo "# cyclictest: ${ct_cmd[*]}"
+echo "# rt-latency: ${rl_cmd[*]}"
+if [[ $mode == parallel ]]; then
+  "${ct_cmd[@]}" >"$outdir/cyclictest.txt" 2>&1 &
+  ct_pid=$!
+  "${rl_cmd[@]}" >"$outdir/rt-latency.txt" 2>&1
+  wait "$ct_pid"
+else
+  "${ct_cmd[@]}" >"$outdir/cyclictest.txt" 2>&1
+  "${rl_cmd[@]}" >"$outdir/rt-latency.txt" 2>&1
+fi
+
+# cyclictest: percentiles from its 1 us histogram ("us count" lines); the
+# overflow count sits above the histogram range (reported as >histmax).
+read -r ct_p50 ct_p99 ct_p999 ct_max ct_n < <(awk -v hm="$histmax" '
+  /^[0-9]+ [0-9]+$/ { c[$1+0] = $2+0; n += $2; next }
+  /# Max Latencies:/ { max = $4+0 }
+  /# Histogram Overflows:/ { ov = $4+0 }
+  END {
+    total = n + ov
+    split("0.5 0.99 0.999", q, " ")
+    for (k = 1; k <= 3; k++) {
+      rank = int(q[k] * total); if (rank < q[k] * total) rank++; if (rank < 1) rank = 1
+      seen = 0; v = "overflow"
+      for (us = 0; us <= hm; us++) { seen += c[us]; if (seen >= rank) { v = us; break } }
+      out[k] = v
+    }
+    print out[1], out[2], out[3], max, total
+  }' "$outdir/cyclictest.txt")
+
+result=$(grep '^RESULT' "$outdir/rt-latency.txt") || { cat "$outdir/rt-latency.txt" >&2; exit 1; }
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$result"; }
+rl_p50=$(field p50_us) rl_p99=$(field p99_us) rl_p999=$(field p999_us) rl_max=$(field max_us) rl_n=$(field cycles)
+
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b + 0 > 0) printf "%.2f", a / b; else print "n/a" }'; }
+printf '\n%-12s %10s %10s %10s %10s %8s\n' "program" "p50_us" "p99_us" "p99.9_us" "max_us" "cycles"
+printf '%-12s %10s %10s %10s %10s %8s\n' cyclictest "$ct_p50" "$ct_p99" "$ct_p999" "$ct_max" "$ct_n"
+printf '%-12s %10s %10s %10s %10s %8s\n' rt-latency "$rl_p50" "$rl_p99" "$rl_p999" "$rl_max" "$rl_n"
+printf '%-12s %10s %10s %10s %10s\n' "ratio rt/ct" "$(ratio "$rl_p50" "$ct_p50")" "$(ratio "$rl_p99" "$ct_p99")" \
+  "$(ratio "$rl_p999" "$ct_p999")" "$(ratio "$rl_max" "$ct_max")"
+echo "# raw outputs: $outdir"

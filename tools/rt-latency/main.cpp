@@ -1,0 +1,169 @@
+// rt-latency: runs canmotion's cyclic executive with an empty (or
+// configurable-cost) cycle and prints its wake-up latency statistics once a
+// second and at the end, like cyclictest. See tools/rt-latency/README.md.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <thread>
+
+#include "rt/clock.hpp"
+#include "rt/cyclic_executive.hpp"
+
+using namespace canmotion::rt;
+
+namespace {
+
+std::atomic<CyclicExecutive*> g_exec{nullptr};
+
+extern "C" void on_signal(int) {
+  if (CyclicExecutive* e = g_exec.load()) {
+    e->request_stop();  // one atomic store: async-signal-safe
+  }
+}
+
+double us(std::int64_t ns) { return static_cast<double>(ns) / 1000.0; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "rt-latency: wake-up latency of canmotion's real-time cycle (like cyclictest).\n"
+      "Runs the cyclic executive (SCHED_FIFO, mlockall, absolute CLOCK_MONOTONIC deadlines)\n"
+      "with an empty cycle, or one that busy-waits --cost microseconds, and prints the\n"
+      "latency statistics once a second and a summary at the end.",
+      "rt-latency"};
+  app.footer(
+      "Examples:\n"
+      "  rt-latency -p 80 -i 1000 -l 20000        # 20000 cycles of 1 ms at SCHED_FIFO 80\n"
+      "  rt-latency -i 500 -D 60 -c 100 -a 1      # 60 s, 0.5 ms period, 100 us work, CPU 1\n"
+      "  rt-latency -q -l 20000 --histogram h.txt # quiet, write the histogram\n"
+      "Compare with cyclictest: tools/rt-latency/compare-cyclictest.sh\n"
+      "Exit status: 0 on success, 1 on error (e.g. an invalid CPU).");
+  std::int64_t interval_us = 1000;
+  int priority = 80;
+  int cpu = -1;
+  double duration_s = 10.0;
+  std::uint64_t loops = 0;
+  std::int64_t cost_us = 0;
+  bool no_mlock = false;
+  bool quiet = false;
+  bool no_dma_latency = false;
+  std::string histogram_file;
+  app.add_option("-i,--interval", interval_us, "cycle period in microseconds")->capture_default_str()->check(CLI::Range(10, 10'000'000));
+  app.add_option("-p,--priority", priority, "SCHED_FIFO priority 1..99, 0 = normal scheduling")->capture_default_str()->check(CLI::Range(0, 99));
+  app.add_option("-a,--affinity", cpu, "pin the cycle thread to this CPU (-1 = no pinning)")->capture_default_str();
+  app.add_option("-D,--duration", duration_s, "run time in seconds (ignored with --loops)")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("-l,--loops", loops, "number of cycles (0 = use --duration)")->capture_default_str();
+  app.add_option("-c,--cost", cost_us, "busy-wait this many microseconds in every cycle")->capture_default_str()->check(CLI::Range(0, 10'000'000));
+  app.add_flag("--no-mlock", no_mlock, "do not mlockall()");
+  app.add_flag("--no-dma-latency", no_dma_latency,
+               "do not hold /dev/cpu_dma_latency at 0 (cyclictest holds it by default)");
+  app.add_flag("-q,--quiet", quiet, "print only the final summary");
+  app.add_option("--histogram", histogram_file, "write the latency histogram (lower_ns upper_ns count per line) to FILE");
+  CLI11_PARSE(app, argc, argv);
+
+  const Nanos period{interval_us * 1000};
+  if (loops == 0) {
+    loops = static_cast<std::uint64_t>(duration_s * 1e9 / static_cast<double>(period.count()));
+    if (loops == 0) {
+      loops = 1;
+    }
+  }
+
+  // Like cyclictest: keep CPUs out of deep idle states while we measure, by
+  // holding /dev/cpu_dma_latency open with 0 us (PM QoS). Best effort.
+  int dma_fd = -1;
+  if (!no_dma_latency) {
+    dma_fd = ::open("/dev/cpu_dma_latency", O_RDWR | O_CLOEXEC);
+    const std::int32_t zero = 0;
+    if (dma_fd >= 0 && ::write(dma_fd, &zero, sizeof(zero)) != sizeof(zero)) {
+      ::close(dma_fd);
+      dma_fd = -1;
+    }
+  }
+
+  MonotonicClock clock;
+  ExecutiveConfig cfg;
+  cfg.period = period;
+  cfg.rt.lock_memory = !no_mlock;
+  cfg.rt.priority = priority;
+  cfg.rt.cpu = cpu;
+  cfg.thread_name = "rt-latency";
+  cfg.warn = [](std::string_view w) { fmt::print(stderr, "rt-latency: warning: {}\n", w); };
+  CyclicExecutive exec(cfg, clock);
+  const Nanos cost{cost_us * 1000};
+  const std::uint64_t last = loops;
+  exec.set_cycle([&clock, cost, last](const CycleInfo& c) noexcept {
+    if (cost.count() > 0) {
+      while (clock.now() - c.wake < cost) {
+      }
+    }
+    return c.cycle + 1 >= last ? CycleResult::stop : CycleResult::run_on;
+  });
+
+  g_exec.store(&exec);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  if (const std::error_code ec = exec.start()) {
+    fmt::print(stderr, "rt-latency: cannot start: {}\n{}", ec.message(), exec.setup_report().describe());
+    return 1;
+  }
+  if (!quiet) {
+    fmt::print("# period {} us, priority {}, cpu {}, {} cycles, cost {} us, mlockall {}, cpu_dma_latency {}\n",
+               interval_us, priority, cpu, loops, cost_us, no_mlock ? "off" : "on",
+               dma_fd >= 0 ? "0 us" : "not set");
+    std::string setup = exec.setup_report().describe();
+    for (std::size_t pos = 0; (pos = setup.find('\n', pos)) != std::string::npos && pos + 1 < setup.size();) {
+      setup.replace(pos, 1, "\n# ");
+      pos += 3;
+    }
+    fmt::print("# {}", setup);
+  }
+  while (exec.running()) {
+    // Wake up often enough to notice the end, print once a second.
+    for (int i = 0; i < 20 && exec.running(); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    if (!quiet && exec.running()) {
+      fmt::print("{}\n", format_line(exec.stats()));
+      std::fflush(stdout);
+    }
+  }
+  exec.join();
+  g_exec.store(nullptr);
+
+  const CycleStats s = exec.stats();
+  fmt::print("{}", format_summary(s));
+  fmt::print("RESULT cycles={} min_us={:.2f} mean_us={:.2f} p50_us={:.2f} p99_us={:.2f} p999_us={:.2f} "
+             "max_us={:.2f} exec_max_us={:.2f} overruns={} realtime={}\n",
+             s.cycles, us(s.latency_min_ns), us(s.latency_mean_ns), us(s.latency_p50_ns), us(s.latency_p99_ns),
+             us(s.latency_p999_ns), us(s.latency_max_ns), us(s.exec_max_ns), s.overruns,
+             exec.setup_report().realtime() ? "yes" : "no");
+  if (!histogram_file.empty()) {
+    std::ofstream out(histogram_file);
+    if (!out) {
+      fmt::print(stderr, "rt-latency: cannot write {}\n", histogram_file);
+      return 1;
+    }
+    const Histogram& h = exec.statistics().latency();
+    out << "# lower_ns upper_ns count\n";
+    for (std::size_t i = 0; i < Histogram::kBuckets; ++i) {
+      if (const auto n = h.bucket_count(i)) {
+        out << Histogram::bucket_lower(i) << ' ' << Histogram::bucket_upper(i) << ' ' << n << '\n';
+      }
+    }
+  }
+  if (dma_fd >= 0) {
+    ::close(dma_fd);
+  }
+  return 0;
+}
