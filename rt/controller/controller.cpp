@@ -1,5 +1,6 @@
 #include "rt/controller/controller.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -79,16 +80,26 @@ std::optional<motion::AxisId> Controller::axis_id(std::string_view name) const {
   return std::nullopt;
 }
 
-std::optional<motion::ControlId> Controller::control_id(std::string_view name) {
+namespace {
+std::string lower_name(std::string_view s) {
+  std::string o(s);
+  for (char& c : o) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return o;
+}
+}  // namespace
+
+std::optional<motion::ControlId> Controller::control_id(std::string_view name_in) {
+  const std::string name = lower_name(name_in);  // Logix tag names are case-insensitive
   std::lock_guard lock(names_mu_);
   if (auto it = control_names_.find(name); it != control_names_.end()) return it->second;
   if (control_names_.size() >= motion::kMaxControlTags) return std::nullopt;
   const auto id = static_cast<motion::ControlId>(control_names_.size());
-  control_names_.emplace(std::string(name), id);
+  control_names_.emplace(name, id);
   return id;
 }
 
-std::optional<motion::ControlId> Controller::find_control(std::string_view name) const {
+std::optional<motion::ControlId> Controller::find_control(std::string_view name_in) const {
+  const std::string name = lower_name(name_in);
   std::lock_guard lock(names_mu_);
   if (auto it = control_names_.find(name); it != control_names_.end()) return it->second;
   return std::nullopt;

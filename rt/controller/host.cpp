@@ -1,0 +1,76 @@
+#include "rt/controller/host.hpp"
+
+#include <fmt/format.h>
+
+#include "motion/st_parser.hpp"
+
+namespace canmotion::rt {
+
+std::optional<std::string> ControllerHost::bind(std::string_view call, motion::Request& out, std::string* control_tag) {
+  const motion::ParseResult pr = motion::parse_st_call(call);
+  if (!pr.ok()) return fmt::format("column {}: {}", pr.error.column, pr.error.message);
+  const motion::ParsedCall& pc = *pr.call;
+  const motion::InstrSig& sig = motion::signature(pc.instr);
+  motion::Symbols sym;
+  for (std::size_t a = 0; a < c_.axis_count(); ++a) sym.axes.emplace(c_.axis_name(static_cast<motion::AxisId>(a)), static_cast<motion::AxisId>(a));
+  for (std::size_t i = 0; i < pc.operands.size() && i < sig.operands.size(); ++i) {
+    if (sig.operands[i].kind != motion::OperandKind::Control || pc.operands[i].kind != motion::StOperand::Kind::Tag) continue;
+    const auto id = c_.control_id(pc.operands[i].text);
+    if (!id) return fmt::format("no room for control tag '{}' (all {} are in use)", pc.operands[i].text, motion::kMaxControlTags);
+    sym.controls.emplace(pc.operands[i].text, *id);
+    if (control_tag) *control_tag = pc.operands[i].text;
+  }
+  for (const auto& [name, value] : tags_.user_tags()) sym.numeric_tags.emplace(name, value);
+  return motion::bind_call(pc, sym, out);
+}
+
+std::optional<std::string> ControllerHost::check_call(std::string_view call) {
+  motion::Request r;
+  return bind(call, r, nullptr);
+}
+
+std::optional<std::string> ControllerHost::check_tag(std::string_view tag, bool for_write) {
+  std::string e;
+  const auto t = tags_.resolve(tag, &e);
+  if (for_write) {
+    if (t && !t->writable) return fmt::format("tag '{}' is read-only", tag);
+    return std::nullopt;  // a new numeric tag is created by its first assignment
+  }
+  if (t) return std::nullopt;
+  // A control tag first used by a later call in the same script is fine.
+  if (const std::size_t dot = tag.find('.'); dot != std::string_view::npos) {
+    const std::string_view base = tag.substr(0, dot);
+    if (!c_.axis_id(base) && base != "Controller") {
+      (void)c_.control_id(base);
+      if (tags_.resolve(tag, &e)) return std::nullopt;
+    }
+  }
+  return e;
+}
+
+std::optional<std::string> ControllerHost::execute(std::string_view call, std::string* control_tag) {
+  Command c;
+  c.kind = Command::Kind::kInstruction;
+  if (auto e = bind(call, c.request, control_tag)) return e;
+  const std::uint64_t seq = c_.submit(c);
+  if (seq == 0) return std::string("the command queue to the RT thread is full; try again");
+  last_seq_ = seq;
+  return std::nullopt;
+}
+
+const Status& ControllerHost::refresh() {
+  c_.read_status(*status_);
+  return *status_;
+}
+
+bool ControllerHost::settled() { return refresh().done_seq >= last_seq_; }
+
+std::optional<double> ControllerHost::read(std::string_view tag, std::string* error) {
+  return tags_.read(refresh(), tag, error);
+}
+
+std::optional<std::string> ControllerHost::write(std::string_view tag, double value) {
+  return tags_.write(tag, value, true);
+}
+
+}  // namespace canmotion::rt

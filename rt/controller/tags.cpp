@@ -1,0 +1,243 @@
+#include "rt/controller/tags.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+
+#include <fmt/format.h>
+
+namespace canmotion::rt {
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string o(s);
+  for (char& c : o) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return o;
+}
+
+bool iequals(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+// Axis attributes (TagRef::member numbers).
+enum Attr : std::uint8_t {
+  kActualPosition, kCommandPosition, kActualVelocity, kCommandVelocity, kCommandAcceleration, kPositionError,
+  kMotionStatus, kAxisStatus, kAxisFault, kAxisState, kDriveState, kStatusword, kControlword, kLastEmcy,
+  kTpdoMissed, kMaxPositionError,
+};
+struct Named {
+  std::string_view name;
+  std::uint8_t value;
+};
+constexpr std::array kAttrs{
+    Named{"ActualPosition", kActualPosition},   Named{"CommandPosition", kCommandPosition},
+    Named{"ActualVelocity", kActualVelocity},   Named{"CommandVelocity", kCommandVelocity},
+    Named{"CommandAcceleration", kCommandAcceleration}, Named{"PositionError", kPositionError},
+    Named{"MotionStatus", kMotionStatus},       Named{"AxisStatus", kAxisStatus},
+    Named{"AxisFault", kAxisFault},             Named{"AxisState", kAxisState},
+    Named{"DriveState", kDriveState},           Named{"Statusword", kStatusword},
+    Named{"Controlword", kControlword},         Named{"LastEmcy", kLastEmcy},
+    Named{"TpdoMissed", kTpdoMissed},           Named{"MaxPositionError", kMaxPositionError},
+};
+namespace ms = motion::motion_status;
+constexpr std::array kMotionBits{
+    Named{"AccelStatus", ms::AccelStatus},
+    Named{"DecelStatus", ms::DecelStatus},
+    Named{"MoveStatus", ms::MoveStatus},
+    Named{"JogStatus", ms::JogStatus},
+    Named{"GearingStatus", ms::GearingStatus},
+    Named{"HomingStatus", ms::HomingStatus},
+    Named{"StoppingStatus", ms::StoppingStatus},
+    Named{"AxisHomedStatus", ms::AxisHomedStatus},
+    Named{"PositionCamStatus", ms::PositionCamStatus},
+    Named{"TimeCamStatus", ms::TimeCamStatus},
+    Named{"PositionCamPendingStatus", ms::PositionCamPendingStatus},
+    Named{"TimeCamPendingStatus", ms::TimeCamPendingStatus},
+    Named{"GearingLockStatus", ms::GearingLockStatus},
+    Named{"PositionCamLockStatus", ms::PositionCamLockStatus},
+    Named{"TimeCamLockStatus", ms::TimeCamLockStatus},
+    Named{"MasterOffsetMoveStatus", ms::MasterOffsetMoveStatus},
+    Named{"CoordinatedMotionStatus", ms::CoordinatedMotionStatus},
+    Named{"TransformStateStatus", ms::TransformStateStatus},
+    Named{"ControlledByTransformStatus", ms::ControlledByTransformStatus},
+    Named{"DirectVelocityControlStatus", ms::DirectVelocityControlStatus},
+    Named{"DirectTorqueControlStatus", ms::DirectTorqueControlStatus},
+    Named{"MoveLockStatus", ms::MoveLockStatus},
+    Named{"JogLockStatus", ms::JogLockStatus},
+    Named{"MasterOffsetMoveLockStatus", ms::MasterOffsetMoveLockStatus},
+    Named{"MaximumSpeedExceeded", ms::MaximumSpeedExceeded},
+};
+namespace as = motion::axis_status;
+constexpr std::array kStatusBits{
+    Named{"ServoActionStatus", as::ServoActionStatus},   Named{"DriveEnableStatus", as::DriveEnableStatus},
+    Named{"ShutdownStatus", as::ShutdownStatus},         Named{"ConfigUpdateInProcess", as::ConfigUpdateInProcess},
+    Named{"InhibitStatus", as::InhibitStatus},           Named{"DirectControlStatus", as::DirectControlStatus},
+    Named{"AxisUpdateStatus", as::AxisUpdateStatus},
+};
+namespace af = motion::axis_fault;
+constexpr std::array kFaultBits{
+    Named{"PhysicalAxisFault", af::PhysicalAxisFault}, Named{"ModuleFault", af::ModuleFault},
+    Named{"ConfigFault", af::ConfigFault},             Named{"GroupFault", af::GroupFault},
+    Named{"MotionFault", af::MotionFault},             Named{"GuardFault", af::GuardFault},
+    Named{"InitializationFault", af::InitializationFault}, Named{"APRFault", af::APRFault},
+    Named{"SafetyFault", af::SafetyFault},
+};
+// MOTION_INSTRUCTION members.
+enum Member : std::uint8_t { kErr, kExerr, kState, kSegment, kStatusMember };
+constexpr std::array kControlFlags{
+    Named{"EN", motion::flag::EN}, Named{"DN", motion::flag::DN}, Named{"ER", motion::flag::ER},
+    Named{"PC", motion::flag::PC}, Named{"IP", motion::flag::IP}, Named{"AC", motion::flag::AC},
+    Named{"ACCEL", motion::flag::ACCEL}, Named{"DECEL", motion::flag::DECEL},
+};
+constexpr std::array kControlMembers{
+    Named{"ERR", kErr}, Named{"EXERR", kExerr}, Named{"STATE", kState}, Named{"SEGMENT", kSegment},
+    Named{"STATUS", kStatusMember},
+};
+
+template <std::size_t N>
+const Named* find(const std::array<Named, N>& a, std::string_view name) {
+  for (const Named& n : a)
+    if (iequals(n.name, name)) return &n;
+  return nullptr;
+}
+
+}  // namespace
+
+TagTable::TagTable(Controller& c) : c_(c) {
+  add_statistic("Cycle", [&c] { return static_cast<double>(c.cycles()); });
+  add_statistic("Time", [&c] { return static_cast<double>(c.cycles()) * c.period_s(); });
+}
+
+void TagTable::add_statistic(const std::string& name, std::function<double()> get) {
+  stats_.emplace_back(name, std::move(get));
+}
+
+std::vector<std::string_view> TagTable::axis_members() {
+  std::vector<std::string_view> v;
+  for (const auto& n : kAttrs) v.push_back(n.name);
+  for (const auto& n : kMotionBits) v.push_back(n.name);
+  for (const auto& n : kStatusBits) v.push_back(n.name);
+  for (const auto& n : kFaultBits) v.push_back(n.name);
+  return v;
+}
+
+std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* error) {
+  const std::size_t dot = name.find('.');
+  if (dot == std::string_view::npos) {
+    if (auto it = user_.find(lower(name)); it != user_.end())
+      return TagRef{TagRef::Kind::kUser, 0, 0, true};
+    if (error)
+      *error = fmt::format("no tag named '{}': write Axis.Attribute (X.ActualPosition), control.MEMBER (mam1.DN), "
+                           "Controller.<statistic>, or a numeric tag created by '{} := value;'",
+                           name, name);
+    return std::nullopt;
+  }
+  const std::string_view base = name.substr(0, dot);
+  const std::string_view member = name.substr(dot + 1);
+  if (iequals(base, "Controller")) {
+    for (std::size_t i = 0; i < stats_.size(); ++i)
+      if (iequals(stats_[i].first, member)) return TagRef{TagRef::Kind::kController, static_cast<std::uint16_t>(i), 0, false};
+    std::vector<std::string_view> names;
+    for (const auto& s : stats_) names.push_back(s.first);
+    if (error) *error = fmt::format("Controller has no member '{}'; members: {}", member, fmt::join(names, ", "));
+    return std::nullopt;
+  }
+  for (std::size_t a = 0; a < c_.axis_count(); ++a) {
+    if (!iequals(c_.axis_name(static_cast<motion::AxisId>(a)), base)) continue;
+    const auto id = static_cast<std::uint16_t>(a);
+    if (const Named* n = find(kAttrs, member)) return TagRef{TagRef::Kind::kAxis, id, n->value, false};
+    if (const Named* n = find(kMotionBits, member)) return TagRef{TagRef::Kind::kMotionBit, id, n->value, false};
+    if (const Named* n = find(kStatusBits, member)) return TagRef{TagRef::Kind::kAxisStatusBit, id, n->value, false};
+    if (const Named* n = find(kFaultBits, member)) return TagRef{TagRef::Kind::kAxisFaultBit, id, n->value, false};
+    if (error)
+      *error = fmt::format("axis '{}' has no attribute '{}'; attributes: {}, and every MotionStatus, AxisStatus "
+                           "and AxisFault bit by name (e.g. GearingLockStatus)",
+                           base, member, fmt::join(kAttrs.begin(), kAttrs.begin() + kMotionStatus + 4, ", ",
+                                                   [](const Named& n) { return n.name; }));
+    return std::nullopt;
+  }
+  if (const auto ctl = c_.find_control(lower(base))) {
+    if (const Named* n = find(kControlFlags, member)) return TagRef{TagRef::Kind::kControlFlag, *ctl, n->value, false};
+    if (const Named* n = find(kControlMembers, member)) return TagRef{TagRef::Kind::kControl, *ctl, n->value, false};
+    if (error)
+      *error = fmt::format("'{}' is a MOTION_INSTRUCTION; members: EN DN ER PC IP AC ACCEL DECEL ERR EXERR STATE "
+                           "SEGMENT STATUS, not '{}'",
+                           base, member);
+    return std::nullopt;
+  }
+  if (error) {
+    std::vector<std::string> axes;
+    for (std::size_t a = 0; a < c_.axis_count(); ++a) axes.push_back(c_.axis_name(static_cast<motion::AxisId>(a)));
+    *error = fmt::format("'{}' is neither an axis ({}), a control tag used by an instruction so far, nor Controller",
+                         base, fmt::join(axes, ", "));
+  }
+  return std::nullopt;
+}
+
+double TagTable::read(const Status& s, const TagRef& t) const {
+  switch (t.kind) {
+    case TagRef::Kind::kUser: return 0.0;  // read through the name (see read(s, name))
+    case TagRef::Kind::kController: return stats_.at(t.index).second();
+    case TagRef::Kind::kControlFlag: return s.controls[t.index].get(t.member) ? 1.0 : 0.0;
+    case TagRef::Kind::kControl: {
+      const motion::ControlTag& c = s.controls[t.index];
+      switch (t.member) {
+        case kErr: return c.err;
+        case kExerr: return c.exerr;
+        case kState: return c.state;
+        case kSegment: return c.segment;
+        default: return c.status;
+      }
+    }
+    case TagRef::Kind::kMotionBit: return (s.axes[t.index].tag.motion_status >> t.member) & 1u;
+    case TagRef::Kind::kAxisStatusBit: return (s.axes[t.index].tag.axis_status >> t.member) & 1u;
+    case TagRef::Kind::kAxisFaultBit: return (s.axes[t.index].tag.axis_fault >> t.member) & 1u;
+    case TagRef::Kind::kAxis: {
+      const AxisSnapshot& a = s.axes[t.index];
+      switch (t.member) {
+        case kActualPosition: return a.tag.actual_position;
+        case kCommandPosition: return a.tag.command_position;
+        case kActualVelocity: return a.tag.actual_velocity;
+        case kCommandVelocity: return a.tag.command_velocity;
+        case kCommandAcceleration: return a.tag.command_acceleration;
+        case kPositionError: return a.tag.position_error;
+        case kMotionStatus: return a.tag.motion_status;
+        case kAxisStatus: return a.tag.axis_status;
+        case kAxisFault: return a.tag.axis_fault;
+        case kAxisState: return static_cast<double>(a.tag.state);
+        case kDriveState: return static_cast<double>(a.drive_state);
+        case kStatusword: return a.statusword;
+        case kControlword: return a.controlword;
+        case kLastEmcy: return a.last_emcy;
+        case kTpdoMissed: return static_cast<double>(a.tpdo_missed);
+        default: return a.max_abs_position_error;
+      }
+    }
+  }
+  return 0.0;
+}
+
+std::optional<double> TagTable::read(const Status& s, std::string_view name, std::string* error) {
+  const auto t = resolve(name, error);
+  if (!t) return std::nullopt;
+  if (t->kind == TagRef::Kind::kUser) return user_.find(lower(name))->second;
+  return read(s, *t);
+}
+
+std::optional<std::string> TagTable::write(std::string_view name, double value, bool create) {
+  std::string e;
+  const auto t = resolve(name, &e);
+  if (t && !t->writable) return fmt::format("tag '{}' is read-only", name);
+  if (!t) {
+    if (!create || name.find('.') != std::string_view::npos || name.empty() ||
+        !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_'))
+      return e;
+    if (c_.axis_id(name) || c_.find_control(lower(name))) return fmt::format("'{}' is an axis or control tag, not a number", name);
+  }
+  user_[lower(name)] = value;
+  return std::nullopt;
+}
+
+}  // namespace canmotion::rt

@@ -1,0 +1,71 @@
+#pragma once
+/// \file
+/// Tag names as users write them in scripts and canmotionctl, resolved
+/// against a Controller and read from its status snapshot:
+///
+///   X.ActualPosition  X.CommandPosition  X.ActualVelocity  X.CommandVelocity
+///   X.PositionError   X.MotionStatus     X.AxisStatus      X.AxisFault
+///   X.AxisState       X.<status bit>     (every MotionStatus / AxisStatus /
+///                                          AxisFault bit by its Logix name,
+///                                          e.g. X.GearingLockStatus)
+///   X.DriveState  X.Statusword  X.Controlword  X.LastEmcy  X.TpdoMissed  (CIP drive axes)
+///   mag1.EN .DN .ER .PC .IP .AC .ACCEL .DECEL .ERR .EXERR .STATE .SEGMENT .STATUS
+///   Controller.Cycle  Controller.Time  and the statistics the owner registers
+///   user numeric tags (created by `tag := value;`)
+///
+/// Names are case-insensitive, as in Logix. Resolution is not realtime;
+/// reading a resolved tag from a Status is cheap.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rt/controller/controller.hpp"
+
+namespace canmotion::rt {
+
+/// A resolved tag.
+struct TagRef {
+  enum class Kind : std::uint8_t { kAxis, kMotionBit, kAxisStatusBit, kAxisFaultBit, kControl, kControlFlag, kController, kUser };
+  Kind kind = Kind::kAxis;
+  std::uint16_t index = 0;  ///< axis id, control id, or statistic/user slot
+  std::uint8_t member = 0;  ///< attribute number, bit number or member number
+  bool writable = false;
+};
+
+/// Resolves names and reads values. One per Controller, used from non-RT
+/// threads (not thread-safe itself: give each thread its own or lock).
+class TagTable {
+ public:
+  explicit TagTable(Controller& c);
+
+  /// Resolve `name`; on failure sets `error` to a sentence with what would be valid.
+  std::optional<TagRef> resolve(std::string_view name, std::string* error);
+  /// Read a resolved tag from a status snapshot.
+  [[nodiscard]] double read(const Status& s, const TagRef& t) const;
+  /// Resolve and read in one go.
+  std::optional<double> read(const Status& s, std::string_view name, std::string* error);
+  /// Write a writable (user) tag. Creates it when `create` is true.
+  std::optional<std::string> write(std::string_view name, double value, bool create);
+
+  /// Extra read-only controller statistics (e.g. `Controller.LatencyMaxUs`),
+  /// evaluated when read.
+  void add_statistic(const std::string& name, std::function<double()> get);
+
+  /// User numeric tags (for binding operands like `MAM(X, m, 0, Dist, ...)`).
+  [[nodiscard]] const std::map<std::string, double, std::less<>>& user_tags() const noexcept { return user_; }
+
+  /// All attribute and bit names of an axis (for help texts and `status`).
+  static std::vector<std::string_view> axis_members();
+
+ private:
+  Controller& c_;
+  std::map<std::string, double, std::less<>> user_;  // lower-case name -> value
+  std::vector<std::pair<std::string, std::function<double()>>> stats_;
+};
+
+}  // namespace canmotion::rt
