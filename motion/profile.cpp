@@ -228,19 +228,23 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
       return sg * (s.x - b.x);
     };
     const double dstop = stop_dist(lim);
-    if (dstop > Rabs) {
+    // A braking acceleration that the jerk limit cannot ramp out before the
+    // velocity reaches zero (possible after MCD lowered the decel jerk).
+    auto reverses = [&](double jd) noexcept { return arel < 0 && vrel - arel * arel / (2 * jd) < 0; };
+    if (dstop > Rabs || (policy == Overshoot::StopAtTarget && reverses(lim.jd))) {
       if (policy == Overshoot::Reverse) {
         vel_change_lim(b, 0.0, lim, sg);
         continue;
       }
-      // Stop exactly on target: scale decel (and jerk) up by k >= 1.
+      // Stop exactly on target: scale decel (and jerk) up by the smallest k >= 1
+      // that neither reverses nor passes the target.
       double lo = 0.0, hi = std::log(1e9);  // log k
       for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
         const double mid = (lo + hi) / 2;
         const double k = std::exp(mid);
         Limits l = lim;
         l.a *= k; l.d *= k; l.ja *= k; l.jd *= k;
-        if (stop_dist(l) > Rabs) lo = mid; else hi = mid;
+        if (reverses(l.jd) || stop_dist(l) > Rabs) lo = mid; else hi = mid;
       }
       const double k = std::exp(hi);
       Limits l = lim;

@@ -63,7 +63,10 @@ constexpr E kCoordSpeedUnits[] = {{"unitspersec", 0}, {"%ofmaximum", 1}, {"units
 
 constexpr OperandSig ax(std::string_view n) { return {n, K::Axis}; }
 constexpr OperandSig ctl() { return {"MotionControl", K::Control}; }
-constexpr OperandSig en(std::string_view n, std::span<const E> e) { return {n, K::Enum, e}; }
+/// "Immediate" enumeration: keyword or number only.
+constexpr OperandSig en(std::string_view n, std::span<const E> e) { return {n, K::Enum, e, Range::Any, false}; }
+/// "Immediate or Tag" enumeration: keyword, number or numeric tag.
+constexpr OperandSig ent(std::string_view n, std::span<const E> e) { return {n, K::Enum, e, Range::Any, true}; }
 constexpr OperandSig real(std::string_view n, Range r = Range::Any) { return {n, K::Real, {}, r}; }
 constexpr OperandSig integer(std::string_view n, Range r = Range::Any) { return {n, K::Int, {}, r}; }
 
@@ -75,23 +78,23 @@ constexpr OperandSig kMas[] = {ax("Axis"), ctl(), en("StopType", kStopType), en(
                                real("DecelRate"), en("DecelUnits", kAccelUnits01), en("ChangeDecelJerk", kNoYes),
                                real("DecelJerk"), en("JerkUnits", kJerkUnitsMas)};
 
-constexpr OperandSig kMaj[] = {ax("Axis"), ctl(), en("Direction", kJogDir), real("Speed", Range::NonNegative),
+constexpr OperandSig kMaj[] = {ax("Axis"), ctl(), ent("Direction", kJogDir), real("Speed", Range::NonNegative),
                                en("SpeedUnits", kSpeedUnitsMaj), real("AccelRate", Range::Positive),
                                en("AccelUnits", kAccelUnitsMaj), real("DecelRate", Range::Positive),
                                en("DecelUnits", kAccelUnitsMaj), en("Profile", kProfile), real("AccelJerk"),
                                real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj), en("Merge", kMerge),
-                               en("MergeSpeed", kMergeSpeed), real("LockPosition"), en("LockDirection", kLockDir)};
+                               en("MergeSpeed", kMergeSpeed), real("LockPosition"), ent("LockDirection", kLockDir)};
 
-constexpr OperandSig kMam[] = {ax("Axis"), ctl(), en("MoveType", kMoveType), real("Position"),
+constexpr OperandSig kMam[] = {ax("Axis"), ctl(), ent("MoveType", kMoveType), real("Position"),
                                real("Speed", Range::NonNegative), en("SpeedUnits", kSpeedUnitsMam),
                                real("AccelRate", Range::Positive), en("AccelUnits", kAccelUnitsMam),
                                real("DecelRate", Range::Positive), en("DecelUnits", kAccelUnitsMam),
                                en("Profile", kProfile), real("AccelJerk"), real("DecelJerk"),
                                en("JerkUnits", kJerkUnitsMam), en("Merge", kMerge), en("MergeSpeed", kMergeSpeed),
-                               real("LockPosition"), en("LockDirection", kLockDir),
+                               real("LockPosition"), ent("LockDirection", kLockDir),
                                {"EventDistance", K::RealArray}, {"CalculatedData", K::RealArray}};
 
-constexpr OperandSig kMag[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), en("Direction", kCamDir), real("Ratio"),
+constexpr OperandSig kMag[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), ent("Direction", kCamDir), real("Ratio"),
                                integer("SlaveCounts"), integer("MasterCounts"), en("MasterReference", kMasterRef),
                                en("RatioFormat", kRatioFormat), en("Clutch", kClutch), real("AccelRate"),
                                en("AccelUnits", kAccelUnits01)};
@@ -108,44 +111,44 @@ constexpr OperandSig kMrp[] = {ax("Axis"), ctl(), en("Type", kMrpType), en("Posi
 constexpr OperandSig kMccp[] = {ctl(), {"Cam", K::CamArray}, integer("Length"), real("StartSlope"), real("EndSlope"),
                                 {"CamProfile", K::CamProfile}};
 
-constexpr OperandSig kMapc[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), en("Direction", kCamDir),
+constexpr OperandSig kMapc[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), ent("Direction", kCamDir),
                                 {"CamProfile", K::CamProfile}, real("SlaveScaling"), real("MasterScaling"),
                                 en("ExecutionMode", kExecModeMapc), en("ExecutionSchedule", kExecSchedMapc),
                                 real("MasterLockPosition"), real("CamLockPosition"), en("MasterReference", kMasterRef),
                                 en("MasterDirection", kMasterDir)};
 
-constexpr OperandSig kMatc[] = {ax("Axis"), ctl(), en("Direction", kCamDir), {"CamProfile", K::CamProfile},
+constexpr OperandSig kMatc[] = {ax("Axis"), ctl(), ent("Direction", kCamDir), {"CamProfile", K::CamProfile},
                                 real("DistanceScaling"), real("TimeScaling"), en("ExecutionMode", kExecModeMatc),
                                 en("ExecutionSchedule", kExecSchedMatc), real("LockPosition"),
-                                en("LockDirection", kLockDir), en("InstructionMode", kInstrMode)};
+                                ent("LockDirection", kLockDir), en("InstructionMode", kInstrMode)};
 
-constexpr OperandSig kMdac[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), en("MotionType", kMdacType),
+constexpr OperandSig kMdac[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), ent("MotionType", kMdacType),
                                 en("MasterReference", kMasterRef)};
 
 constexpr OperandSig kMds[] = {ax("Axis"), ctl(), real("Speed"), en("SpeedUnits", kMdsUnits)};
 
 constexpr OperandSig kMgs[] = {{"Group", K::Group}, ctl(), en("StopMode", kMgsMode)};
 
-constexpr OperandSig kMclm[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), en("MoveType", kCoordMoveType),
+constexpr OperandSig kMclm[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), ent("MoveType", kCoordMoveType),
                                 {"Position", K::RealArray}, real("Speed", Range::NonNegative),
                                 en("SpeedUnits", kCoordSpeedUnits), real("AccelRate", Range::Positive),
                                 en("AccelUnits", kAccelUnitsMaj), real("DecelRate", Range::Positive),
                                 en("DecelUnits", kAccelUnitsMaj), en("Profile", kProfile), real("AccelJerk"),
-                                real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj), en("TerminationType", kTermType),
+                                real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj), ent("TerminationType", kTermType),
                                 en("Merge", kMergeCoord), en("MergeSpeed", kMergeSpeed), real("CommandTolerance"),
-                                real("LockPosition"), en("LockDirection", kLockDir), {"EventDistance", K::RealArray},
+                                real("LockPosition"), ent("LockDirection", kLockDir), {"EventDistance", K::RealArray},
                                 {"CalculatedData", K::RealArray}};
 
-constexpr OperandSig kMccm[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), en("MoveType", kCoordMoveType),
-                                {"Position", K::RealArray}, en("CircleType", kCircleType),
-                                {"Via/Center/Radius", K::RealArray}, en("Direction", kCircleDir),
+constexpr OperandSig kMccm[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), ent("MoveType", kCoordMoveType),
+                                {"Position", K::RealArray}, ent("CircleType", kCircleType),
+                                {"Via/Center/Radius", K::RealArray}, ent("Direction", kCircleDir),
                                 real("Speed", Range::NonNegative), en("SpeedUnits", kCoordSpeedUnits),
                                 real("AccelRate", Range::Positive), en("AccelUnits", kAccelUnitsMaj),
                                 real("DecelRate", Range::Positive), en("DecelUnits", kAccelUnitsMaj),
                                 en("Profile", kProfile), real("AccelJerk"), real("DecelJerk"),
-                                en("JerkUnits", kJerkUnitsMaj), en("TerminationType", kTermType),
+                                en("JerkUnits", kJerkUnitsMaj), ent("TerminationType", kTermType),
                                 en("Merge", kMergeCoord), en("MergeSpeed", kMergeSpeed), real("CommandTolerance"),
-                                real("LockPosition"), en("LockDirection", kLockDir), {"EventDistance", K::RealArray},
+                                real("LockPosition"), ent("LockDirection", kLockDir), {"EventDistance", K::RealArray},
                                 {"CalculatedData", K::RealArray}};
 
 constexpr OperandSig kMcs[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), en("StopType", kMcsStop),

@@ -86,6 +86,9 @@ class Emulator final : public canopen::SdoServerBackend {
   /// Time-driven duties: heartbeat producer, heartbeat consumer, SDO server
   /// timeout. The motor never advances here, only on SYNC.
   void step(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  /// Set the time used while handling the next frames (on_frame does not
+  /// take a time: received timestamps may come from another clock).
+  void set_time(std::int64_t now_ns) noexcept { now_ns_ = now_ns; }
   /// Drain `bus`, handle every frame, then step(now_ns); replies go to `bus`.
   /// This is how the emulator attaches to a SimBus endpoint or a SocketCanBus.
   void service(can::Transport& bus, std::int64_t now_ns) noexcept;

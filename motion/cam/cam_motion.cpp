@@ -51,6 +51,9 @@ CamError CamMotion::start(const CamProfile& profile, const CamMotionConfig& conf
   lock_ = lock;
   dir_ = static_cast<double>(config.direction);
   y_lock_ = profile.evaluate(lock, cursor_).position;
+  last_ = CamMotionOutput{};
+  last_.profile_master = lock;
+  last_.segment = cursor_.segment;
   return CamError::None;
 }
 
@@ -64,6 +67,13 @@ double CamMotion::pass_end(std::int64_t pass) const noexcept {
 CamMotionOutput CamMotion::step(double x) noexcept {
   CamMotionOutput out{};
   if (profile_ == nullptr) return out;
+  if (!std::isfinite(x)) {
+    // A non-finite master/time (a fault upstream): hold the last output.
+    out = last_;
+    out.velocity = 0.0;
+    out.acceleration = 0.0;
+    return out;
+  }
   const double ks = dir_ * config_.scaling.slave;
   const double inv = 1.0 / config_.scaling.master;
   double v = lock_ + x * inv;
@@ -88,6 +98,7 @@ CamMotionOutput CamMotion::step(double x) noexcept {
     out.position = ks * (s.position - y_lock_);
     out.profile_master = v;
     out.segment = cursor_.segment;
+    last_ = out;
     return out;  // outside the range: holds the end position, velocity 0
   }
   const CamSample s = profile_->evaluate(v, cursor_);
@@ -96,6 +107,7 @@ CamMotionOutput CamMotion::step(double x) noexcept {
   out.acceleration = ks * inv * inv * s.acceleration;
   out.profile_master = v;
   out.segment = cursor_.segment;
+  last_ = out;
   return out;
 }
 

@@ -84,8 +84,9 @@ struct CamMotionOutput {
   bool complete = false;
 };
 
-/// A running cam. Stateless apart from its configuration and a segment
-/// cursor: step(x) is a pure function of x, so position is exactly
+/// A running cam. Stateless apart from its configuration, a segment cursor
+/// and the last output (repeated for a non-finite x): step(x) is a pure
+/// function of x, so position is exactly
 /// reproducible and does not drift over long runs.
 ///
 /// Continuous mode unwinds: with L = master_span and D = slave_span,
@@ -113,7 +114,9 @@ class CamMotion {
   /// Evaluates the cam at driving coordinate x, measured from the start
   /// (x = 0 at start): cam time in s for a time-driven MATC, master travel
   /// for MAPC / master-driven MATC (unwrapped; negative when the master runs
-  /// backwards). Returns zeros when not active. Realtime-safe, O(1) amortised
+  /// backwards). Returns zeros when not active. A non-finite x (an upstream
+  /// fault) repeats the last output with velocity and acceleration 0.
+  /// Realtime-safe, O(1) amortised
   /// for monotonic x, O(log n) after a jump.
   [[nodiscard]] CamMotionOutput step(double x) noexcept;
 
@@ -138,6 +141,7 @@ class CamMotion {
   const CamProfile* profile_ = nullptr;
   CamMotionConfig config_{};
   CamCursor cursor_{};
+  CamMotionOutput last_{};
   double m0_ = 0.0, m1_ = 0.0, span_ = 0.0, slave_span_ = 0.0;
   double lock_ = 0.0, y_lock_ = 0.0, dir_ = 1.0;
 };

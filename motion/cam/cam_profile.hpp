@@ -195,7 +195,7 @@ class CamProfile {
 
   /// Slave position, velocity and acceleration at `master` (binary search).
   /// Outside the master range see EndBehaviour. Returns zeros when the profile
-  /// is not calculated. Realtime-safe.
+  /// is not calculated; a NaN master gives NaN. Realtime-safe.
   [[nodiscard]] CamSample evaluate(double master, EndBehaviour end = EndBehaviour::Clamp) const noexcept;
   /// As evaluate(master, end), with a segment hint. Realtime-safe.
   [[nodiscard]] CamSample evaluate(double master, CamCursor& cursor,

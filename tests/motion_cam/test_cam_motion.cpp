@@ -182,6 +182,21 @@ TEST(CamOnce, CompletesAndHoldsTheEndPosition) {
   EXPECT_EQ(o.range, CamRange::BeforeStart);
 }
 
+TEST(CamOnce, NonFiniteCoordinateHoldsTheLastOutput) {
+  CamProfile p(2);
+  calc({{0, 0, L}, {1, 3, L}}, p);
+  CamMotion cm;
+  ASSERT_EQ(cm.start(p, {ExecutionMode::Continuous, {1, 1}}), CamError::None);
+  const auto a = cm.step(2.5);
+  for (double bad : {std::nan(""), HUGE_VAL, -HUGE_VAL}) {
+    const auto o = cm.step(bad);
+    EXPECT_EQ(o.position, a.position);
+    EXPECT_EQ(o.pass, a.pass);
+    EXPECT_EQ(o.velocity, 0.0);
+  }
+  EXPECT_DOUBLE_EQ(cm.step(2.75).position, 8.25);
+}
+
 TEST(CamPersistent, UnlocksOutsideAndRelocksInside) {
   CamProfile p(3);
   calc({{0, 0, L}, {1, 1, L}, {2, 1, L}}, p);
