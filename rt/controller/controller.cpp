@@ -250,6 +250,12 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
       planner_.reset_control(c.control);
     } else if (c.kind == Command::Kind::kEnableDrives) {
       for (auto& b : buses_) b.network->enable_all();
+    } else if (c.kind == Command::Kind::kPreOperational) {
+      for (auto& b : buses_) {
+        auto& sink = static_cast<RecordingSink&>(*b.sink);
+        sink.now_ns = now_ns;
+        b.network->master().send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, sink);
+      }
     }
     done_seq_ = c.seq;
   }

@@ -78,6 +78,7 @@ struct Command {
     kInstruction,   ///< execute `request` (one rung transition)
     kResetControl,  ///< clear control tag `control` (prescan)
     kEnableDrives,  ///< ask every drive to enable (outside the planner; tests, bring-up)
+    kPreOperational,  ///< NMT enter pre-operational to every node on every bus (controlled stop)
   };
   Kind kind = Kind::kInstruction;
   motion::Request request{};

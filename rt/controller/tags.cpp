@@ -151,11 +151,13 @@ std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* erro
     if (const Named* n = find(kMotionBits, member)) return TagRef{TagRef::Kind::kMotionBit, id, n->value, false};
     if (const Named* n = find(kStatusBits, member)) return TagRef{TagRef::Kind::kAxisStatusBit, id, n->value, false};
     if (const Named* n = find(kFaultBits, member)) return TagRef{TagRef::Kind::kAxisFaultBit, id, n->value, false};
-    if (error)
+    if (error) {
+      std::vector<std::string_view> attrs;
+      for (const Named& n : kAttrs) attrs.push_back(n.name);
       *error = fmt::format("axis '{}' has no attribute '{}'; attributes: {}, and every MotionStatus, AxisStatus "
                            "and AxisFault bit by name (e.g. GearingLockStatus)",
-                           base, member, fmt::join(kAttrs.begin(), kAttrs.begin() + kMotionStatus + 4, ", ",
-                                                   [](const Named& n) { return n.name; }));
+                           base, member, fmt::join(attrs, ", "));
+    }
     return std::nullopt;
   }
   if (const auto ctl = c_.find_control(lower(base))) {

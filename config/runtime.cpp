@@ -1,0 +1,99 @@
+#include "config/runtime.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "fieldbus/canopen/cob_id.hpp"
+
+namespace canmotion::config {
+
+cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s) {
+  cia402::DriveConfig d;
+  d.node = a.node;
+  d.mode = cia402::Mode::kCsp;
+  d.cycle_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));
+  d.pdo_profile = a.drive.pdo;
+  d.producer_heartbeat_ms = a.drive.heartbeat_ms;
+  d.consumer_heartbeat_ms = bus.master_heartbeat_ms > 0 ? a.drive.master_heartbeat_timeout_ms : 0;
+  d.boot_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.boot_ms) * 1'000'000;
+  d.start_timeout_ns = d.boot_timeout_ns;
+  d.sdo_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.sdo_ms) * 1'000'000;
+  d.transition_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.transition_ms) * 1'000'000;
+  if (a.drive.following_error_window > 0) d.extra_writes.push_back({0x6065, 0, 4, a.drive.following_error_window});
+  for (const SdoWrite& w : a.drive.sdo_writes)
+    d.extra_writes.push_back({w.index, w.sub, w.size, static_cast<std::uint32_t>(static_cast<std::int64_t>(w.value))});
+  return d;
+}
+
+emulator::EmulatorConfig emulator_config(const AxisSettings& a) {
+  emulator::EmulatorConfig e;
+  e.node = a.node;
+  const double conv = a.axis.conversion_constant;
+  // Give the model headroom over the axis's own limits, so that the emulated
+  // drive follows any profile the planner may command.
+  e.max_velocity = std::max(e.max_velocity, 2.0 * a.axis.max_speed * conv);
+  e.max_acceleration = std::max(e.max_acceleration, 4.0 * std::max(a.axis.max_accel, a.axis.max_decel) * conv);
+  if (a.drive.following_error_window > 0) e.following_error_window = a.drive.following_error_window;
+  return e;
+}
+
+Runtime build_runtime(const Config& cfg, bool force_sim) {
+  Runtime rt;
+  rt::ControllerSpec spec;
+  spec.period_ns = static_cast<std::int64_t>(std::llround(cfg.controller.period_s * 1e9));
+  for (const BusSettings& b : cfg.buses) {
+    rt::BusSpec bs;
+    bs.name = b.name;
+    bs.network.master.node_id = b.master_node;
+    bs.network.master.heartbeat_period_ms = b.master_heartbeat_ms;
+    bs.network.master.sync_counter_overflow = b.sync_counter_overflow;
+    if (force_sim || b.is_sim()) {
+      if (!rt.sim) rt.sim = std::make_unique<rt::SimWorld>();
+      bs.transport = &rt.sim->add_bus(b.name);
+      rt.trace_names.push_back(b.name);
+    } else {
+      // Receive only what a CANopen master needs: the nodes' EMCY, TPDOs,
+      // SDO responses and heartbeats (0x080 + node .. 0x700 + node).
+      std::vector<can::Filter> filters;
+      for (const AxisSettings& a : cfg.axes) {
+        if (a.axis.type != motion::AxisType::CipDrive || a.bus != b.name) continue;
+        for (std::uint32_t base : {canopen::cob::kEmcyBase, 0x180u, 0x280u, 0x380u, 0x480u, canopen::cob::kSdoTxBase,
+                                   canopen::cob::kHeartbeatBase})
+          filters.push_back(can::Filter{base + a.node, 0x7FF, false});
+      }
+      std::error_code ec;
+      std::string why;
+      auto sock = can::SocketCanBus::open(b.interface, filters, ec, &why);
+      if (!sock) throw std::runtime_error(fmt::format("{}: bus '{}' (line {}): {}", cfg.path, b.name, b.where.line, why));
+      bs.transport = sock.get();
+      rt.sockets.push_back(std::move(sock));
+      rt.trace_names.push_back(b.interface);
+    }
+    spec.buses.push_back(bs);
+  }
+  for (const AxisSettings& a : cfg.axes) {
+    rt::AxisSpec as;
+    as.name = a.name;
+    as.config = a.axis;
+    if (a.axis.type == motion::AxisType::CipDrive) {
+      std::size_t bi = 0;
+      while (bi < cfg.buses.size() && cfg.buses[bi].name != a.bus) ++bi;
+      as.bus = static_cast<int>(bi);
+      as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s);
+      if (force_sim || cfg.buses[bi].is_sim()) {
+        // The simulated bus index equals the bus index: every simulated bus was added in order.
+        std::size_t sim_index = 0;
+        for (std::size_t k = 0; k < bi; ++k)
+          if (force_sim || cfg.buses[k].is_sim()) ++sim_index;
+        rt.sim->add_drive(sim_index, emulator_config(a));
+      }
+    }
+    spec.axes.push_back(as);
+  }
+  rt.controller = std::make_unique<rt::Controller>(std::move(spec));
+  return rt;
+}
+
+}  // namespace canmotion::config

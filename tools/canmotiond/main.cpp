@@ -1,0 +1,432 @@
+// canmotiond: the canmotion daemon. Loads and validates a configuration,
+// opens the buses (or simulates them), boots the drives and runs the cycle.
+// Argument parsing and I/O only; the work is in config/ and rt/.
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "config/config.hpp"
+#include "config/runtime.hpp"
+#include "fieldbus/can/candump_format.hpp"
+#include "fieldbus/canopen/emcy.hpp"
+#include "rt/clock.hpp"
+#include "rt/controller/host.hpp"
+#include "rt/controller/script.hpp"
+#include "rt/cyclic_executive.hpp"
+#include "rt/systemd_notify.hpp"
+
+namespace {
+
+using namespace canmotion;
+
+std::atomic<int> g_signal{0};
+void on_signal(int sig) { g_signal.store(sig); }
+
+struct Options {
+  std::string config;
+  bool sim = false;
+  double duration = 0;  // 0 = until the script ends or a signal
+  std::string script;
+  std::string trace;
+  std::string csv;
+  bool stats = false;
+  std::string socket;
+  bool quiet = false;
+};
+
+/// Writes the trace and CSV files and prints events; drained from the
+/// controller's rings on a non-RT thread (or inline in --sim).
+class Outputs {
+ public:
+  Outputs(const Options& o, config::Runtime& rt, const config::Config& cfg) : rt_(rt), cfg_(cfg) {
+    if (!o.trace.empty()) {
+      trace_ = std::fopen(o.trace.c_str(), "w");
+      if (!trace_) throw std::runtime_error(fmt::format("cannot write trace file '{}'", o.trace));
+      rt.controller->set_trace(true);
+    }
+    if (!o.csv.empty()) {
+      csv_ = std::fopen(o.csv.c_str(), "w");
+      if (!csv_) throw std::runtime_error(fmt::format("cannot write CSV file '{}'", o.csv));
+      std::fputs("cycle,time,axis,cmd_pos,act_pos,cmd_vel,act_vel,motion_status,axis_status\n", csv_);
+      rt.controller->set_telemetry(true);
+    }
+    // Real time: transmit records carry CLOCK_MONOTONIC, kernel receive stamps
+    // CLOCK_REALTIME; put both on the realtime scale like candump.
+    if (!rt.all_simulated()) {
+      timespec m{}, r{};
+      clock_gettime(CLOCK_MONOTONIC, &m);
+      clock_gettime(CLOCK_REALTIME, &r);
+      mono_to_real_ = (r.tv_sec - m.tv_sec) * 1'000'000'000LL + (r.tv_nsec - m.tv_nsec);
+    }
+  }
+  ~Outputs() {
+    if (trace_) std::fclose(trace_);
+    if (csv_) std::fclose(csv_);
+  }
+  void drain(bool quiet) {
+    rt::Controller& c = *rt_.controller;
+    rt::TraceRecord tr;
+    char line[can::kCandumpLineMax + 2];
+    while (c.pop_trace(tr)) {
+      if (!trace_) continue;
+      const bool simulated = rt_.all_simulated() || rt_.sockets.empty();
+      std::int64_t t = tr.frame.t_ns;
+      if (tr.tx && !simulated) t += mono_to_real_;
+      const std::size_t n = can::format_candump_line(line, tr.frame.frame, t, rt_.trace_names[tr.bus]);
+      if (n > 0) {
+        line[n] = '\n';
+        std::fwrite(line, 1, n + 1, trace_);
+      }
+    }
+    rt::Sample s;
+    const double T = c.period_s();
+    while (c.pop_sample(s)) {
+      if (!csv_) continue;
+      std::fprintf(csv_, "%llu,%.6f,%s,%.6f,%.6f,%.6f,%.6f,%u,%u\n", static_cast<unsigned long long>(s.cycle),
+                   static_cast<double>(s.cycle) * T, c.axis_name(s.axis).c_str(), s.cmd_pos, s.act_pos, s.cmd_vel,
+                   s.act_vel, s.motion_status, s.axis_status);
+    }
+    rt::Event e;
+    while (c.pop_event(e)) {
+      if (e.kind == rt::Event::Kind::kDriveFailed) {
+        fmt::print(stderr, "canmotiond: axis {}: {}\n", c.axis_name(static_cast<motion::AxisId>(e.axis)),
+                   e.failure.to_string());
+      } else if (!quiet && e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kEmcy) {
+        fmt::print(stderr, "canmotiond: bus {} node {}: EMCY 0x{:04X} {}\n", cfg_.buses[e.bus].name, e.node.node,
+                   e.node.emcy.code, canopen::emcy_code_text(e.node.emcy.code));
+      } else if (e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kHeartbeatLost) {
+        fmt::print(stderr, "canmotiond: bus {} node {}: heartbeat lost\n", cfg_.buses[e.bus].name, e.node.node);
+      } else if (e.kind == rt::Event::Kind::kBusState) {
+        fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
+      }
+    }
+  }
+
+ private:
+  config::Runtime& rt_;
+  const config::Config& cfg_;
+  std::FILE* trace_ = nullptr;
+  std::FILE* csv_ = nullptr;
+  std::int64_t mono_to_real_ = 0;
+};
+
+/// The controlled stop (SIGINT/SIGTERM, or the end of the run): stop every
+/// axis at its configured deceleration, disable the drives, put the nodes in
+/// pre-operational. Each phase is bounded (see README).
+class Shutdown {
+ public:
+  enum class Phase { kNone, kStopping, kDisabling, kPreOp, kDone };
+  explicit Shutdown(rt::ControllerHost& h) : h_(h) {}
+  Phase phase() const { return phase_; }
+  void begin(double now) {
+    if (phase_ != Phase::kNone) return;
+    phase_ = Phase::kStopping;
+    since_ = now;
+    rt::Controller& c = h_.controller();
+    for (std::size_t a = 0; a < c.axis_count(); ++a) {
+      const std::string& n = c.axis_name(static_cast<motion::AxisId>(a));
+      std::string ctl;
+      // MAS(All), decel as configured (ChangeDecel No).
+      (void)h_.execute(fmt::format("MAS({}, canmotiond_stop_{}, All, No, 100, %ofmaximum, No, 100, %ofmaximum)", n, a), &ctl);
+    }
+  }
+  /// Advance; returns true when done.
+  bool step(double now) {
+    rt::Controller& c = h_.controller();
+    const rt::Status& s = h_.refresh();
+    switch (phase_) {
+      case Phase::kNone: return false;
+      case Phase::kStopping: {
+        bool moving = false;
+        for (std::size_t a = 0; a < c.axis_count(); ++a) moving |= s.axes[a].tag.command_velocity != 0.0;
+        if ((!moving && h_.settled()) || now - since_ > kStopTimeout) {
+          for (std::size_t a = 0; a < c.axis_count(); ++a) {
+            std::string ctl;
+            (void)h_.execute(fmt::format("MSF({}, canmotiond_msf_{})", c.axis_name(static_cast<motion::AxisId>(a)), a), &ctl);
+          }
+          phase_ = Phase::kDisabling;
+          since_ = now;
+        }
+        return false;
+      }
+      case Phase::kDisabling: {
+        bool enabled = false;
+        for (std::size_t a = 0; a < c.axis_count(); ++a)
+          enabled |= s.axes[a].drive_state == cia402::State::kOperationEnabled;
+        if ((!enabled && h_.settled()) || now - since_ > kDisableTimeout) {
+          rt::Command cmd;
+          cmd.kind = rt::Command::Kind::kPreOperational;
+          (void)c.submit(cmd);
+          phase_ = Phase::kPreOp;
+          since_ = now;
+        }
+        return false;
+      }
+      case Phase::kPreOp:
+        // The NMT frame goes out in the next cycle; end right after it, before
+        // the drives' missing TPDOs would be counted as lost.
+        if (now - since_ >= 2 * h_.controller().period_s()) phase_ = Phase::kDone;
+        return phase_ == Phase::kDone;
+      case Phase::kDone: return true;
+    }
+    return true;
+  }
+  static constexpr double kStopTimeout = 5.0;
+  static constexpr double kDisableTimeout = 2.0;
+
+ private:
+  rt::ControllerHost& h_;
+  Phase phase_ = Phase::kNone;
+  double since_ = 0;
+};
+
+void print_summary(const Options& o, config::Runtime& rt, rt::ControllerHost& host, const rt::CycleStats& st,
+                   double wall_s, bool real_time) {
+  const rt::Status& s = host.refresh();
+  rt::Controller& c = *rt.controller;
+  const double sim_s = static_cast<double>(s.cycle) * c.period_s();
+  fmt::print("summary: {} cycles, {:.3f} s of controller time in {:.3f} s wall ({:.0f}x real time)\n", s.cycle, sim_s,
+             wall_s, wall_s > 0 ? sim_s / wall_s : 0.0);
+  if (real_time)
+    fmt::print("summary: wake-up latency max {:.1f} us, p99 {:.1f} us; overruns {}\n", static_cast<double>(st.latency_max_ns) / 1e3,
+               static_cast<double>(st.latency_p99_ns) / 1e3, st.overruns);
+  for (std::size_t a = 0; a < c.axis_count(); ++a) {
+    const rt::AxisSnapshot& x = s.axes[a];
+    const auto& cfg = c.axis_spec(static_cast<motion::AxisId>(a)).config;
+    if (cfg.type == motion::AxisType::CipDrive)
+      fmt::print("summary: axis {:<10} node {:>3}  max following error {:.6f} {}  final position {:.4f}  TPDOs missed {}\n",
+                 c.axis_name(static_cast<motion::AxisId>(a)), c.axis_spec(static_cast<motion::AxisId>(a)).drive.node,
+                 x.max_abs_position_error, cfg.units_name, x.tag.actual_position, x.tpdo_missed);
+    else
+      fmt::print("summary: axis {:<10} virtual   final position {:.4f} {}\n", c.axis_name(static_cast<motion::AxisId>(a)),
+                 x.tag.command_position, cfg.units_name);
+  }
+  if (!o.trace.empty()) fmt::print("summary: trace (candump -L) written to {}\n", o.trace);
+  if (!o.csv.empty()) fmt::print("summary: CSV written to {}\n", o.csv);
+  if (s.trace_dropped || s.telemetry_dropped)
+    fmt::print("summary: WARNING: {} trace and {} CSV records were dropped (writer too slow)\n", s.trace_dropped,
+               s.telemetry_dropped);
+}
+
+void print_progress(rt::ControllerHost& host) {
+  const rt::Status& s = host.refresh();
+  rt::Controller& c = host.controller();
+  std::string line = fmt::format("t={:7.3f}", static_cast<double>(s.cycle) * c.period_s());
+  for (std::size_t a = 0; a < c.axis_count(); ++a)
+    line += fmt::format("  {}={:.3f}", c.axis_name(static_cast<motion::AxisId>(a)), s.axes[a].tag.actual_position);
+  fmt::print("{}\n", line);
+  std::fflush(stdout);
+}
+
+int run(const Options& o) {
+  // 1. Configuration: everything is validated before any bus is touched.
+  config::Config cfg;
+  try {
+    cfg = config::load_file(o.config);
+  } catch (const config::ConfigError& e) {
+    fmt::print(stderr, "{}\ncanmotiond: configuration has errors; nothing was sent on any bus\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "canmotiond: {}\n", e.what());
+    return 2;
+  }
+  for (const auto& w : cfg.warnings) fmt::print(stderr, "{}\n", w.str());
+
+  // 2. Buses and controller.
+  config::Runtime rt;
+  try {
+    rt = config::build_runtime(cfg, o.sim);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "canmotiond: {}\n", e.what());
+    return 1;
+  }
+  rt::Controller& ctl = *rt.controller;
+  rt::ControllerHost host(ctl);
+  const bool sim = rt.all_simulated();
+
+  // 3. Script, checked against the controller before anything runs.
+  std::optional<rt::script::Script> script;
+  if (!o.script.empty()) {
+    try {
+      script = rt::script::load_file(o.script, host);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "canmotiond: {}\n", e.what());
+      return 2;
+    }
+  }
+  std::unique_ptr<rt::script::Runner> runner;
+  if (script) runner = std::make_unique<rt::script::Runner>(*script, host, [](const std::string& l) {
+      fmt::print("{}\n", l);
+      std::fflush(stdout);
+    });
+
+  std::unique_ptr<Outputs> out;
+  try {
+    out = std::make_unique<Outputs>(o, rt, cfg);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "canmotiond: {}\n", e.what());
+    return 2;
+  }
+
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+
+  const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(std::llround(ctl.period_s() * 1e9)));
+  rt::ExecutiveConfig ec;
+  ec.period = period;
+  ec.rt = sim ? rt::RtSettings::none()
+              : rt::RtSettings{cfg.controller.lock_memory, cfg.controller.lock_memory ? 256u * 1024u : 0u,
+                               cfg.controller.priority, cfg.controller.cpu};
+  ec.warn = [](std::string_view w) { fmt::print(stderr, "canmotiond: WARNING: {}\n", w); };
+  rt::VirtualClock vclock;
+  rt::MonotonicClock mclock;
+  rt::Clock& clock = sim ? static_cast<rt::Clock&>(vclock) : static_cast<rt::Clock&>(mclock);
+  rt::CyclicExecutive exec(ec, clock);
+
+  fmt::print("canmotiond: {} axes, {} buses ({}), period {} ms{}\n", ctl.axis_count(), cfg.buses.size(),
+             sim ? "simulated, virtual time" : "real time", ctl.period_s() * 1e3,
+             script ? ", script " + o.script : std::string());
+  const auto wall0 = std::chrono::steady_clock::now();
+  Shutdown shutdown(host);
+  int status = 0;
+  const std::uint64_t per_second = static_cast<std::uint64_t>(std::llround(1.0 / ctl.period_s()));
+  std::uint64_t next_progress = per_second;
+  bool ended = false;
+
+  // The non-RT work of one step: outputs, script, progress, end of run.
+  auto housekeeping = [&](std::uint64_t cycle) -> bool {
+    const double now = static_cast<double>(cycle) * ctl.period_s();
+    out->drain(o.quiet);
+    if (runner && shutdown.phase() == Shutdown::Phase::kNone) {
+      const auto st = runner->step(now);
+      if (st == rt::script::Runner::Status::kFailed) {
+        fmt::print(stderr, "canmotiond: script failed: {}\n", runner->error());
+        status = 1;
+        shutdown.begin(now);
+      } else if (st == rt::script::Runner::Status::kDone && o.duration <= 0) {
+        shutdown.begin(now);
+      }
+    }
+    if (o.duration > 0 && now >= o.duration) shutdown.begin(now);
+    if (g_signal.load() != 0 && shutdown.phase() == Shutdown::Phase::kNone) {
+      fmt::print(stderr, "canmotiond: signal {}: stopping axes, disabling drives\n", g_signal.load());
+      shutdown.begin(now);
+    }
+    if (!o.quiet && cycle >= next_progress) {
+      next_progress += per_second;
+      print_progress(host);
+      if (o.stats && !sim) fmt::print("{}\n", rt::format_line(exec.statistics().snapshot()));
+    }
+    return shutdown.step(now);
+  };
+
+  if (rt.sim) rt.sim->power_on(0);
+  if (sim) {
+    // --sim: the same cycle code on a virtual clock, with the non-RT work
+    // inline between cycles so that runs are deterministic.
+    exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
+      const auto t = static_cast<std::int64_t>(info.cycle) * period.count();
+      rt.sim->begin_cycle(t);
+      ctl.cycle(t);
+      rt.sim->end_cycle(t);
+      try {
+        ended = housekeeping(info.cycle + 1);
+      } catch (...) {
+        ended = true;
+        status = 1;
+      }
+      return ended ? rt::CycleResult::stop : rt::CycleResult::run_on;
+    });
+    if (auto e = exec.run(); e) {
+      fmt::print(stderr, "canmotiond: cannot run the cycle: {}\n", e.message());
+      return 1;
+    }
+  } else {
+    exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
+      const std::int64_t t = info.wake.count();
+      if (rt.sim) rt.sim->begin_cycle(t);
+      ctl.cycle(t);
+      if (rt.sim) rt.sim->end_cycle(t);
+    });
+    if (auto e = exec.start(); e) {
+      fmt::print(stderr, "canmotiond: cannot start the cyclic thread: {}\n", e.message());
+      return 1;
+    }
+    rt::SdNotifier::ready();
+    std::unique_ptr<rt::WatchdogThread> wd;
+    if (auto iv = rt::SdNotifier::watchdog_interval()) {
+      wd = std::make_unique<rt::WatchdogThread>([&exec] { return exec.cycle_count(); }, *iv / 2);
+      wd->start();
+    }
+    while (!ended) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      ended = housekeeping(ctl.cycles());
+    }
+    rt::SdNotifier::stopping();
+    if (wd) wd->stop();
+    exec.stop();
+  }
+  out->drain(true);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (!o.quiet || o.stats) print_summary(o, rt, host, exec.statistics().snapshot(), wall, !sim);
+  if (o.stats) fmt::print("{}\n", rt::format_summary(exec.statistics().snapshot()));
+  if (runner && runner->status() == rt::script::Runner::Status::kRunning && status == 0) {
+    fmt::print(stderr, "canmotiond: the run ended before the script did (statement {} of {})\n",
+               runner->position() + 1, script->statements.size());
+    status = 1;
+  }
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{
+      "canmotiond: the canmotion real-time servo master. Runs Logix motion instructions on a cyclic thread and "
+      "drives CiA 402 servo drives over CANopen (SocketCAN), or simulated drives with --sim.",
+      "canmotiond"};
+  app.add_option("-c,--config", o.config, "configuration file (YAML)")->required()->check(CLI::ExistingFile);
+  app.add_flag("--sim", o.sim,
+               "simulate every bus in process with an emulated CiA 402 drive per AXIS_CIP_DRIVE node; virtual "
+               "time, as fast as possible, deterministic");
+  app.add_option("--duration", o.duration, "stop after this many seconds of controller time (default: when the "
+                                           "script ends, or on SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--script", o.script, "motion script to run (see README: Motion scripts)")->check(CLI::ExistingFile);
+  app.add_option("--trace", o.trace, "write every frame on every bus to FILE in candump -L format");
+  app.add_option("--csv", o.csv, "write one row per axis per cycle to FILE");
+  app.add_flag("--stats", o.stats, "print cycle statistics once a second and at the end");
+  app.add_option("--socket", o.socket, "UNIX socket for canmotionctl");
+  app.add_flag("-q,--quiet", o.quiet, "no progress lines or summary");
+  app.footer(
+      "Examples:\n"
+      "  canmotiond --config config/examples/demo.yaml --sim --script config/examples/demo.script\n"
+      "  canmotiond --config /etc/canmotion/canmotiond.yaml --stats\n"
+      "Exit status: 0 ok, 1 run-time failure (script failed, bus error), 2 bad configuration or arguments.");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (!o.socket.empty()) {
+    fmt::print(stderr, "canmotiond: --socket is not available in this build yet\n");
+    return 2;
+  }
+  return run(o);
+}
