@@ -327,7 +327,14 @@ Err Planner::execute(const Request& r) noexcept {
   if (e != Err::None) {
     c.reject(e, exerr);
   }
-  for (std::size_t i = 0; i < axis_count_; ++i) update_status(axes_[i]);
+  // refresh the tags of the axes this request named (all axes for group instructions)
+  const auto ops = sig.operands;
+  for (std::size_t i = 0; i < ops.size() && i < r.count; ++i) {
+    if (ops[i].kind == OperandKind::Axis && r.op[i].ref < kMaxAxes && axes_[r.op[i].ref].present)
+      update_status(axes_[r.op[i].ref]);
+    if (ops[i].kind == OperandKind::Group)
+      for (std::size_t k = 0; k < axis_count_; ++k) if (axes_[k].present) update_status(axes_[k]);
+  }
   return e;
 }
 
