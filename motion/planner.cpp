@@ -744,6 +744,7 @@ Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   bool ok;
   Limits l = lim;
   l.v = V > 0 ? V : 1.0;
+  if (!g->scurve) g->k.a = 0.0;  // trapezoidal motion steps its acceleration
   if (jog) {
     ok = plan_velocity(prof, g->k, (g->jog_velocity < 0 ? -1.0 : 1.0) * V, l);
   } else if (V > 0) {
