@@ -744,9 +744,10 @@ Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   bool ok;
   Limits l = lim;
   l.v = V > 0 ? V : 1.0;
-  if (!g->scurve) g->k.a = 0.0;  // trapezoidal motion steps its acceleration
+  Kin from = g->k;
+  if (!g->scurve) from.a = 0.0;  // trapezoidal motion steps its acceleration
   if (jog) {
-    ok = plan_velocity(prof, g->k, (g->jog_velocity < 0 ? -1.0 : 1.0) * V, l);
+    ok = plan_velocity(prof, from, (g->jog_velocity < 0 ? -1.0 : 1.0) * V, l);
   } else if (V > 0) {
     // Limits dropped mid-move: stop exactly on target, never past it (README).
     // Unless the move was already going to pass the target with its old
@@ -758,9 +759,9 @@ Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
       const double stop = probe.end_position() - g->k.p;
       if ((rem >= 0 && stop > rem) || (rem < 0 && stop < rem) || g->k.v * rem < 0) policy = Overshoot::Reverse;
     }
-    ok = plan_move(prof, g->k, g->total - g->k.p, l, policy);
+    ok = plan_move(prof, from, g->total - g->k.p, l, policy);
   } else {
-    ok = plan_velocity(prof, g->k, 0.0, l);  // speed 0: pause
+    ok = plan_velocity(prof, from, 0.0, l);  // speed 0: pause
   }
   if (!ok) { exerr = static_cast<std::int8_t>(I.mcd_speed); return Err::ParameterOutOfRange; }
   g->prof = prof;
