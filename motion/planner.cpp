@@ -170,6 +170,12 @@ Kin Planner::slot_kin(const AxisRt& a, Slot s) const noexcept {
 
 double Planner::user_command(const AxisRt& a) const noexcept { return a.cmd.p + a.frame_offset; }
 
+bool Planner::any_scurve(const AxisRt& a) const noexcept {
+  for (const auto& g : a.gen)
+    if (auto* p = std::get_if<ProfileGen>(&g); p && p->scurve) return true;
+  return false;
+}
+
 bool Planner::any_stopping(const AxisRt& a) const noexcept {
   for (const auto& g : a.gen)
     if (auto* p = std::get_if<ProfileGen>(&g); p && p->role == GenRole::Stop) return true;
@@ -327,7 +333,14 @@ Err Planner::execute(const Request& r) noexcept {
   if (e != Err::None) {
     c.reject(e, exerr);
   }
-  for (std::size_t i = 0; i < axis_count_; ++i) update_status(axes_[i]);
+  // refresh the tags of the axes this request named (all axes for group instructions)
+  const auto ops = sig.operands;
+  for (std::size_t i = 0; i < ops.size() && i < r.count; ++i) {
+    if (ops[i].kind == OperandKind::Axis && r.op[i].ref < kMaxAxes && axes_[r.op[i].ref].present)
+      update_status(axes_[r.op[i].ref]);
+    if (ops[i].kind == OperandKind::Group)
+      for (std::size_t k = 0; k < axis_count_; ++k) if (axes_[k].present) update_status(axes_[k]);
+  }
   return e;
 }
 
@@ -518,8 +531,8 @@ Err Planner::start_maj(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   if (dir < 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitNegative & 1u)) return Err::OvertravelCondition;
   Kin start{};
   auto* old = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Jog)]);
-  if (dy.merge) start = Kin{0, a.cmd.v, a.cmd.a};
-  else if (old) start = Kin{0, old->k.v, old->k.a};
+  if (dy.merge) start = Kin{0, a.cmd.v, any_scurve(a) ? a.cmd.a : 0.0};
+  else if (old) start = Kin{0, old->k.v, old->scurve ? old->k.a : 0.0};
   double V = dy.speed;
   if (dy.merge && dy.merge_current && std::fabs(start.v) > 0) V = std::fabs(start.v);
   if (dy.scurve && dy.jerk_units == 2) {
@@ -576,9 +589,11 @@ Err Planner::start_mam(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   }
   auto* old = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Move)]);
   if (old && old->role != GenRole::Move) old = nullptr;
+  // The new profile continues the acceleration of S-curve motion; trapezoidal
+  // motion steps its acceleration anyway, so it hands over with a = 0.
   Kin start{};
-  if (dy.merge) start = Kin{0, a.cmd.v, a.cmd.a};
-  else if (old) start = Kin{0, old->k.v, old->k.a};
+  if (dy.merge) start = Kin{0, a.cmd.v, any_scurve(a) ? a.cmd.a : 0.0};
+  else if (old) start = Kin{0, old->k.v, old->scurve ? old->k.a : 0.0};
   if (dy.seconds && (a.cmd.v != 0 || a.cmd.a != 0)) return Err::AxisNotAtRest;
   // distance
   const double cur = user_command(a);
@@ -729,13 +744,24 @@ Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   bool ok;
   Limits l = lim;
   l.v = V > 0 ? V : 1.0;
+  Kin from = g->k;
+  if (!g->scurve) from.a = 0.0;  // trapezoidal motion steps its acceleration
   if (jog) {
-    ok = plan_velocity(prof, g->k, (g->jog_velocity < 0 ? -1.0 : 1.0) * V, l);
+    ok = plan_velocity(prof, from, (g->jog_velocity < 0 ? -1.0 : 1.0) * V, l);
   } else if (V > 0) {
     // Limits dropped mid-move: stop exactly on target, never past it (README).
-    ok = plan_move(prof, g->k, g->total - g->k.p, l, Overshoot::StopAtTarget);
+    // Unless the move was already going to pass the target with its old
+    // limits (a merge from motion away from it): then it keeps reversing.
+    Overshoot policy = Overshoot::StopAtTarget;
+    Profile probe;
+    if (plan_stop(probe, g->k, g->lim.d, g->lim.jd)) {
+      const double rem = g->total - g->k.p;
+      const double stop = probe.end_position() - g->k.p;
+      if ((rem >= 0 && stop > rem) || (rem < 0 && stop < rem) || g->k.v * rem < 0) policy = Overshoot::Reverse;
+    }
+    ok = plan_move(prof, from, g->total - g->k.p, l, policy);
   } else {
-    ok = plan_velocity(prof, g->k, 0.0, l);  // speed 0: pause
+    ok = plan_velocity(prof, from, 0.0, l);  // speed 0: pause
   }
   if (!ok) { exerr = static_cast<std::int8_t>(I.mcd_speed); return Err::ParameterOutOfRange; }
   g->prof = prof;

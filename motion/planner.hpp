@@ -243,6 +243,7 @@ class Planner {
   double user_command(const AxisRt& a) const noexcept;
   ControlTag* owner_tag(ControlId id, std::uint32_t gen) noexcept;
   bool any_stopping(const AxisRt& a) const noexcept;
+  bool any_scurve(const AxisRt& a) const noexcept;
 
   double T_;
   std::uint64_t cycle_ = 0;

@@ -273,6 +273,34 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
     }
     if (vs_up <= V) {
       const double vlo = std::max(vs_up, 0.0);
+      // Closed form from zero acceleration when both ramps have a constant-
+      // acceleration phase (quadratic in vp) or, from rest, when both are
+      // triangular (vp^3/2); other shapes use the bounded solve below.
+      if (arel == 0 && vrel >= 0) {
+        const double v0 = vrel, A = lim.a, D = lim.d;
+        const double ia = std::isinf(lim.ja) ? 0.0 : 1.0 / lim.ja, id = std::isinf(lim.jd) ? 0.0 : 1.0 / lim.jd;
+        double vp = -1;
+        {  // both trapezoidal
+          const double qa = 1 / (2 * A) + 1 / (2 * D), qb = A * ia / 2 + D * id / 2;
+          const double qc = -v0 * v0 / (2 * A) + v0 * A * ia / 2 - Rabs;
+          const double disc = qb * qb - 4 * qa * qc;
+          if (disc >= 0) {
+            const double x = (-qb + std::sqrt(disc)) / (2 * qa);
+            if (x - v0 >= A * A * ia && x >= D * D * id && x >= vlo && x <= V) vp = x;
+          }
+        }
+        if (vp < 0 && v0 == 0 && ia > 0 && id > 0) {  // both triangular, from rest
+          const double x = std::cbrt(std::pow(Rabs / (std::sqrt(ia) + std::sqrt(id)), 2.0));
+          if (x < A * A * ia && x < D * D * id && x <= V) vp = x;
+        }
+        if (vp > 0) {
+          const double fvp = f(vp);
+          if (std::fabs(fvp - Rabs) <= 1e-9 * std::max(Rabs, 1e-300)) {
+            build(vp, fvp);
+            break;
+          }
+        }
+      }
       const double flo = f(vlo);
       if (flo <= Rabs) {
         double lo = vlo, hi = V, flo_v = flo;

@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <sys/mman.h>
 
+#include <unistd.h>
+
 #include <cerrno>
 
 namespace canmotion::rt {
@@ -72,6 +74,13 @@ std::string cpu_list(const cpu_set_t& set) {
     }
   }
   return out;
+}
+
+/// Path of the running program for the setcap example (falls back to canmotiond).
+std::string self_path() {
+  char buf[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string("/usr/local/bin/canmotiond");
 }
 
 std::string limit_text(long long v) {
@@ -205,9 +214,9 @@ std::string RtSetupReport::warning() const {
   return fmt::format(
       "real-time set-up incomplete, the engine runs WITHOUT real-time guarantees: {}. "
       "To grant it: run as root, or give the program {} (e.g. setcap "
-      "cap_sys_nice,cap_ipc_lock+ep /usr/local/bin/canmotiond), or under systemd set {}"
+      "cap_sys_nice,cap_ipc_lock+ep {}), or under systemd set {}"
       "(see systemd/canmotiond.service), or add {}to /etc/security/limits.conf and log in again.",
-      lost, caps, limits, conf);
+      lost, caps, self_path(), limits, conf);
 }
 
 std::string RtSetupReport::describe() const {

@@ -56,7 +56,9 @@ CycleWatchdog::Verdict CycleWatchdog::check(std::uint64_t cycle_count) noexcept 
 }
 
 WatchdogThread::WatchdogThread(Progress progress, Nanos check_every, Send send)
-    : progress_(std::move(progress)), check_every_(check_every), send_(std::move(send)) {
+    : progress_(std::move(progress)),
+      check_every_(check_every.count() > 0 ? check_every : Nanos{1'000'000}),
+      send_(std::move(send)) {
   if (!send_) {
     send_ = [](std::string_view s) { return SdNotifier::notify(s); };
   }

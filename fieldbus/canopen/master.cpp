@@ -91,7 +91,7 @@ void Master::set_heartbeat_timeout(std::uint8_t node, std::int64_t timeout_ns, s
   if (st.last_heartbeat_ns < now_ns) st.last_heartbeat_ns = now_ns;  // the timer starts now
 }
 
-void Master::step(std::int64_t now_ns, FrameSink& out) noexcept {
+void Master::step_timers(std::int64_t now_ns, FrameSink& out) noexcept {
   if (cfg_.heartbeat_period_ms > 0) {
     if (!heartbeat_started_ || now_ns >= next_heartbeat_ns_) {
       // The master is always operational while it runs the cycle.
@@ -108,6 +108,9 @@ void Master::step(std::int64_t now_ns, FrameSink& out) noexcept {
       push(NodeEvent{NodeEvent::Kind::kHeartbeatLost, st.node, st.state, {}, now_ns});
     }
   }
+}
+
+void Master::step_sdo(std::int64_t now_ns, FrameSink& out) noexcept {
   for (auto& c : sdo_) c->step(now_ns, out);
 }
 

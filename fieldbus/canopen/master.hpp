@@ -83,8 +83,16 @@ class Master {
   /// registered nodes are consumed; returns true if the frame was one of
   /// those (PDOs and unknown frames return false).
   bool on_frame(const can::TimedFrame& f) noexcept;
-  /// Heartbeat production, heartbeat consumer timeouts, SDO clients.
-  void step(std::int64_t now_ns, FrameSink& out) noexcept;
+  /// Heartbeat production, heartbeat consumer timeouts, SDO clients
+  /// (step_timers() then step_sdo()).
+  void step(std::int64_t now_ns, FrameSink& out) noexcept {
+    step_timers(now_ns, out);
+    step_sdo(now_ns, out);
+  }
+  /// Heartbeat production and heartbeat consumer timeouts only.
+  void step_timers(std::int64_t now_ns, FrameSink& out) noexcept;
+  /// Step every SDO client (start queued transfers, timeouts).
+  void step_sdo(std::int64_t now_ns, FrameSink& out) noexcept;
   /// Send one SYNC (with the counter if configured). Call once per cycle,
   /// after the RPDOs.
   void send_sync(FrameSink& out) noexcept;

@@ -468,7 +468,13 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
     phase_since_ns_ = now_ns;
   }
   if (phase_ != Phase::kOperational) {
-    step_boot(now_ns, out);
+    // Several boot phases may complete in one cycle (boot-up seen ->
+    // configuring queues its first writes at once).
+    for (int i = 0; i < 3 && phase_ != Phase::kOperational && phase_ != Phase::kFailed; ++i) {
+      const Phase before = phase_;
+      step_boot(now_ns, out);
+      if (phase_ == before) break;
+    }
     if (phase_ != Phase::kOperational) return;
   }
   // Missed TPDO accounting: a SYNC went out last cycle and TPDO1 did not come.
@@ -510,7 +516,7 @@ void DriveNetwork::on_frame(const can::TimedFrame& f) noexcept {
 }
 
 void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
-  master_.step(now_ns, out);
+  master_.step_timers(now_ns, out);
   canopen::NodeEvent e;
   while (master_.poll_event(e)) {
     if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
@@ -520,6 +526,8 @@ void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept 
     }
   }
   for (auto& d : drives_) d->step(now_ns, out);
+  // After the proxies so that what they queued this cycle goes out now.
+  master_.step_sdo(now_ns, out);
   master_.send_sync(out);
   for (auto& d : drives_) d->on_sync_sent();
 }

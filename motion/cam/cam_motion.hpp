@@ -44,6 +44,22 @@ struct CamScaling {
 [[nodiscard]] CamSample evaluate_scaled(const CamProfile& profile, double x, const CamScaling& scaling,
                                         CamCursor& cursor, EndBehaviour end = EndBehaviour::Clamp) noexcept;
 
+/// Resolves the MATC/MAPC Direction operand (0 Same, 1 Opposite, 2 Reverse,
+/// 3 Unchanged) into +1 / -1 [seed 004 Direction; reference §1.3].
+/// `previous` is the axis' current or previous camming direction (+1 / -1),
+/// or 0 when the axis has never cammed: then Reverse defaults to Opposite
+/// (-1) and Unchanged to Same (+1). Returns 0 for a value outside 0..3 (the
+/// caller reports ERR 13 with the Direction operand index). Realtime-safe.
+[[nodiscard]] constexpr int resolve_direction(std::int32_t direction, int previous) noexcept {
+  switch (direction) {
+    case 0: return 1;
+    case 1: return -1;
+    case 2: return previous == 0 ? -1 : -previous;
+    case 3: return previous == 0 ? 1 : previous;
+    default: return 0;
+  }
+}
+
 /// Where the driving coordinate is relative to the profile's master range.
 enum class CamRange : std::uint8_t {
   Inside = 0,       ///< inside [master_start, master_end]

@@ -14,7 +14,7 @@ CamProfile::CamProfile(std::size_t capacity) {
   }
   elems_.resize(capacity);
   masters_.assign(capacity, 0.0);
-  scratch_.assign(4 * capacity, 0.0);
+  scratch_.assign(6 * capacity, 0.0);
 }
 
 CamError CamProfile::acquire() noexcept {
@@ -198,10 +198,6 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
     el[i].slave = pts[i].slave;
     el[i].type = i + 1 < n ? pts[i].segment_type : kSegmentLinear;
   }
-  auto cubic = [&](std::size_t seg) { return seg + 1 < n && el[seg].type == kSegmentCubic; };
-  auto h = [&](std::size_t seg) { return el[seg + 1].master - el[seg].master; };
-  auto d = [&](std::size_t seg) { return (el[seg + 1].slave - el[seg].slave) / h(seg); };
-
   // Knot slopes m_k from a tridiagonal system (see README "Spline rule"):
   //  * knot between two cubic segments: C2 row
   //      m_{k-1}/h_{k-1} + 2 (1/h_{k-1} + 1/h_k) m_k + m_{k+1}/h_k
@@ -213,59 +209,69 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
   const auto nn = static_cast<Eigen::Index>(n);
   double* scratch = profile.scratch_.data();
   const std::size_t cap = profile.capacity();
-  Eigen::Map<Eigen::VectorXd> lo(scratch, nn);
-  Eigen::Map<Eigen::VectorXd> di(scratch + cap, nn);
-  Eigen::Map<Eigen::VectorXd> up(scratch + 2 * cap, nn);
-  Eigen::Map<Eigen::VectorXd> r(scratch + 3 * cap, nn);
-  for (std::size_t k = 0; k < n; ++k) {
-    const auto ik = static_cast<Eigen::Index>(k);
+  Eigen::Map<Eigen::VectorXd> lo(scratch, nn);            // sub-diagonal
+  Eigen::Map<Eigen::VectorXd> di(scratch + cap, nn);      // diagonal (then its inverse)
+  Eigen::Map<Eigen::VectorXd> up(scratch + 2 * cap, nn);  // super-diagonal
+  Eigen::Map<Eigen::VectorXd> r(scratch + 3 * cap, nn);   // right-hand side, then m_k
+  Eigen::Map<Eigen::VectorXd> ih(scratch + 4 * cap, nn);  // 1 / h_s per segment
+  Eigen::Map<Eigen::VectorXd> dd(scratch + 5 * cap, nn);  // chord slope d_s per segment
+  for (Eigen::Index s = 0; s + 1 < nn; ++s) {
+    const auto i = static_cast<std::size_t>(s);
+    const double hs = el[i + 1].master - el[i].master;
+    ih[s] = 1.0 / hs;
+    dd[s] = (el[i + 1].slave - el[i].slave) / hs;
+  }
+  auto cubic = [&](Eigen::Index seg) { return seg + 1 < nn && el[static_cast<std::size_t>(seg)].type == kSegmentCubic; };
+  for (Eigen::Index k = 0; k < nn; ++k) {
     const bool left = k > 0 && cubic(k - 1);
     const bool right = cubic(k);
-    lo[ik] = 0.0;
-    up[ik] = 0.0;
-    di[ik] = 1.0;
+    lo[k] = 0.0;
+    up[k] = 0.0;
+    di[k] = 1.0;
     if (left && right) {
-      const double il = 1.0 / h(k - 1);
-      const double ir = 1.0 / h(k);
-      lo[ik] = il;
-      di[ik] = 2.0 * (il + ir);
-      up[ik] = ir;
-      r[ik] = 3.0 * (d(k - 1) * il + d(k) * ir);
+      const double il = ih[k - 1];
+      const double ir = ih[k];
+      lo[k] = il;
+      di[k] = 2.0 * (il + ir);
+      up[k] = ir;
+      r[k] = 3.0 * (dd[k - 1] * il + dd[k] * ir);
     } else if (right) {
-      r[ik] = k == 0 ? req.start_slope : d(k - 1);
+      r[k] = k == 0 ? req.start_slope : dd[k - 1];
     } else if (left) {
-      r[ik] = k + 1 == n ? req.end_slope : d(k);
+      r[k] = k + 1 == nn ? req.end_slope : dd[k];
     } else {
-      r[ik] = 0.0;
+      r[k] = 0.0;
     }
   }
   // Banded (tridiagonal) LU without pivoting, in place on the Eigen vectors.
   // The matrix is strictly diagonally dominant (C2 rows: 2(a+b) > a+b; other
   // rows are identity rows), so no pivoting is needed and the solve is stable.
   // Eigen offers no allocation-free banded solver, so the two sweeps are here.
+  // di[k] is replaced by its inverse once row k is final (one division per row).
   for (Eigen::Index k = 1; k < nn; ++k) {
-    const double w = lo[k] / di[k - 1];
+    di[k - 1] = 1.0 / di[k - 1];
+    const double w = lo[k] * di[k - 1];
     di[k] -= w * up[k - 1];
     r[k] -= w * r[k - 1];
   }
-  r[nn - 1] /= di[nn - 1];
+  di[nn - 1] = 1.0 / di[nn - 1];
+  r[nn - 1] *= di[nn - 1];
   for (Eigen::Index k = nn - 2; k >= 0; --k) {
-    r[k] = (r[k] - up[k] * r[k + 1]) / di[k];
+    r[k] = (r[k] - up[k] * r[k + 1]) * di[k];
   }
 
-  for (std::size_t s = 0; s + 1 < n; ++s) {
-    CamProfileElement& e = el[s];
+  for (Eigen::Index s = 0; s + 1 < nn; ++s) {
+    CamProfileElement& e = el[static_cast<std::size_t>(s)];
     e.a0 = e.slave;
+    const double ds = dd[s];
     if (e.type == kSegmentCubic) {
-      const double hs = h(s);
-      const double ds = d(s);
-      const double m0 = r[static_cast<Eigen::Index>(s)];
-      const double m1 = r[static_cast<Eigen::Index>(s + 1)];
+      const double m0 = r[s];
+      const double m1 = r[s + 1];
       e.a1 = m0;
-      e.a2 = (3.0 * ds - 2.0 * m0 - m1) / hs;
-      e.a3 = (m0 + m1 - 2.0 * ds) / (hs * hs);
+      e.a2 = (3.0 * ds - 2.0 * m0 - m1) * ih[s];
+      e.a3 = (m0 + m1 - 2.0 * ds) * (ih[s] * ih[s]);
     } else {
-      e.a1 = d(s);
+      e.a1 = ds;
       e.a2 = 0.0;
       e.a3 = 0.0;
     }

@@ -125,7 +125,7 @@ struct MccpRequest {
 /// the controller runs; the config loader before). Status is a plain int.
 class CamProfile {
  public:
-  /// Hard upper bound on the capacity of one profile (16 Mi points, ~1.4 GiB
+  /// Hard upper bound on the capacity of one profile (16 Mi points, ~1.9 GiB
   /// with scratch): a guard against absurd configuration values, not a
   /// Logix limit. Size profiles to the largest cam they will receive.
   static constexpr std::size_t kMaxCapacity = std::size_t{1} << 24;
@@ -212,8 +212,9 @@ class CamProfile {
   // profile's search array (80 KB) stays in L2.
   std::vector<double> masters_;
   std::size_t count_ = 0;                 // points of the last successful MCCP
-  // Tridiagonal spline system scratch, 4 * capacity doubles: sub-, main and
-  // super-diagonal, right-hand side / solution, seen by MCCP as Eigen::Map
+  // Tridiagonal spline system scratch, 6 * capacity doubles: sub-, main and
+  // super-diagonal, right-hand side / solution, 1/h and chord slope per
+  // segment, seen by MCCP as Eigen::Map
   // vectors. Kept in a std::vector so every allocation goes through operator
   // new (the RT allocation test counts it).
   std::vector<double> scratch_;

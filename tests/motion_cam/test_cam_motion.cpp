@@ -197,6 +197,23 @@ TEST(CamOnce, NonFiniteCoordinateHoldsTheLastOutput) {
   EXPECT_DOUBLE_EQ(cm.step(2.75).position, 8.25);
 }
 
+TEST(CamDirection, SameOppositeReverseUnchangedWithFirstUseDefaults) {
+  // First execution (no previous direction): Reverse -> Opposite, Unchanged -> Same.
+  EXPECT_EQ(resolve_direction(0, 0), 1);
+  EXPECT_EQ(resolve_direction(1, 0), -1);
+  EXPECT_EQ(resolve_direction(2, 0), -1);
+  EXPECT_EQ(resolve_direction(3, 0), 1);
+  // Relative to the current direction.
+  EXPECT_EQ(resolve_direction(2, 1), -1);
+  EXPECT_EQ(resolve_direction(2, -1), 1);
+  EXPECT_EQ(resolve_direction(3, -1), -1);
+  EXPECT_EQ(resolve_direction(3, 1), 1);
+  EXPECT_EQ(resolve_direction(0, -1), 1);
+  EXPECT_EQ(resolve_direction(1, 1), -1);
+  EXPECT_EQ(resolve_direction(4, 1), 0);
+  EXPECT_EQ(resolve_direction(-1, 0), 0);
+}
+
 TEST(CamPersistent, UnlocksOutsideAndRelocksInside) {
   CamProfile p(3);
   calc({{0, 0, L}, {1, 1, L}, {2, 1, L}}, p);

@@ -297,6 +297,52 @@ TEST(CamProperty, CursorLookupMatchesBinarySearch) {
   }
 }
 
+// Velocity and acceleration outputs are the derivatives of the position
+// output: central differences inside a segment agree (h = 1e-5 of the
+// segment, tolerance from the truncation error of the difference).
+TEST(CamProperty, VelocityAndAccelerationAreDerivativesOfPosition) {
+  const auto seed = cam_test::seed() + 5;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<std::size_t> npts(2, 40);
+  std::uniform_real_distribution<double> slope(-10.0, 10.0);
+  std::uniform_real_distribution<double> frac(0.1, 0.9);
+  CamProfile p(40);
+  for (int c = 0; c < cam_test::count(300); ++c) {
+    SCOPED_TRACE(cam_test::repro(c));
+    const auto cam = cam_test::random_cam(rng, npts(rng), cam_test::Mix::Mixed);
+    ASSERT_TRUE(calc(cam, p, slope(rng), slope(rng)).ok());
+    for (std::size_t k = 0; k + 1 < cam.size(); ++k) {
+      const double hk = cam[k + 1].master - cam[k].master;
+      const double x = cam[k].master + frac(rng) * hk;
+      const double dx = 1e-5 * hk;
+      const CamSample a = p.evaluate(x - dx), m = p.evaluate(x), b = p.evaluate(x + dx);
+      const double fd_v = (b.position - a.position) / (2 * dx);
+      const double fd_a = (b.velocity - a.velocity) / (2 * dx);
+      const double scale_v = 1 + std::abs(m.velocity) + std::abs(m.position) / hk;
+      const double scale_a = 1 + std::abs(m.acceleration) + std::abs(m.velocity) / hk;
+      EXPECT_NEAR(fd_v, m.velocity, 1e-5 * scale_v) << "segment " << k;
+      EXPECT_NEAR(fd_a, m.acceleration, 1e-5 * scale_a) << "segment " << k;
+    }
+  }
+}
+
+// A shorter recalculation into a bigger profile exposes only the new points.
+TEST(CamProfileReuse, RecalculationWithFewerPointsForgetsTheOldTail) {
+  CamProfile p(10);
+  ASSERT_TRUE(calc({{0, 0, L}, {1, 1, L}, {2, 2, L}, {3, 9, L}}, p).ok());
+  EXPECT_EQ(p.point_count(), 4u);
+  ASSERT_TRUE(calc({{0, 0, C}, {1, 1, L}}, p, 0.0, 0.0).ok());
+  EXPECT_EQ(p.point_count(), 2u);
+  EXPECT_EQ(p.segment_count(), 1u);
+  EXPECT_EQ(p.elements().size(), 2u);
+  EXPECT_EQ(p.master_end(), 1.0);
+  EXPECT_EQ(p.slave_end(), 1.0);
+  EXPECT_EQ(p.evaluate(2.5).position, 1.0) << "clamped at the new end, not the old point (3, 9)";
+  CamCursor cur{3};  // a stale cursor from the longer profile is safe
+  EXPECT_NEAR(p.evaluate(0.5, cur).position, 0.5, 1e-15);
+  EXPECT_EQ(cur.segment, 0u);
+}
+
 // ---- ends ------------------------------------------------------------------
 
 TEST(CamEvaluate, ClampAndExtrapolateOutsideTheRange) {

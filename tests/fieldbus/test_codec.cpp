@@ -1,0 +1,418 @@
+// Golden bytes of every frame kind the master and the emulator send, the
+// CiA 402 state table transition by transition, PDO packing, bus budget and
+// the SimBus.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <random>
+
+#include "fieldbus/can/sim_bus.hpp"
+#include "fieldbus/canopen/bus_budget.hpp"
+#include "fieldbus/canopen/master.hpp"
+#include "fieldbus/canopen/pdo.hpp"
+#include "fieldbus/cia402/cia402.hpp"
+#include "fieldbus/cia402/drive_proxy.hpp"
+#include "fieldbus/emulator/emulator.hpp"
+#include "test_support.hpp"
+
+using namespace canmotion;
+using cia402::Command;
+using cia402::State;
+using fbtest::frame;
+using fbtest::hex;
+using fbtest::VecSink;
+
+namespace {
+std::uint64_t test_seed() {
+  if (const char* s = std::getenv("CANMOTION_SEED")) return std::strtoull(s, nullptr, 0);
+  return std::random_device{}();
+}
+int test_count(int dflt) {
+  if (const char* s = std::getenv("CANMOTION_PROP_COUNT")) return std::atoi(s);
+  return dflt;
+}
+}  // namespace
+
+// ---- master frames -------------------------------------------------------------
+TEST(Golden, MasterNmtSyncHeartbeat) {
+  canopen::MasterConfig mc;
+  mc.node_id = 127;
+  mc.heartbeat_period_ms = 100;
+  canopen::Master m(mc);
+  ASSERT_TRUE(m.add_node(2));
+  VecSink out;
+  m.send_nmt(canopen::NmtCommand::kStart, 2, out);
+  m.send_nmt(canopen::NmtCommand::kStop, 2, out);
+  m.send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, out);
+  m.send_nmt(canopen::NmtCommand::kResetNode, 2, out);
+  m.send_nmt(canopen::NmtCommand::kResetCommunication, 2, out);
+  m.send_sync(out);
+  m.step(0, out);              // heartbeat at start
+  m.step(99'000'000, out);     // not yet
+  m.step(100'000'000, out);    // period reached
+  std::vector<std::string> got;
+  for (auto& f : out.frames) got.push_back(hex(f));
+  const std::vector<std::string> expected = {"000#0102", "000#0202", "000#8000", "000#8102",
+                                             "000#8202", "080#",     "77F#05",   "77F#05"};
+  EXPECT_EQ(got, expected);
+}
+
+TEST(Golden, SyncCounterWraps) {
+  canopen::MasterConfig mc;
+  mc.sync_counter_overflow = 3;
+  mc.heartbeat_period_ms = 0;
+  canopen::Master m(mc);
+  VecSink out;
+  for (int i = 0; i < 4; ++i) m.send_sync(out);
+  std::vector<std::string> got;
+  for (auto& f : out.frames) got.push_back(hex(f));
+  EXPECT_EQ(got, (std::vector<std::string>{"080#01", "080#02", "080#03", "080#01"}));
+}
+
+TEST(Golden, MasterRpdosAndBootConfiguration) {
+  cia402::NetworkConfig nc;
+  cia402::DriveNetwork net(nc);
+  cia402::DriveConfig dc;
+  dc.node = 2;
+  dc.pdo_profile = cia402::PdoProfile::kCspCsvCst;
+  auto& d = net.add_drive(dc);
+  // Boot-up seen: the proxy starts configuring.
+  net.on_frame(can::TimedFrame{frame("702#00"), 0});
+  VecSink out;
+  net.cycle(1'000'000, out);  // boot-up seen: configuration starts with 0x6060 = 8
+  std::vector<std::string> got;
+  for (auto& f : out.frames) got.push_back(hex(f));
+  EXPECT_EQ(got, (std::vector<std::string>{"77F#05", "602#2F60600008000000", "080#"}));
+  EXPECT_EQ(d.phase(), cia402::Phase::kConfiguring);
+  // RPDO packing: controlword + target position; target velocity + torque + mode.
+  const auto& pdos = d.pdos();
+  ASSERT_EQ(pdos.rpdo_count, 2);
+  EXPECT_EQ(pdos.rpdo[0].size_bytes, 6);
+  EXPECT_EQ(pdos.rpdo[1].size_bytes, 7);
+  EXPECT_EQ(pdos.tpdo[1].entries[2].raw(), 0x60610008u);
+}
+
+TEST(Golden, ProxyRpdoAndTpdoBytes) {
+  cia402::DriveNetwork net;
+  cia402::DriveConfig dc;
+  dc.node = 3;
+  dc.producer_heartbeat_ms = 0;
+  dc.consumer_heartbeat_ms = 0;
+  auto& d = net.add_drive(dc);
+  net.on_frame(can::TimedFrame{frame("703#00"), 0});
+  VecSink out;
+  // Answer every SDO write until NMT start goes out.
+  for (int i = 1; i < 200 && d.phase() != cia402::Phase::kStarting; ++i) {
+    out.clear();
+    net.cycle(i * 1'000'000, out);
+    for (auto& f : out.frames)
+      if (f.id == 0x603) {
+        can::Frame r = frame("583#6000000000000000");
+        r.data[1] = f.data[1], r.data[2] = f.data[2], r.data[3] = f.data[3];
+        net.on_frame(can::TimedFrame{r, i * 1'000'000});
+      }
+  }
+  ASSERT_EQ(d.phase(), cia402::Phase::kStarting) << cia402::phase_name(d.phase());
+  EXPECT_EQ(hex(out.frames[out.frames.size() - 2]), "000#0103");  // NMT start, then SYNC
+  // TPDO1: statusword 0x0231 (Ready to switch on), position -2.
+  net.on_frame(can::TimedFrame{frame("183#3102FEFFFFFF"), 300'000'000});
+  out.clear();
+  net.cycle(301'000'000, out);
+  EXPECT_EQ(d.phase(), cia402::Phase::kOperational);
+  EXPECT_EQ(d.feedback().position, -2);
+  EXPECT_EQ(d.state(), State::kReadyToSwitchOn);
+  auto rpdo = [&] {
+    for (auto& f : out.frames)
+      if (f.id == 0x203) return hex(f);
+    return std::string("none");
+  };
+  // Disabled: controlword 0 (disable voltage), target follows actual.
+  EXPECT_EQ(rpdo(), "203#0000FEFFFFFF");
+  d.enable();
+  out.clear();
+  net.cycle(302'000'000, out);
+  EXPECT_EQ(rpdo(), "203#0700FEFFFFFF");  // switch on (3)
+  EXPECT_EQ(hex(out.frames.back()), "080#");  // RPDOs before the SYNC
+}
+
+// ---- emulator frames -------------------------------------------------------
+TEST(Golden, EmulatorBootHeartbeatSdoTpdoEmcy) {
+  emulator::EmulatorConfig ec;
+  ec.node = 2;
+  ec.initial_position = 0x01020304;
+  emulator::Emulator emu(ec);
+  VecSink out;
+  emu.power_on(0, out);
+  ASSERT_EQ(out.frames.size(), 1u);
+  EXPECT_EQ(hex(out.frames[0]), "702#00");
+  out.clear();
+  // Heartbeat producer 0x1017 = 10 ms.
+  emu.on_frame(can::TimedFrame{frame("602#2B1710000A000000"), 0}, out);
+  EXPECT_EQ(hex(out.frames.at(0)), "582#6017100000000000");
+  emu.step(10'000'000, out);
+  EXPECT_EQ(hex(out.frames.at(1)), "702#7F");
+  out.clear();
+  // Operational, then a SYNC: TPDO1 = statusword 0x0250 (switch on disabled + remote + qs bit), position.
+  emu.on_frame(can::TimedFrame{frame("000#0102"), 0}, out);
+  emu.on_frame(can::TimedFrame{frame("080#"), 0}, out);
+  ASSERT_EQ(out.frames.size(), 1u);
+  EXPECT_EQ(hex(out.frames[0]), "182#600204030201");
+  out.clear();
+  emu.step(20'000'000, out);
+  EXPECT_EQ(hex(out.frames.at(0)), "702#05");
+  out.clear();
+  // Fault injection through 0x2000: EMCY 0x8611, error register generic+profile.
+  emu.on_frame(can::TimedFrame{frame("602#2B00200011860000"), 0}, out);
+  emu.on_frame(can::TimedFrame{frame("080#"), 0}, out);
+  std::vector<std::string> got;
+  for (auto& f : out.frames) got.push_back(hex(f));
+  EXPECT_EQ(got, (std::vector<std::string>{"582#6000200000000000", "082#1186210000000000", "182#1F0204030201"}));
+  EXPECT_EQ(emu.state(), State::kFaultReactionActive);
+  out.clear();
+  emu.on_frame(can::TimedFrame{frame("080#"), 0}, out);
+  EXPECT_EQ(hex(out.frames.at(0)), "182#280204030201");  // Fault (14)
+  // Fault reset over RPDO1 (edge of bit 7), applied at the next SYNC: EMCY 0000.
+  out.clear();
+  emu.on_frame(can::TimedFrame{frame("202#800004030201"), 0}, out);
+  EXPECT_TRUE(out.frames.empty());  // RPDOs wait for SYNC
+  emu.on_frame(can::TimedFrame{frame("080#"), 0}, out);
+  got.clear();
+  for (auto& f : out.frames) got.push_back(hex(f));
+  EXPECT_EQ(got, (std::vector<std::string>{"082#0000000000000000", "182#600204030201"}));
+}
+
+TEST(Golden, EmulatorRpdoLengthErrorGivesEmcy8210) {
+  emulator::EmulatorConfig ec;
+  ec.node = 2;
+  emulator::Emulator emu(ec);
+  VecSink out;
+  emu.power_on(0, out);
+  emu.on_frame(can::TimedFrame{frame("000#0100"), 0}, out);  // start all
+  out.clear();
+  emu.on_frame(can::TimedFrame{frame("202#0F00"), 0}, out);
+  ASSERT_EQ(out.frames.size(), 1u);
+  EXPECT_EQ(hex(out.frames[0]), "082#1082000000000000");
+}
+
+// ---- CiA 402 state table, transition by transition ---------------------------
+TEST(StateTable, EveryCommandedTransition) {
+  struct Row {
+    State from;
+    std::uint16_t cw;
+    State to;
+    std::uint8_t transition;
+  };
+  const Row rows[] = {
+      {State::kSwitchOnDisabled, 0x0006, State::kReadyToSwitchOn, 2},
+      {State::kReadyToSwitchOn, 0x0007, State::kSwitchedOn, 3},
+      {State::kReadyToSwitchOn, 0x000F, State::kSwitchedOn, 3},
+      {State::kSwitchedOn, 0x000F, State::kOperationEnabled, 4},
+      {State::kOperationEnabled, 0x0007, State::kSwitchedOn, 5},
+      {State::kSwitchedOn, 0x0006, State::kReadyToSwitchOn, 6},
+      {State::kReadyToSwitchOn, 0x0000, State::kSwitchOnDisabled, 7},
+      {State::kReadyToSwitchOn, 0x0002, State::kSwitchOnDisabled, 7},
+      {State::kOperationEnabled, 0x0006, State::kReadyToSwitchOn, 8},
+      {State::kOperationEnabled, 0x0000, State::kSwitchOnDisabled, 9},
+      {State::kSwitchedOn, 0x0000, State::kSwitchOnDisabled, 10},
+      {State::kSwitchedOn, 0x0002, State::kSwitchOnDisabled, 10},
+      {State::kOperationEnabled, 0x0002, State::kQuickStopActive, 11},
+      {State::kQuickStopActive, 0x0000, State::kSwitchOnDisabled, 12},
+  };
+  for (const Row& r : rows) {
+    const auto res = cia402::apply_controlword(r.from, 0, r.cw);
+    EXPECT_EQ(res.next, r.to) << cia402::state_name(r.from) << " + 0x" << std::hex << r.cw;
+    EXPECT_EQ(res.transition, r.transition) << cia402::state_name(r.from) << " + 0x" << std::hex << r.cw;
+    // The table agrees with the transition list.
+    EXPECT_EQ(cia402::kTransitions[r.transition].from, r.from);
+    EXPECT_EQ(cia402::kTransitions[r.transition].to, r.to);
+  }
+  // 15: only on the rising edge of bit 7.
+  EXPECT_EQ(cia402::apply_controlword(State::kFault, 0x0000, 0x0080), (cia402::StepResult{State::kSwitchOnDisabled, 15}));
+  EXPECT_EQ(cia402::apply_controlword(State::kFault, 0x0080, 0x0080).transition, cia402::kNoTransition);
+  EXPECT_EQ(cia402::apply_controlword(State::kFault, 0x0000, 0x000F).transition, cia402::kNoTransition);
+  // 16: only with 0x605A = 5..8.
+  EXPECT_EQ(cia402::apply_controlword(State::kQuickStopActive, 0x0002, 0x000F, 6),
+            (cia402::StepResult{State::kOperationEnabled, 16}));
+  EXPECT_EQ(cia402::apply_controlword(State::kQuickStopActive, 0x0002, 0x000F, 2).transition, cia402::kNoTransition);
+}
+
+TEST(StateTable, CommandsWithoutTransitionLeaveTheStateAlone) {
+  const State all[] = {State::kSwitchOnDisabled, State::kReadyToSwitchOn, State::kSwitchedOn,
+                       State::kOperationEnabled, State::kQuickStopActive};
+  const std::uint16_t cws[] = {0x0000, 0x0002, 0x0006, 0x0007, 0x000F};
+  int transitions = 0;
+  for (State s : all)
+    for (std::uint16_t cw : cws) {
+      const auto r = cia402::apply_controlword(s, cw, cw);
+      if (r.transition != cia402::kNoTransition) {
+        ++transitions;
+        EXPECT_NE(r.next, s);
+      } else {
+        EXPECT_EQ(r.next, s);
+      }
+    }
+  EXPECT_EQ(transitions, 14);  // the rows of EveryCommandedTransition
+  // Drive-side automatic states never move on a command.
+  EXPECT_EQ(cia402::apply_controlword(State::kNotReadyToSwitchOn, 0, 0x0006).transition, cia402::kNoTransition);
+  EXPECT_EQ(cia402::apply_controlword(State::kFaultReactionActive, 0, 0x0080).transition, cia402::kNoTransition);
+}
+
+TEST(StateTable, MasterPlanReachesEveryTargetThroughNumberedTransitions) {
+  const State starts[] = {State::kSwitchOnDisabled, State::kReadyToSwitchOn, State::kSwitchedOn,
+                          State::kOperationEnabled, State::kQuickStopActive, State::kFault};
+  const State targets[] = {State::kOperationEnabled, State::kSwitchOnDisabled, State::kSwitchedOn,
+                           State::kReadyToSwitchOn};
+  for (State s0 : starts)
+    for (State target : targets) {
+      State s = s0;
+      std::uint16_t prev = 0;
+      for (int i = 0; i < 6 && s != target; ++i) {
+        const auto p = cia402::next_step(s, target);
+        ASSERT_TRUE(p.has_value()) << cia402::state_name(s) << " -> " << cia402::state_name(target);
+        const std::uint16_t cw = cia402::controlword(p->command);
+        const auto r = cia402::apply_controlword(s, p->command == Command::kFaultReset ? 0 : prev, cw);
+        EXPECT_EQ(r.transition, p->transition);
+        EXPECT_EQ(r.next, p->expect);
+        s = r.next;
+        prev = cw;
+      }
+      EXPECT_EQ(s, target) << "from " << cia402::state_name(s0);
+    }
+  EXPECT_FALSE(cia402::next_step(State::kFaultReactionActive, State::kOperationEnabled).has_value());
+}
+
+TEST(StateTable, ProxyFailureExplainsItself) {
+  cia402::Failure f;
+  f.kind = cia402::FailureKind::kTransitionTimeout;
+  f.node = 2;
+  f.transition = 4;
+  f.wanted = State::kOperationEnabled;
+  f.reached = State::kSwitchedOn;
+  f.statusword = 0x0233;
+  f.has_emcy = true;
+  f.emcy_code = 0x8611;
+  f.waited_ns = 500'000'000;
+  EXPECT_EQ(f.to_string(),
+            "node 2: transition 4 (Switched on -> Operation enabled) towards Operation enabled timed out after 500.0 ms: "
+            "drive is in Switched on, statusword 0x0233, last EMCY 0x8611 (following error)");
+}
+
+// ---- PDO packing ----------------------------------------------------------------
+TEST(Pdo, OffsetsComputedAtConfiguration) {
+  canopen::PdoMap m;
+  m.add(0x6040, 0, 16);
+  m.add(0x607A, 0, 32);
+  m.add(0x6060, 0, 8);
+  ASSERT_TRUE(m.finalize());
+  EXPECT_EQ(m.entries[1].bit_offset, 16);
+  EXPECT_EQ(m.entries[2].bit_offset, 48);
+  EXPECT_EQ(m.size_bytes, 7);
+  m.add(0x60FF, 0, 32);
+  EXPECT_FALSE(m.finalize());  // 88 bits
+}
+
+TEST(Pdo, PackUnpackRoundTripProperty) {
+  const std::uint64_t seed = test_seed();
+  const int count = test_count(20000);
+  std::mt19937_64 rng(seed);
+  for (int i = 0; i < count; ++i) {
+    std::array<std::uint8_t, 8> buf{};
+    for (auto& b : buf) b = static_cast<std::uint8_t>(rng());
+    const auto before = buf;
+    const unsigned bits = 1 + static_cast<unsigned>(rng() % 32);
+    const unsigned off = static_cast<unsigned>(rng() % (65 - bits));
+    const std::uint64_t v = rng() & ((std::uint64_t{1} << bits) - 1);
+    canopen::pack_bits(buf, off, bits, v);
+    ASSERT_EQ(canopen::unpack_bits(buf, off, bits), v) << "seed " << seed << " i " << i;
+    for (unsigned b = 0; b < 64; ++b) {  // other bits untouched
+      if (b >= off && b < off + bits) continue;
+      ASSERT_EQ((buf[b / 8] >> (b % 8)) & 1, (before[b / 8] >> (b % 8)) & 1) << "seed " << seed << " i " << i;
+    }
+  }
+  EXPECT_EQ(canopen::sign_extend(0xFFFE, 16), -2);
+}
+
+// ---- bus budget ------------------------------------------------------------------
+TEST(BusBudget, WorstCaseFrameLengths) {
+  EXPECT_EQ(canopen::frame_bits_worst_case(0), 55u);
+  EXPECT_EQ(canopen::frame_bits_worst_case(1), 65u);
+  EXPECT_EQ(canopen::frame_bits_worst_case(6), 115u);
+  EXPECT_EQ(canopen::frame_bits_worst_case(8), 135u);
+  EXPECT_EQ(canopen::frame_bits_worst_case(8, true), 160u);
+  EXPECT_EQ(canopen::frame_bits_no_stuffing(8), 111u);
+}
+
+TEST(BusBudget, DefaultCspMapping) {
+  canopen::NodeTraffic axis;
+  axis.rpdo_bytes[0] = 6;
+  axis.rpdo_count = 1;
+  axis.tpdo_bytes[0] = 6;
+  axis.tpdo_count = 1;
+  const canopen::NodeTraffic three[] = {axis, axis, axis};
+  canopen::BusBudgetInput in;
+  in.cycle_ns = 1'000'000;
+  in.nodes = three;
+  const auto b = canopen::bus_budget(in);
+  EXPECT_EQ(b.frames_per_cycle, 7u);
+  EXPECT_EQ(b.cyclic_bits, 55u + 3 * 230u);
+  EXPECT_DOUBLE_EQ(b.load_percent, 74.5);
+  EXPECT_EQ(canopen::max_axes(axis, 1'000'000, 1'000'000), 4u);
+  EXPECT_EQ(canopen::max_axes(axis, 2'000'000, 1'000'000), 8u);
+  EXPECT_EQ(canopen::max_axes(axis, 4'000'000, 1'000'000), 17u);
+}
+
+// ---- SimBus -----------------------------------------------------------------------
+TEST(SimBus, BroadcastDropDelayCorrupt) {
+  can::SimBus bus;
+  auto& a = bus.add_endpoint("a");
+  auto& b = bus.add_endpoint("b");
+  auto& c = bus.add_endpoint("c");
+  std::array<can::TimedFrame, 8> buf;
+  bus.set_time(5);
+  ASSERT_EQ(a.send(frame("181#01")), can::SendResult::kOk);
+  EXPECT_EQ(a.receive(buf), 0u);  // not to the sender
+  ASSERT_EQ(b.receive(buf), 1u);
+  EXPECT_EQ(buf[0].t_ns, 5);
+  EXPECT_EQ(c.receive(buf), 1u);
+  bus.add_fault(can::SimFault{0x181, can::SimFault::Action::kDrop, 1, 1});  // drop the 2nd match only
+  can::SimFault delay{0x182, can::SimFault::Action::kDelay, 0, 1};
+  delay.delay_ns = 100;
+  bus.add_fault(delay);
+  can::SimFault corrupt{0x183, can::SimFault::Action::kCorrupt, 0, 1};
+  corrupt.byte = 0;
+  corrupt.xor_mask = 0x0F;
+  bus.add_fault(corrupt);
+  a.send(frame("181#02"));  // passes (skip 1)
+  a.send(frame("181#03"));  // dropped
+  a.send(frame("181#04"));  // passes
+  a.send(frame("182#05"));  // delayed
+  a.send(frame("183#F0"));  // corrupted
+  ASSERT_EQ(b.receive(buf), 3u);
+  EXPECT_EQ(hex(buf[0].frame), "181#02");
+  EXPECT_EQ(hex(buf[1].frame), "181#04");
+  EXPECT_EQ(hex(buf[2].frame), "183#FF");
+  bus.set_time(104);
+  EXPECT_EQ(b.receive(buf), 0u);
+  bus.set_time(105);
+  ASSERT_EQ(b.receive(buf), 1u);
+  EXPECT_EQ(hex(buf[0].frame), "182#05");
+  EXPECT_EQ(buf[0].t_ns, 105);
+  EXPECT_EQ(bus.counters().dropped, 1u);
+  EXPECT_EQ(bus.counters().delayed, 1u);
+  EXPECT_EQ(bus.counters().corrupted, 1u);
+}
+
+TEST(SimBus, OverflowAndBusOffAreEvents) {
+  can::SimBus bus;
+  auto& a = bus.add_endpoint("a");
+  auto& b = bus.add_endpoint("b", 2);
+  for (int i = 0; i < 3; ++i) a.send(frame("080#"));
+  EXPECT_EQ(b.counters().rx_dropped, 1u);
+  std::array<can::BusEvent, 4> ev;
+  ASSERT_EQ(b.poll_events(ev), 1u);
+  EXPECT_EQ(ev[0].kind, can::BusEvent::Kind::kRxOverflow);
+  bus.set_state(can::BusState::kBusOff);
+  EXPECT_EQ(a.send(frame("080#")), can::SendResult::kBusOff);
+  ASSERT_EQ(a.poll_events(ev), 1u);
+  EXPECT_EQ(ev[0].state, can::BusState::kBusOff);
+}

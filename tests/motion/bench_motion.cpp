@@ -1,0 +1,142 @@
+// Google Benchmark: planner step cost per axis per cycle, S-curve MAM start
+// (planning) cost, and ST parse cost. Figures go to BENCHMARKS.md.
+#include <benchmark/benchmark.h>
+
+#include <array>
+#include <memory>
+
+#include "motion/planner.hpp"
+#include "motion/profile.hpp"
+#include "motion/st_parser.hpp"
+
+using namespace canmotion::motion;
+
+namespace {
+
+constexpr int kAxes = 32;
+
+struct Bench {
+  std::unique_ptr<Planner> p = std::make_unique<Planner>(0.001);
+  Symbols sym;
+  std::array<AxisFeedback, kMaxAxes> fb{};
+  std::array<AxisOutput, kMaxAxes> out{};
+  std::uint64_t cycle = 0;
+  Bench() {
+    AxisConfig c;
+    c.max_speed = 1000;
+    for (int i = 0; i < kAxes; ++i) {
+      p->configure_axis(static_cast<AxisId>(i), c);
+      sym.axes["a" + std::to_string(i)] = static_cast<AxisId>(i);
+      sym.controls["mso" + std::to_string(i)] = static_cast<ControlId>(i);
+      sym.controls["mv" + std::to_string(i)] = static_cast<ControlId>(100 + i);
+    }
+    for (int i = 0; i < kAxes; ++i) run("MSO(a" + std::to_string(i) + ", mso" + std::to_string(i) + ");");
+  }
+  void run(const std::string& t) {
+    Request q;
+    if (auto e = parse_and_bind(t, sym, q)) throw std::runtime_error(*e);
+    p->execute(q);
+  }
+  void step() {
+    Input in{++cycle, std::span<const AxisFeedback>(fb.data(), kAxes), {}};
+    Output o{std::span<AxisOutput>(out.data(), kAxes)};
+    p->update(in, o);
+  }
+};
+
+std::string mam(int i, const char* profile) {
+  return "MAM(a" + std::to_string(i) + ", mv" + std::to_string(i) +
+         ", 1, 1e9, 100, unitspersec, 1000, unitspersec2, 1000, unitspersec2, " + profile +
+         ", 60, 60, %oftime, disabled, programmed, 0, none, 0, 0);";
+}
+
+// step() of the whole planner divided by the number of moving axes
+void step_bench(benchmark::State& st, const char* kind) {
+  Bench b;
+  for (int i = 0; i < kAxes; ++i) {
+    if (std::string(kind) == "jog")
+      b.run("MAJ(a" + std::to_string(i) + ", mv" + std::to_string(i) +
+            ", 0, 100, unitspersec, 1000, unitspersec2, 1000, unitspersec2, trapezoidal, 0, 0, unitspersec3, disabled, programmed, 0, none);");
+    else
+      b.run(mam(i, kind));
+  }
+  b.step();
+  for (auto _ : st) {
+    b.step();
+    benchmark::DoNotOptimize(b.out[0].position);
+  }
+  st.SetItemsProcessed(st.iterations() * kAxes);
+  st.counters["ns_per_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes),
+                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void BM_StepMoveTrapezoidal(benchmark::State& st) { step_bench(st, "trapezoidal"); }
+void BM_StepMoveSCurve(benchmark::State& st) { step_bench(st, "scurve"); }
+void BM_StepJog(benchmark::State& st) { step_bench(st, "jog"); }
+
+// plan_move for an S-curve from a moving state (a merge): the planning maths alone
+void BM_PlanSCurveMoveFromMotion(benchmark::State& st) {
+  Limits l{100, 1000, 800, 20000, 15000};
+  Profile prof;
+  double d = 3.0;
+  for (auto _ : st) {
+    plan_move(prof, Kin{0, 35, 400}, d, l);
+    benchmark::DoNotOptimize(prof);
+    d = d == 3.0 ? 250.0 : 3.0;  // alternate short (peak velocity solve) and long moves
+  }
+}
+void BM_PlanSCurveMoveRestToRest(benchmark::State& st) {
+  Limits l{100, 1000, 800, 20000, 15000};
+  Profile prof;
+  double d = 0.5;
+  for (auto _ : st) {
+    plan_move(prof, Kin{0, 0, 0}, d, l);
+    benchmark::DoNotOptimize(prof);
+    d = d == 0.5 ? 250.0 : 0.5;
+  }
+}
+
+// Full MAM start through Planner::execute (validation + units + planning + tags)
+void BM_StartSCurveMam(benchmark::State& st) {
+  Bench b;
+  Request q;
+  parse_and_bind("MAM(a0, mv0, 0, 12.5, 100, unitspersec, 1000, unitspersec2, 800, unitspersec2, scurve, 60, 50, "
+                 "%oftime, disabled, programmed, 0, none, 0, 0);",
+                 b.sym, q);
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(b.p->execute(q));
+  }
+}
+
+void BM_ParseMam(benchmark::State& st) {
+  const std::string text =
+      "MAM(a0, mv0, 0, 100, 50, unitspersec, 500, unitspersec2, 500, unitspersec2, trapezoidal, 100, 100, %oftime, "
+      "disabled, 0, 0, 0, 0, 0);";
+  for (auto _ : st) {
+    auto r = parse_st_call(text);
+    benchmark::DoNotOptimize(r);
+  }
+}
+void BM_ParseAndBindMam(benchmark::State& st) {
+  Bench b;
+  const std::string text =
+      "MAM(a0, mv0, 0, 100, 50, unitspersec, 500, unitspersec2, 500, unitspersec2, trapezoidal, 100, 100, %oftime, "
+      "disabled, 0, 0, 0, 0, 0);";
+  Request q;
+  for (auto _ : st) {
+    auto e = parse_and_bind(text, b.sym, q);
+    benchmark::DoNotOptimize(e);
+  }
+}
+
+}  // namespace
+
+BENCHMARK(BM_StepMoveTrapezoidal);
+BENCHMARK(BM_StepMoveSCurve);
+BENCHMARK(BM_StepJog);
+BENCHMARK(BM_PlanSCurveMoveFromMotion);
+BENCHMARK(BM_PlanSCurveMoveRestToRest);
+BENCHMARK(BM_StartSCurveMam);
+BENCHMARK(BM_ParseMam);
+BENCHMARK(BM_ParseAndBindMam);
+BENCHMARK_MAIN();
