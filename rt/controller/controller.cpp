@@ -95,6 +95,7 @@ std::optional<motion::ControlId> Controller::control_id(std::string_view name_in
   if (control_names_.size() >= motion::kMaxControlTags) return std::nullopt;
   const auto id = static_cast<motion::ControlId>(control_names_.size());
   control_names_.emplace(name, id);
+  controls_in_use_.store(control_names_.size(), std::memory_order_release);
   return id;
 }
 
@@ -320,7 +321,9 @@ void Controller::publish(std::int64_t now_ns) noexcept {
     s.buses[b].counters = buses_[b].transport->counters();
     s.buses[b].send_rejected = buses_[b].rejected;
   }
-  for (std::size_t c = 0; c < s.controls.size(); ++c) s.controls[c] = planner_.control(static_cast<motion::ControlId>(c));
+  // Control tags handed out so far (requests can only name those).
+  const std::size_t nctl = controls_in_use_.load(std::memory_order_acquire);
+  for (std::size_t c = 0; c < nctl; ++c) s.controls[c] = planner_.control(static_cast<motion::ControlId>(c));
   s.trace_dropped = trace_dropped_;
   s.telemetry_dropped = telemetry_dropped_;
   s.commands_deferred = deferred_;

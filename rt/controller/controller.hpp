@@ -256,6 +256,7 @@ class Controller {
   std::atomic<std::uint64_t> cycle_{0};
   std::atomic<bool> trace_on_{false};
   std::atomic<bool> telemetry_on_{false};
+  std::atomic<std::size_t> controls_in_use_{0};  ///< control ids handed out; publish copies only these
 
   SpscRing<Command, kCommandCapacity> commands_;
   SpscRing<Event, kEventCapacity> events_;

@@ -145,6 +145,7 @@ class Shutdown {
   }
   /// Advance; returns true when done.
   bool step(double now) {
+    if (phase_ == Phase::kNone) return false;  // no snapshot copy while running normally
     rt::Controller& c = h_.controller();
     const rt::Status& s = h_.refresh();
     switch (phase_) {
