@@ -252,11 +252,7 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
     } else if (c.kind == Command::Kind::kEnableDrives) {
       for (auto& b : buses_) b.network->enable_all();
     } else if (c.kind == Command::Kind::kPreOperational) {
-      for (auto& b : buses_) {
-        auto& sink = static_cast<RecordingSink&>(*b.sink);
-        sink.now_ns = now_ns;
-        b.network->master().send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, sink);
-      }
+      preop_pending_ = true;  // sent after this cycle's SYNC, so its TPDOs still come back
     }
     done_seq_ = c.seq;
   }
@@ -275,6 +271,10 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
     auto& sink = static_cast<RecordingSink&>(*buses_[b].sink);
     sink.now_ns = now_ns;
     buses_[b].network->cycle(now_ns, sink);
+  }
+  if (preop_pending_) {
+    preop_pending_ = false;
+    for (auto& b : buses_) b.network->master().send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, *b.sink);
   }
   // 8. Publish.
   publish(now_ns);

@@ -248,6 +248,7 @@ class Controller {
   std::array<can::TimedFrame, kRxBatch> rx_{};
   std::array<double, motion::kMaxAxes> max_err_{};
   std::optional<Command> held_;  ///< a command popped but deferred to the next cycle
+  bool preop_pending_ = false;
   std::uint64_t done_seq_ = 0;
   std::uint64_t deferred_ = 0;
   std::uint64_t trace_dropped_ = 0;

@@ -177,9 +177,17 @@ class Shutdown {
         return false;
       }
       case Phase::kPreOp:
-        // The NMT frame goes out in the next cycle; end right after it, before
-        // the drives' missing TPDOs would be counted as lost.
-        if (now - since_ >= 2 * h_.controller().period_s()) phase_ = Phase::kDone;
+        // The NMT frame goes out at the end of the cycle that executes the
+        // command (after its SYNC); the next cycle receives that SYNC's TPDOs.
+        // End after it, before a SYNC that pre-operational drives ignore.
+        if (!preop_sent_) {
+          if (h_.settled()) {
+            preop_sent_ = true;
+            since_ = now;
+          }
+        } else if (now > since_) {
+          phase_ = Phase::kDone;
+        }
         return phase_ == Phase::kDone;
       case Phase::kDone: return true;
     }
@@ -192,6 +200,7 @@ class Shutdown {
   rt::ControllerHost& h_;
   Phase phase_ = Phase::kNone;
   double since_ = 0;
+  bool preop_sent_ = false;
 };
 
 void print_summary(const Options& o, config::Runtime& rt, rt::ControllerHost& host, const rt::CycleStats& st,
