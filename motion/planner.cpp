@@ -49,6 +49,27 @@ const Idx& idx() noexcept {
 
 inline bool is_md_jerk(int u) noexcept { return u == 4 || u == 6 || u == 7; }
 
+/// Generic access to any generator's state.
+struct GenRef {
+  Kin* k = nullptr;
+  ControlId owner = kNoControl;
+  std::uint32_t owner_gen = 0;
+};
+GenRef gen_ref(Generator& g) noexcept {
+  if (auto* p = std::get_if<ProfileGen>(&g)) return {&p->k, p->owner, p->owner_gen};
+  if (auto* q = std::get_if<GearGen>(&g)) return {&q->k, q->owner, q->owner_gen};
+  return {};
+}
+
+/// floor(a * b / c) in exact integer arithmetic (c > 0).
+std::int64_t mul_div_floor(std::int64_t a, std::int64_t b, std::int64_t c) noexcept {
+  __extension__ typedef __int128 i128;
+  const i128 n = static_cast<i128>(a) * static_cast<i128>(b);
+  i128 q = n / c;
+  if ((n % c != 0) && ((n < 0) != (c < 0))) --q;
+  return static_cast<std::int64_t>(q);
+}
+
 /// Decoded dynamics of MAM/MAJ (operands Speed .. LockDirection are laid out
 /// identically in both; `is` is the index of Speed).
 struct Dyn {
@@ -164,8 +185,8 @@ ControlTag* Planner::owner_tag(ControlId id, std::uint32_t gen) noexcept {
 }
 
 Kin Planner::slot_kin(const AxisRt& a, Slot s) const noexcept {
-  if (auto* g = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(s)])) return g->k;
-  return Kin{};
+  const GenRef r = gen_ref(const_cast<Generator&>(a.gen[static_cast<std::size_t>(s)]));
+  return r.k ? *r.k : Kin{};
 }
 
 double Planner::user_command(const AxisRt& a) const noexcept { return a.cmd.p + a.frame_offset; }
@@ -184,10 +205,10 @@ bool Planner::any_stopping(const AxisRt& a) const noexcept {
 
 void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
   auto& slot = a.gen[static_cast<std::size_t>(s)];
-  if (auto* g = std::get_if<ProfileGen>(&slot)) {
-    a.base += g->k.p;
+  if (const GenRef g = gen_ref(slot); g.k) {
+    a.base += g.k->p;
     if (clear_owner_ip) {
-      if (ControlTag* c = owner_tag(g->owner, g->owner_gen)) {
+      if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) {
         c->set(flag::IP, false);
         c->set(flag::ACCEL, false);
         c->set(flag::DECEL, false);
@@ -227,9 +248,9 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
     Kin tot{};
     bool any = false;
     for (std::size_t s = 0; s < kSlots; ++s) {
-      if (auto* g = std::get_if<ProfileGen>(&a.gen[s])) {
-        tot.v += g->k.v;
-        tot.a += g->k.a;
+      if (const GenRef g = gen_ref(a.gen[s]); g.k) {
+        tot.v += g.k->v;
+        tot.a += g.k->a;
         any = true;
       }
       fold(a, static_cast<Slot>(s), true);
@@ -250,9 +271,9 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
   bool any = false;
   for (std::size_t s = 0; s < kSlots; ++s) {
     if (!(mask & (1u << s))) continue;
-    auto* g = std::get_if<ProfileGen>(&a.gen[s]);
-    if (!g) continue;
-    const Kin k = g->k;
+    const GenRef g = gen_ref(a.gen[s]);
+    if (!g.k) continue;
+    const Kin k = *g.k;
     fold(a, static_cast<Slot>(s), true);
     if (k.v == 0 && k.a == 0) continue;
     ProfileGen st;
@@ -324,6 +345,7 @@ Err Planner::execute(const Request& r) noexcept {
       case Instr::MAM: e = start_mam(r, axes_[ax], exerr); break;
       case Instr::MCD: e = start_mcd(r, axes_[ax], exerr); break;
       case Instr::MRP: e = start_mrp(r, axes_[ax]); break;
+      case Instr::MAG: e = start_mag(r, axes_[ax], exerr); break;
       case Instr::MGS:
       case Instr::MGSD:
       case Instr::MGSR: e = start_group(r, exerr); break;
@@ -448,10 +470,8 @@ Err Planner::start_mas(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   double speed = 0.0;
   for (std::size_t s = 0; s < kSlots; ++s) {
     if (!(mask & (1u << s))) continue;
-    if (auto* g = std::get_if<ProfileGen>(&a.gen[s])) {
-      scurve = scurve || g->scurve;
-      speed += g->k.v;
-    }
+    if (auto* g = std::get_if<ProfileGen>(&a.gen[s])) scurve = scurve || g->scurve;
+    if (const GenRef g = gen_ref(a.gen[s]); g.k) speed += g.k->v;
   }
   speed = std::fabs(speed);
   double jd = a.cfg.max_decel_jerk;
@@ -989,6 +1009,13 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
 void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
   double sum_p = 0, sum_v = 0, sum_a = 0;
   for (std::size_t s = 0; s < kSlots; ++s) {
+    if (auto* gg = std::get_if<GearGen>(&a.gen[s])) {
+      step_gear(*gg);
+      sum_p += gg->k.p;
+      sum_v += gg->k.v;
+      sum_a += gg->k.a;
+      continue;
+    }
     auto* g = std::get_if<ProfileGen>(&a.gen[s]);
     if (!g) continue;
     const double t = static_cast<double>(cycle_ - g->t0_cycle) * T_;
@@ -1058,6 +1085,9 @@ void Planner::update_status(AxisRt& a) noexcept {
   const auto* jg = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Jog)]);
   setb(MoveStatus, mv && mv->role == GenRole::Move);
   setb(JogStatus, jg && jg->role == GenRole::Jog);
+  const auto* gr = std::get_if<GearGen>(&a.gen[static_cast<std::size_t>(Slot::Gear)]);
+  setb(GearingStatus, gr != nullptr);
+  setb(GearingLockStatus, gr && gr->locked);
   setb(StoppingStatus, any_stopping(a));
   setb(HomingStatus, a.homing);
   setb(AxisHomedStatus, a.homed);
@@ -1098,6 +1128,145 @@ void Planner::update_status(AxisRt& a) noexcept {
   t.position_error = a.cmd.p - act;
 }
 
+// --- MAG
+Err Planner::start_mag(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+  if (Err e = common_checks(a, true); e != Err::None) return e;
+  if (a.homing) return Err::HomeInProcess;
+  const AxisId slave_id = r.op[0].ref;
+  const AxisId master_id = r.op[1].ref;
+  const AxisRt& m = axes_[master_id];
+  if (!m.cfg.configured) return Err::AxisNotConfigured;
+  if (m.cfg.inhibited) return Err::AxisIsInhibited;
+  if (master_id == slave_id) return Err::MasterAxisConflict;
+  // circular master chain: the master (transitively) geared to this slave
+  AxisId c = master_id;
+  for (std::size_t n = 0; n < kMaxAxes; ++n) {
+    const auto* g = std::get_if<GearGen>(&axes_[c].gen[static_cast<std::size_t>(Slot::Gear)]);
+    if (!g) break;
+    if (g->master == slave_id) return Err::MasterAxisConflict;
+    c = g->master;
+  }
+  static const int iDir = operand_index(Instr::MAG, "Direction"), iRatio = operand_index(Instr::MAG, "Ratio"),
+                   iSc = operand_index(Instr::MAG, "SlaveCounts"), iMc = operand_index(Instr::MAG, "MasterCounts"),
+                   iRef = operand_index(Instr::MAG, "MasterReference"), iFmt = operand_index(Instr::MAG, "RatioFormat"),
+                   iClutch = operand_index(Instr::MAG, "Clutch"), iAcc = operand_index(Instr::MAG, "AccelRate"),
+                   iAccU = operand_index(Instr::MAG, "AccelUnits");
+  // Direction: same/opposite, or reverse/unchanged relative to the last gearing
+  // direction (first use: reverse = opposite, unchanged = same) [seed 003].
+  const int d = ival(r, iDir);
+  const int dir = d == 0 ? 1 : d == 1 ? -1 : d == 2 ? (a.gear_dir == 0 ? -1 : -a.gear_dir) : (a.gear_dir == 0 ? 1 : a.gear_dir);
+  GearGen g;
+  g.master = master_id;
+  g.fractional = ival(r, iFmt) == 1;
+  g.cc_master = m.cfg.conversion_constant;
+  g.cc_slave = a.cfg.conversion_constant;
+  // a virtual master has no actual position: it always gives command [seed 000]
+  g.use_actual = ival(r, iRef) == 0 && m.cfg.type == AxisType::CipDrive;
+  if (g.fractional) {
+    const double sc = dval(r, iSc), mc = dval(r, iMc);
+    if (!(sc > 0) || sc > 2147483647.0) { exerr = static_cast<std::int8_t>(iSc); return Err::ParameterOutOfRange; }
+    if (!(mc > 0) || mc > 2147483647.0) { exerr = static_cast<std::int8_t>(iMc); return Err::ParameterOutOfRange; }
+    g.slave_counts = dir * static_cast<std::int64_t>(sc);
+    g.master_counts = static_cast<std::int64_t>(mc);
+  } else {
+    const double ratio = dval(r, iRatio);
+    const double mag = std::fabs(ratio);
+    // 0.00001 .. 9.99999 inclusive, sign-sensitive [seed 003]
+    if (!(mag >= 0.00001 - 1e-12) || !(mag <= 9.99999 + 1e-12)) { exerr = static_cast<std::int8_t>(iRatio); return Err::ParameterOutOfRange; }
+    g.ratio = dir * ratio;
+  }
+  const bool clutch = ival(r, iClutch) == 0;
+  if (clutch) {
+    const double acc = dval(r, iAcc);
+    if (!(acc > 0)) { exerr = static_cast<std::int8_t>(iAcc); return Err::ParameterOutOfRange; }
+    g.clutch_accel = ival(r, iAccU) == 1 ? acc / 100.0 * a.cfg.max_accel : acc;
+    if (!(g.clutch_accel > 0)) { exerr = static_cast<std::int8_t>(iAcc); return Err::ParameterOutOfRange; }
+  }
+  // commit: a new MAG supersedes the active one (ratio, direction or master change)
+  Kin start{};
+  if (const GenRef old = gen_ref(a.gen[static_cast<std::size_t>(Slot::Gear)]); old.k) start = Kin{0, old.k->v, 0};
+  fold(a, Slot::Gear, true);
+  ControlTag& ct = controls_[r.control];
+  g.k = start;
+  g.owner = r.control;
+  g.owner_gen = ct.generation;
+  if (!clutch) {  // lock at once: the offset follows the master from here
+    g.locked = true;
+    g.master_ref = g.use_actual ? m.fb_pos : m.cmd.p;
+    g.master_ref_counts = std::llround(g.master_ref * g.cc_master);
+    g.offset_at_lock = 0.0;
+    g.k = Kin{};
+  }
+  a.gen[static_cast<std::size_t>(Slot::Gear)] = g;
+  a.gear_dir = dir;
+  ct.set(flag::DN, true);
+  ct.set(flag::IP, true);
+  return Err::None;
+}
+
+void Planner::step_gear(GearGen& g) noexcept {
+  const AxisRt& m = axes_[g.master];
+  const double mp = g.use_actual ? m.fb_pos : m.cmd.p;
+  const double mv = g.use_actual ? m.fb_vel : m.cmd.v;
+  const double ma = g.use_actual ? 0.0 : m.cmd.a;
+  const double k = g.fractional ? static_cast<double>(g.slave_counts) / static_cast<double>(g.master_counts) *
+                                      g.cc_master / g.cc_slave
+                                : g.ratio;
+  const double target_v = k * mv;
+  if (!g.locked) {
+    // clutch: trapezoidal ramp of the slave's gear velocity to the geared speed
+    const double dv = target_v - g.k.v;
+    const double step = g.clutch_accel * T_;
+    if (std::fabs(dv) <= step) {
+      g.k.p += (g.k.v + target_v) / 2 * T_;
+      g.k.v = target_v;
+      g.k.a = 0.0;
+      g.locked = true;
+      g.master_ref = mp;
+      g.master_ref_counts = std::llround(mp * g.cc_master);
+      g.offset_at_lock = g.k.p;
+    } else {
+      const double acc = dv > 0 ? g.clutch_accel : -g.clutch_accel;
+      const double v1 = g.k.v + acc * T_;
+      g.k.p += (g.k.v + v1) / 2 * T_;
+      g.k.v = v1;
+      g.k.a = acc;
+    }
+    return;
+  }
+  if (g.fractional) {
+    // exact: slave counts = floor(master counts moved * S / M); no accumulated error
+    const std::int64_t dm = std::llround(mp * g.cc_master) - g.master_ref_counts;
+    const std::int64_t sc = mul_div_floor(dm, g.slave_counts, g.master_counts);
+    g.k.p = g.offset_at_lock + static_cast<double>(sc) / g.cc_slave;
+  } else {
+    g.k.p = g.offset_at_lock + g.ratio * (mp - g.master_ref);
+  }
+  g.k.v = target_v;
+  g.k.a = k * ma;
+}
+
+void Planner::compute_order() noexcept {
+  // depth-first: an axis after its gear master (MAG refuses cycles: ERR 10)
+  std::array<std::uint8_t, kMaxAxes> mark{};
+  order_n_ = 0;
+  for (std::size_t i = 0; i < axis_count_; ++i) {
+    if (!axes_[i].present || mark[i]) continue;
+    // walk up the master chain iteratively, then emit from the top down
+    std::array<AxisId, kMaxAxes> chain{};
+    std::size_t n = 0;
+    AxisId c = static_cast<AxisId>(i);
+    while (n < kMaxAxes && !mark[c]) {
+      mark[c] = 1;
+      chain[n++] = c;
+      const auto* g = std::get_if<GearGen>(&axes_[c].gen[static_cast<std::size_t>(Slot::Gear)]);
+      if (!g || g->master >= kMaxAxes || !axes_[g->master].present) break;
+      c = g->master;
+    }
+    while (n > 0) order_[order_n_++] = chain[--n];
+  }
+}
+
 Result Planner::update(const Input& in, Output& out) noexcept {
   if (started_ && in.cycle <= cycle_) return Result::ErrorCycleNotIncreasing;
   // 1. feedback and exceptions (against last cycle's command)
@@ -1110,12 +1279,13 @@ Result Planner::update(const Input& in, Output& out) noexcept {
   // 2. requests in program order; generators started now have their time
   //    origin at the last stepped cycle, so they continue from its state.
   for (const Request& r : in.requests) execute(r);
-  // 3. step axes (index order; masters before slaves once gearing exists)
+  // 3. step axes, masters before their gear slaves
   cycle_ = in.cycle;
   started_ = true;
-  for (std::size_t i = 0; i < axis_count_; ++i) {
+  compute_order();
+  for (std::size_t n = 0; n < order_n_; ++n) {
+    const std::size_t i = order_[n];
     AxisRt& a = axes_[i];
-    if (!a.present) continue;
     step_axis(a, i < out.axes.size() ? &out.axes[i] : nullptr);
     update_status(a);
   }

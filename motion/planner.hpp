@@ -134,6 +134,26 @@ struct ProfileGen {
   std::uint8_t post_stop = 0;  ///< stop ramps of MGS: 0 none, 1 disable, 2 shutdown
 };
 
+/// State of an MAG (electronic gearing). The slave offset follows the master
+/// position (drive frame) at the ratio; O(1) step. No axis limits apply.
+struct GearGen {
+  AxisId master = kNoAxis;
+  bool use_actual = false;     ///< master reference actual (CIP masters only)
+  bool fractional = false;     ///< RatioFormat fraction: exact integer counts
+  double ratio = 1.0;          ///< signed real ratio, direction included
+  std::int64_t slave_counts = 1, master_counts = 1;  ///< signed fraction, direction included
+  double cc_master = 1.0, cc_slave = 1.0;            ///< conversion constants (counts/unit)
+  bool locked = false;         ///< GearingLockStatus
+  double clutch_accel = 0.0;   ///< units/s^2 while clutching
+  double master_ref = 0.0;     ///< master position at lock (units, drive frame)
+  std::int64_t master_ref_counts = 0;
+  double offset_at_lock = 0.0;
+  Kin k{};                     ///< offset of this generator, velocity, acceleration
+  bool scurve = false;         ///< (gear ramps are trapezoidal)
+  ControlId owner = kNoControl;
+  std::uint32_t owner_gen = 0;
+};
+
 /// Per-axis generator slots. Generators superpose: the command position is
 /// base + the sum of the slot offsets. Bound: one slot per kind of motion
 /// Logix can run at the same time on one axis (move, jog, gear, time cam,
@@ -141,8 +161,8 @@ struct ProfileGen {
 enum class Slot : std::uint8_t { Move = 0, Jog, Gear, TimeCam, PositionCam, MasterOffset, StopAll, Count };
 inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
 
-/// The closed set of generator states. Issue 5 adds gear/cam/direct states here.
-using Generator = std::variant<std::monostate, ProfileGen>;
+/// The closed set of generator states. Issue 5 adds cam and direct states here.
+using Generator = std::variant<std::monostate, ProfileGen, GearGen>;
 
 // ------------------------------------------------------------------ planner
 /// The planner. All state is inside (fixed arrays); update() is noexcept,
@@ -202,6 +222,7 @@ class Planner {
     std::uint64_t mso_deadline = 0;
     ControlId mah = kNoControl;
     std::uint32_t mah_gen = 0;
+    int gear_dir = 0;           ///< last gearing direction (+1 same, -1 opposite, 0 never geared)
     bool homing = false;        ///< drive homing (mode 6) in progress
     bool homing_started = false;
     std::uint32_t exc_prev = 0;  ///< exceptions active last cycle
@@ -225,11 +246,14 @@ class Planner {
   Err start_mam(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mcd(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mrp(const Request&, AxisRt&) noexcept;
+  Err start_mag(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_group(const Request&, std::int8_t& exerr) noexcept;
 
   // helpers
   Err common_checks(const AxisRt& a, bool need_servo) const noexcept;
   void step_axis(AxisRt& a, AxisOutput* out) noexcept;
+  void step_gear(GearGen& g) noexcept;
+  void compute_order() noexcept;
   void handle_feedback(AxisId id, AxisRt& a, const AxisFeedback* fb) noexcept;
   void handle_exceptions(AxisRt& a) noexcept;
   void fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept;
@@ -252,6 +276,8 @@ class Planner {
   std::array<AxisRt, kMaxAxes> axes_{};
   std::array<ControlTag, kMaxControlTags> controls_{};
   std::array<GroupOp, kMaxGroups> groups_{};
+  std::array<AxisId, kMaxAxes> order_{};  ///< step order: masters before slaves
+  std::size_t order_n_ = 0;
 };
 
 }  // namespace canmotion::motion

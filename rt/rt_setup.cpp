@@ -239,6 +239,31 @@ std::string RtSetupReport::describe() const {
   return out;
 }
 
+std::string RtSetupReport::error_message() const {
+  for (const auto& s : steps) {
+    if (!s.requested || !s.error || s.not_permitted()) {
+      continue;
+    }
+    switch (s.step) {
+      case RtStep::lock_memory:
+        return fmt::format("mlockall failed: {}", s.error.message());
+      case RtStep::prefault_stack:
+        return fmt::format("stack prefault of {} bytes refused: at most {} bytes", settings.prefault_stack_bytes,
+                           RtSettings::kMaxPrefaultBytes);
+      case RtStep::scheduler:
+        if (settings.priority < 1 || settings.priority > 99) {
+          return fmt::format("SCHED_FIFO priority {} is out of range: valid priorities are 1..99 (0 = no real time)",
+                             settings.priority);
+        }
+        return fmt::format("SCHED_FIFO priority {} failed: {}", settings.priority, s.error.message());
+      case RtStep::affinity:
+        return fmt::format("cannot pin the real-time thread to CPU {}: {} (allowed CPUs: {})", settings.cpu,
+                           s.error.message(), allowed_cpus.empty() ? "unknown" : allowed_cpus);
+    }
+  }
+  return {};
+}
+
 RtSetupReport apply_rt_settings(const RtSettings& settings, const RtSyscalls& sys) {
   RtSetupReport r;
   r.settings = settings;

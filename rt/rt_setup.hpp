@@ -102,6 +102,10 @@ struct RtSetupReport {
   std::string warning() const;
   /// One line per requested step, "SCHED_FIFO 80: ok" / ": Operation not permitted".
   std::string describe() const;
+  /// When hard_error() is set: one sentence naming the step, the value and
+  /// what would be valid, e.g. "cannot pin the real-time thread to CPU 5:
+  /// Invalid argument (allowed CPUs: 0-1)". Empty otherwise.
+  std::string error_message() const;
 };
 
 /// Runs the steps in order on the CALLING thread (scheduler and affinity are

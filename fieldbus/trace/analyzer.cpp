@@ -64,15 +64,21 @@ void Analyzer::calibrate(const Decoder& decoder) {
   calibrated_ = true;
   if (opt_.nominal_period_ns > 0) {
     bus_.nominal_period_ns = opt_.nominal_period_ns;
-    bus_.nominal_source = "option";
+    bus_.nominal_source = opt_.nominal_source;
   } else if (decoder.sync_period_from_trace_ns() > 0) {
     bus_.nominal_period_ns = decoder.sync_period_from_trace_ns();
     bus_.nominal_source = "trace (0x1006)";
   } else if (!calib_.empty()) {
-    std::vector<std::int64_t> sorted = calib_;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-    bus_.nominal_period_ns = sorted[sorted.size() / 2];
-    bus_.nominal_source = "median of first periods";
+    // The mean of the first periods, rounded to two significant digits
+    // (1972.8 us -> 2000 us, 1000.3 us -> 1000 us, 251 us -> 250 us).
+    double sum = 0;
+    for (std::int64_t p : calib_) sum += static_cast<double>(p);
+    const double mean = sum / static_cast<double>(calib_.size());
+    double step = 1;
+    while (step * 100 <= mean) step *= 10;
+    bus_.nominal_period_ns = static_cast<std::int64_t>(std::llround(mean / step) * static_cast<long long>(step));
+    if (bus_.nominal_period_ns <= 0) bus_.nominal_period_ns = static_cast<std::int64_t>(mean);
+    bus_.nominal_source = "mean of the first periods, rounded";
   }
   // Bin width: the 95th percentile of |deviation| spread over the half-width.
   std::vector<std::int64_t> dev;
@@ -113,7 +119,6 @@ void Analyzer::add_period(std::int64_t p) {
 }
 
 void Analyzer::add_load(std::int64_t t, std::uint32_t bits) {
-  if (bits == 0) return;
   std::int64_t rel = t - bus_.t_first;
   if (rel < 0) rel = 0;  // out-of-order timestamps count into the first window
   auto idx = static_cast<std::size_t>(rel / load_window_);
@@ -174,10 +179,17 @@ void Analyzer::on_sync(const Decoded& d, const Decoder& decoder) {
     if (ns.missing_times.size() < opt_.list_cap) ns.missing_times.push_back(last_sync_);
     l.syncs_since_tpdo = every;  // count each silent cycle once
   }
+  const std::uint32_t lag = std::min(opt_.ferr_lag_cycles, AnalyzerOptions::kMaxLag);
   for (Live& l : live_) {
-    if (l.has_target) {
+    if (!l.has_target) continue;
+    // Ring of the targets applied at the last lag + 1 SYNCs.
+    l.history_head = (l.history_head + 1) % static_cast<std::uint32_t>(l.history.size());
+    l.history[l.history_head] = l.target;
+    if (l.history_len < l.history.size()) ++l.history_len;
+    if (l.history_len > lag) {
       l.has_applied = true;
-      l.applied = l.target;
+      const auto n = static_cast<std::uint32_t>(l.history.size());
+      l.applied = l.history[(l.history_head + n - lag) % n];
     }
   }
   have_sync_ = true;

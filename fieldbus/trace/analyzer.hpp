@@ -31,12 +31,19 @@ struct NodeSettings {
 
 /// Analysis settings.
 struct AnalyzerOptions {
-  std::int64_t nominal_period_ns = 0;  ///< 0: from a 0x1006 write in the trace, else the median of the first periods
+  std::int64_t nominal_period_ns = 0;  ///< 0: from a 0x1006 write in the trace, else the rounded mean of the first periods
+  std::string nominal_source = "option";  ///< shown in the summary when nominal_period_ns is given ("option", "config")
   double bitrate = 1'000'000.0;        ///< bit/s, for the bus load
   std::int64_t load_window_ns = 100'000'000;  ///< initial bus-load window (doubles when the series is full)
   std::size_t max_load_windows = 512;         ///< cap of the bus-load series
   std::size_t timeline_cap = 1000;            ///< state changes kept per node
   std::size_t list_cap = 256;                 ///< EMCYs, aborts, missing-TPDO times, error frames kept
+  /// Following error compares the actual position in the TPDO after SYNC k
+  /// with the target applied at SYNC k - lag (0: a drive that reports the
+  /// position reached for the target applied at this SYNC, like canmotion's
+  /// emulator; 1: a drive that samples its position at SYNC before applying).
+  std::uint32_t ferr_lag_cycles = 0;
+  static constexpr std::uint32_t kMaxLag = 15;
   std::array<NodeSettings, kMaxNode + 1> nodes{};
 };
 
@@ -187,6 +194,9 @@ class Analyzer {
     std::int64_t target = 0;
     bool has_applied = false;
     std::int64_t applied = 0;
+    std::array<std::int64_t, AnalyzerOptions::kMaxLag + 1> history{};  // targets applied at the last SYNCs
+    std::uint32_t history_len = 0;
+    std::uint32_t history_head = 0;
     bool producing = false;      // TPDOs expected on SYNC
     std::uint32_t syncs_since_tpdo = 0;
     canopen::NmtState nmt = canopen::NmtState::kUnknown;

@@ -437,7 +437,11 @@ void Decoder::decode_pdo(Decoded& d) noexcept {
     }
   }
   d.field_count = count;
-  if (offset != avail) d.pdo_length_mismatch = true;
+  d.pdo_mapped_bits = static_cast<std::uint16_t>(offset);
+  if (offset != avail) {
+    d.pdo_length_mismatch = true;
+    d.problem = "PDO length differs from its mapping";
+  }
 }
 
 const Decoded& Decoder::decode_error(std::uint32_t err_class, std::int64_t t_ns) noexcept {

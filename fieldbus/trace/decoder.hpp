@@ -134,6 +134,7 @@ struct Decoded {
   std::uint8_t field_count = 0;
   std::array<PdoField, kMaxPdoEntries> fields{};
   bool pdo_length_mismatch = false;  ///< frame length differs from the mapped length
+  std::uint16_t pdo_mapped_bits = 0;  ///< total bits of the layout
 
   // CiA 402 values carried by this frame (PDO or expedited SDO)
   bool has_controlword = false;

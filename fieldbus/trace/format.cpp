@@ -287,8 +287,8 @@ void describe_pdo(const Decoded& d, fmt::memory_buffer& out) {
     }
   }
   if (d.pdo_length_mismatch) {
-    fmt::format_to(fmt::appender(out), " (frame has {} bytes, mapping {} source)", d.tf.frame.len,
-                   layout_source_name(d.layout));
+    fmt::format_to(fmt::appender(out), " (frame has {} bytes, the {} mapping {} bits)", d.tf.frame.len,
+                   layout_source_name(d.layout), d.pdo_mapped_bits);
   }
 }
 
@@ -324,6 +324,28 @@ void append_error_classes(fmt::memory_buffer& out, std::uint32_t err_class) {
     }
   }
   if (first) put(out, "no class bits");
+}
+
+void append_error_details(fmt::memory_buffer& out, std::uint32_t err_class, const std::array<std::uint8_t, 8>& data,
+                          std::uint8_t len) {
+  append_error_classes(out, err_class);
+  if ((err_class & CAN_ERR_CRTL) != 0 && len > 1 && data[1] != 0) {
+    constexpr std::array<std::string_view, 7> crtl = {"rx-overflow",      "tx-overflow",      "rx-error-warning",
+                                                      "tx-error-warning", "rx-error-passive", "tx-error-passive",
+                                                      "back-to-error-active"};
+    put(out, " {");
+    bool first = true;
+    for (unsigned b = 0; b < crtl.size(); ++b) {
+      if ((data[1] & (1U << b)) == 0) continue;
+      if (!first) out.push_back(',');
+      first = false;
+      put(out, crtl[b]);
+    }
+    put(out, "}");
+  }
+  if (len == 8 && (data[6] != 0 || data[7] != 0)) {
+    fmt::format_to(fmt::appender(out), " tx-errors={} rx-errors={}", data[6], data[7]);
+  }
 }
 
 void append_time(fmt::memory_buffer& out, std::int64_t t_ns, int digits) {
@@ -433,24 +455,7 @@ void format_description(const Decoded& d, fmt::memory_buffer& out) {
       break;
     case EventKind::kErrorFrame:
       put(out, "ERROR FRAME: ");
-      append_error_classes(out, f.id);
-      if ((f.id & CAN_ERR_CRTL) != 0 && f.len > 1 && f.data[1] != 0) {
-        constexpr std::array<std::string_view, 7> crtl = {"rx-overflow",      "tx-overflow",      "rx-error-warning",
-                                                          "tx-error-warning", "rx-error-passive", "tx-error-passive",
-                                                          "back-to-error-active"};
-        put(out, " {");
-        bool first = true;
-        for (unsigned b = 0; b < crtl.size(); ++b) {
-          if ((f.data[1] & (1U << b)) == 0) continue;
-          if (!first) out.push_back(',');
-          first = false;
-          put(out, crtl[b]);
-        }
-        put(out, "}");
-      }
-      if (f.len == 8 && (f.data[6] != 0 || f.data[7] != 0)) {
-        fmt::format_to(fmt::appender(out), " tx-errors={} rx-errors={}", f.data[6], f.data[7]);
-      }
+      append_error_details(out, f.id, f.data, f.len);
       break;
     case EventKind::kUnknown:
       put(out, f.extended() ? "extended id (not CANopen)" : "unknown CAN id");

@@ -41,6 +41,10 @@ std::string_view statusword_state_name(std::uint16_t statusword) noexcept;
 std::string_view controlword_command_name(std::uint16_t controlword) noexcept;
 /// Error-frame class names (CAN_ERR_* bits of the id), comma separated, appended to out.
 void append_error_classes(fmt::memory_buffer& out, std::uint32_t err_class);
+/// Error-frame classes with the controller-problem details of the payload
+/// (as candump -e prints them) and the error counters, appended to out.
+void append_error_details(fmt::memory_buffer& out, std::uint32_t err_class, const std::array<std::uint8_t, 8>& data,
+                          std::uint8_t len);
 /// Name of error-frame class bit `bit` (0..8), "" beyond.
 std::string_view error_class_name(unsigned bit) noexcept;
 /// Lower-case kind name used in JSON ("nmt", "sync", "tpdo", ...).

@@ -156,7 +156,7 @@ void format_summary_text(std::string_view iface, const Analyzer& a, const Report
       put(out, "    ");
       time_at(out, opt, e.t_ns, t0);
       put(out, "  ");
-      append_error_classes(out, e.classes);
+      append_error_details(out, e.classes, e.data, 8);
       put(out, "\n");
     }
     if (b.error_list.size() < b.error_frames) {
@@ -236,8 +236,12 @@ void format_summary_text(std::string_view iface, const Analyzer& a, const Report
     if (ns.ferr_count == 0) {
       put(out, "following error: no samples in Operation enabled with a target\n");
     } else {
-      fmt::format_to(fmt::appender(out), "following error (target at SYNC - actual, {} samples in Operation enabled): max |e| {} counts",
-                     ns.ferr_count, ns.ferr_max_abs);
+      if (ao.ferr_lag_cycles == 0) {
+        put(out, "following error (target applied at SYNC - actual");
+      } else {
+        fmt::format_to(fmt::appender(out), "following error (target applied {} SYNC(s) earlier - actual", ao.ferr_lag_cycles);
+      }
+      fmt::format_to(fmt::appender(out), ", {} samples in Operation enabled): max |e| {} counts", ns.ferr_count, ns.ferr_max_abs);
       if (opt.has_time) {
         put(out, " at ");
         time_at(out, opt, ns.ferr_t_max, t0);
@@ -315,7 +319,7 @@ void format_summary_json(std::string_view iface, const Analyzer& a, const Report
     put(out, "{\"t\":");
     t(b.error_list[i].t_ns);
     put(out, ",\"classes\":\"");
-    append_error_classes(out, b.error_list[i].classes);
+    append_error_details(out, b.error_list[i].classes, b.error_list[i].data, 8);
     put(out, "\"}");
   }
   put(out, "]},\"nodes\":[");

@@ -138,8 +138,11 @@ TEST(RtExecutive, StartRunsOnItsThreadAndStopsAtABoundary) {
   EXPECT_GE(s.latency_min_ns, 0);
   EXPECT_GE(s.measured_period_min_ns, 0);
   EXPECT_EQ(s.period_ns, 200'000);
+  // The thread is gone: ten more periods pass without a cycle.
   const auto after = exec.cycle_count();
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));
   EXPECT_EQ(exec.cycle_count(), after) << "no cycle after stop()";
+  EXPECT_EQ(exec.stats().cycles, after);
 }
 
 TEST(RtExecutive, RtThreadAllocatesNothingWithQueuesSnapshotsAndStats) {

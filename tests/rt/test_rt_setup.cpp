@@ -175,6 +175,7 @@ TEST(RtSetup, EveryStepReportsItsOwnError) {
   const std::string d = r.describe();
   EXPECT_NE(d.find("mlockall: Cannot allocate memory (not permitted)"), std::string::npos) << d;
   EXPECT_NE(d.find("CPU affinity cpu 2: Invalid argument"), std::string::npos) << d;
+  EXPECT_EQ(r.error_message(), "cannot pin the real-time thread to CPU 2: Invalid argument (allowed CPUs: 0-1,3)");
 }
 
 TEST(RtSetup, InvalidSettingsAreHardErrorsWithoutSyscalls) {
@@ -183,6 +184,9 @@ TEST(RtSetup, InvalidSettingsAreHardErrorsWithoutSyscalls) {
   auto r = apply_rt_settings(s, Script::syscalls());
   EXPECT_EQ(r.hard_error(), std::errc::invalid_argument);
   EXPECT_EQ(Script::fifo_calls, 0);
+  EXPECT_NE(r.error_message().find("priority 100 is out of range: valid priorities are 1..99"), std::string::npos)
+      << r.error_message();
+  EXPECT_TRUE(apply_rt_settings(full(), Script::syscalls()).error_message().empty());
   s = full(-5, -1);
   r = apply_rt_settings(s, Script::syscalls());
   EXPECT_EQ(r.hard_error(), std::errc::invalid_argument);

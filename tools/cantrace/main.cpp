@@ -54,6 +54,9 @@ Options:
                              (default: config, else 0x1006 written in the trace, else the median)
              --bitrate BPS   bus bitrate for the bus load (default: config, else 1000000)
              --window MS     bus-load window in milliseconds (default 100)
+             --lag N         following error: compare the actual position with the target
+                             applied N SYNCs earlier (default 0; 1 for drives that sample
+                             their position at SYNC before applying the new target)
          -n, --count N       stop after N frames
          -h, --help          show this help
 
@@ -85,6 +88,7 @@ struct Options {
   std::int64_t period_ns = 0;
   double bitrate = 0;
   std::int64_t window_ns = 100'000'000;
+  std::uint32_t lag = 0;
   std::uint64_t count = 0;
 };
 
@@ -136,6 +140,14 @@ Options parse_args(int argc, char** argv) {
       o.bitrate = number(a, value());
     } else if (a == "--window") {
       o.window_ns = static_cast<std::int64_t>(number(a, value()) * 1e6 + 0.5);
+    } else if (a == "--lag") {
+      const char* v = value();
+      char* end = nullptr;
+      const long n = std::strtol(v, &end, 10);
+      if (end == v || *end != '\0' || n < 0 || n > static_cast<long>(tr::AnalyzerOptions::kMaxLag)) {
+        usage_error(fmt::format("--lag needs a whole number of SYNC cycles 0..{}, not '{}'", tr::AnalyzerOptions::kMaxLag, v));
+      }
+      o.lag = static_cast<std::uint32_t>(n);
     } else if (a == "-n" || a == "--count") {
       o.count = static_cast<std::uint64_t>(number(a, value()));
     } else if (a.size() > 1 && a[0] == '-') {
@@ -200,9 +212,13 @@ Bus* App::bus_for(std::string_view iface) {
   tr::AnalyzerOptions ao;
   ao.nominal_period_ns = opt_.period_ns;
   ao.load_window_ns = opt_.window_ns;
+  ao.ferr_lag_cycles = opt_.lag;
   ao.bitrate = opt_.bitrate > 0 ? opt_.bitrate : 1'000'000.0;
   if (config_) {
-    if (ao.nominal_period_ns == 0) ao.nominal_period_ns = config_->period_ns;
+    if (ao.nominal_period_ns == 0 && config_->period_ns > 0) {
+      ao.nominal_period_ns = config_->period_ns;
+      ao.nominal_source = "config controller.period_ms";
+    }
     for (const auto& cb : config_->buses) {
       if (opt_.bitrate <= 0 && cb.bitrate > 0 && (cb.interface == iface || config_->buses.size() == 1)) ao.bitrate = cb.bitrate;
     }
@@ -370,6 +386,7 @@ int App::read_live() {
   }
   Bus* b = bus_for(opt_.live);
   fmt_opt_.has_time = true;
+  std::fprintf(stderr, "cantrace: listening on %s (CTRL-C stops)\n", opt_.live.c_str());
   std::array<can::TimedFrame, 256> frames{};
   std::array<can::BusEvent, 16> events{};
   while (!g_stop) {

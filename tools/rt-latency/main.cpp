@@ -22,6 +22,9 @@ using namespace canmotion::rt;
 namespace {
 
 std::atomic<CyclicExecutive*> g_exec{nullptr};
+std::atomic<bool> g_print_request{false};
+
+extern "C" void on_usr1(int) { g_print_request.store(true); }
 
 extern "C" void on_signal(int) {
   if (CyclicExecutive* e = g_exec.load()) {
@@ -46,6 +49,7 @@ int main(int argc, char** argv) {
       "  rt-latency -i 500 -D 60 -c 100 -a 1      # 60 s, 0.5 ms period, 100 us work, CPU 1\n"
       "  rt-latency -q -l 20000 --histogram h.txt # quiet, write the histogram\n"
       "Compare with cyclictest: tools/rt-latency/compare-cyclictest.sh\n"
+      "Signals: SIGUSR1 prints the full summary now; SIGINT/SIGTERM stop at a cycle boundary.\n"
       "Exit status: 0 on success, 1 on error (e.g. an invalid CPU).");
   std::int64_t interval_us = 1000;
   int priority = 80;
@@ -68,7 +72,11 @@ int main(int argc, char** argv) {
                "do not hold /dev/cpu_dma_latency at 0 (cyclictest holds it by default)");
   app.add_flag("-q,--quiet", quiet, "print only the final summary");
   app.add_option("--histogram", histogram_file, "write the latency histogram (lower_ns upper_ns count per line) to FILE");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;  // can-utils convention: exit 1 on error
+  }
 
   const Nanos period{interval_us * 1000};
   if (loops == 0) {
@@ -112,9 +120,11 @@ int main(int argc, char** argv) {
   g_exec.store(&exec);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  std::signal(SIGUSR1, on_usr1);
 
   if (const std::error_code ec = exec.start()) {
-    fmt::print(stderr, "rt-latency: cannot start: {}\n{}", ec.message(), exec.setup_report().describe());
+    const std::string why = exec.setup_report().error_message();
+    fmt::print(stderr, "rt-latency: cannot start: {}\n", why.empty() ? ec.message() : why);
     return 1;
   }
   if (!quiet) {
@@ -132,6 +142,10 @@ int main(int argc, char** argv) {
     // Wake up often enough to notice the end, print once a second.
     for (int i = 0; i < 20 && exec.running(); ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (g_print_request.exchange(false)) {  // kill -USR1: the full summary now
+        fmt::print("{}", format_summary(exec.stats()));
+        std::fflush(stdout);
+      }
     }
     if (!quiet && exec.running()) {
       fmt::print("{}\n", format_line(exec.stats()));

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# vcan integration test, CHECK part: the candump -L trace shows boot-up, the
+# SDO configuration, NMT start, SYNC at the period, one RPDO and one TPDO per
+# node per cycle while operational, and the reply to the raw SDO upload.
+#   vcan-check.sh CYCLE_US
+set -euo pipefail
+cycle_us="$1"
+trace="$CANMOTION_TRACE"
+fail() { echo "vcan-check: $*" >&2; exit 1; }
+has() { grep -q " $1\$" "$trace"; }
+frames="$CANMOTION_ARTIFACTS/frames.txt"
+awk '{print $1, $3}' "$trace" | tr -d '()' > "$frames"   # "sec.usec ID#DATA"
+for n in 2 3; do
+  has "70$n#00" || fail "no boot-up of node $n"
+  # SDO configuration (expedited writes acknowledged): mode 8, 0x60C2, TPDO1 mapping, heartbeat.
+  has "60$n#2F60600008000000" || fail "node $n: no SDO write 0x6060 = 8"
+  has "58$n#6060600000000000" || fail "node $n: 0x6060 write not acknowledged"
+  grep -q " 60$n#2FC26001" "$trace" || fail "node $n: no SDO write 0x60C2:1"
+  has "60$n#23001A0110004160" || fail "node $n: no TPDO1 mapping entry statusword"
+  has "60$n#23001A0220006460" || fail "node $n: no TPDO1 mapping entry position actual"
+  has "60$n#2B17100064000000" || fail "node $n: no heartbeat producer write"
+  has "000#010$n" || fail "no NMT start of node $n"
+  ! grep -q " 58$n#80" "$trace" || fail "node $n: an SDO transfer was aborted: $(grep " 58$n#80" "$trace" | head -1)"
+done
+# SYNC at the period (mean interval; the VM's timing is loose, so be generous).
+awk -v p="$cycle_us" '$2 == "080#" { if (last != "") { s += ($1 - last); n++ } last = $1 }
+  END { if (n < 100) { print "only " n " SYNC intervals"; exit 1 }
+        m = s / n * 1e6; printf "vcan-check: %d SYNCs, mean interval %.0f us (period %d us)\n", n + 1, m, p
+        if (m < 0.8 * p || m > 3 * p) { print "mean SYNC interval out of range"; exit 1 } }' "$frames" ||
+  fail "SYNC period check failed"
+# One RPDO and one TPDO per node per cycle while operational: count them between
+# the first and the last TPDO of each node and compare with the SYNCs there.
+for n in 2 3; do
+  awk -v r="20$n" -v tp="18$n" '
+    { split($2, a, "#"); id = a[1] }
+    id == tp { if (first == "") first = NR; last = NR }
+    { ids[NR] = id }
+    END {
+      for (i = first; i <= last; i++) { if (ids[i] == "080") s++; if (ids[i] == r) rp++; if (ids[i] == tp) t++ }
+      printf "vcan-check: node %s: %d SYNC, %d RPDO, %d TPDO while operational\n", substr(tp, 3), s, rp, t
+      if (s < 100 || rp < s - 2 || rp > s + 2 || t < s - 2 || t > s + 2) { print "not one RPDO and one TPDO per cycle"; exit 1 }
+    }' "$frames" || fail "node $n: PDO count check failed"
+done
+# The raw cansend upload of 0x1000 and the emulator's expedited reply.
+grep -n ' 602#4000100000000000$' "$trace" >/dev/null || fail "the cansend request is not in the trace"
+awk '$3 == "602#4000100000000000" { req = NR } req && NR > req && $3 == "582#4300100092010200" { ok = 1 }
+  END { exit ok ? 0 : 1 }' "$trace" || fail "no reply 582#4300100092010200 to the 0x1000 upload"
+echo "vcan-check: boot-up, SDO configuration, NMT start, SYNC period, PDOs per cycle and the raw SDO upload all present"
