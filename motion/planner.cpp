@@ -162,6 +162,11 @@ Err decode_dynamics(const Request& r, int is, const AxisConfig& cfg, double last
 
 Planner::Planner(double cycle_period) noexcept : T_(cycle_period > 0 ? cycle_period : 0.001) { (void)idx(); }
 
+std::uint32_t Planner::reset_grace_cycles() const noexcept {
+  // 100 ms (at least 3 cycles) for the drive to leave Fault after a reset
+  return std::max<std::uint32_t>(3, static_cast<std::uint32_t>(0.1 / T_));
+}
+
 bool Planner::configure_axis(AxisId id, const AxisConfig& cfg) noexcept {
   if (id >= kMaxAxes) return false;
   if (!(cfg.conversion_constant > 0) || (cfg.rotary && !(cfg.unwind > 0)) || cfg.max_speed < 0 ||
@@ -425,6 +430,7 @@ Err Planner::start_masr(const Request& r, AxisRt& a) noexcept {
   a.tag.exception_faults = 0;
   a.tag.motion_fault_status = 0;
   a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
+  a.reset_grace = a.fault_reset_pulse ? reset_grace_cycles() : 0;
   controls_[r.control].set(flag::DN, true);
   return Err::None;
 }
@@ -436,6 +442,7 @@ Err Planner::start_mafr(const Request& r, AxisRt& a) noexcept {
   a.tag.exception_faults = 0;
   a.tag.motion_fault_status = 0;
   a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
+  a.reset_grace = a.fault_reset_pulse ? reset_grace_cycles() : 0;
   controls_[r.control].set(flag::DN, true);
   return Err::None;
 }
@@ -832,6 +839,7 @@ Err Planner::start_group(const Request& r, std::int8_t& exerr) noexcept {
         a.tag.exception_faults = 0;
         a.tag.motion_fault_status = 0;
         a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
+        a.reset_grace = a.fault_reset_pulse ? reset_grace_cycles() : 0;
       }
     }
     c.set(flag::DN, true);
@@ -943,7 +951,10 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
   std::uint32_t active = 0;
   auto bit = [](ExceptionKind k) { return 1u << static_cast<unsigned>(k); };
   if (a.cfg.type == AxisType::CipDrive) {
-    if (a.fb.drive_fault || a.fb.drive == DriveState::Fault) active |= bit(ExceptionKind::DriveFault);
+    const bool drive_fault = a.fb.drive_fault || a.fb.drive == DriveState::Fault;
+    // after a fault reset the drive needs a few cycles to leave Fault
+    if (a.reset_grace > 0) a.reset_grace = drive_fault ? a.reset_grace - 1 : 0;
+    if (drive_fault && a.reset_grace == 0) active |= bit(ExceptionKind::DriveFault);
     if (a.fb.node_lost) active |= bit(ExceptionKind::NodeLost);
     if (a.fb.bus_off) active |= bit(ExceptionKind::BusOff);
     if (a.servo && a.cfg.position_error_tolerance > 0 &&

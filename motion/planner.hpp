@@ -214,6 +214,7 @@ class Planner {
     bool faulted = false;       ///< StopDrive/Shutdown fault latched: ERR 20 until MAFR/MASR
     bool homed = false;
     bool fault_reset_pulse = false;
+    std::uint32_t reset_grace = 0;  ///< cycles during which a drive fault is not re-latched after a fault reset
     std::array<Generator, kSlots> gen{};
     double last_speed = 0.0;    ///< last non-zero programmed speed (zero-speed S-curve rule)
     // multi-cycle state instructions
@@ -254,6 +255,7 @@ class Planner {
   void step_axis(AxisRt& a, AxisOutput* out) noexcept;
   void step_gear(GearGen& g) noexcept;
   void compute_order() noexcept;
+  std::uint32_t reset_grace_cycles() const noexcept;
   void handle_feedback(AxisId id, AxisRt& a, const AxisFeedback* fb) noexcept;
   void handle_exceptions(AxisRt& a) noexcept;
   void fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept;

@@ -74,6 +74,27 @@ void BM_StepMoveTrapezoidal(benchmark::State& st) { step_bench(st, "trapezoidal"
 void BM_StepMoveSCurve(benchmark::State& st) { step_bench(st, "scurve"); }
 void BM_StepJog(benchmark::State& st) { step_bench(st, "jog"); }
 
+// MAG: half the axes are virtual masters jogging, each other axis is geared to one
+void gear_bench(benchmark::State& st, bool fractional) {
+  Bench b;
+  for (int i = 0; i < kAxes; i += 2) {
+    const std::string m = "a" + std::to_string(i), s = "a" + std::to_string(i + 1);
+    b.run("MAJ(" + m + ", mv" + std::to_string(i) +
+          ", 0, 100, unitspersec, 1000, unitspersec2, 1000, unitspersec2, trapezoidal, 0, 0, unitspersec3, disabled, programmed, 0, none);");
+    b.run("MAG(" + s + ", " + m + ", mv" + std::to_string(i + 1) + ", same, 0.5, 1, 3, command, " +
+          (fractional ? "fraction_slave_master_counts" : "real") + ", disabled, 0, unitspersec2);");
+  }
+  b.step();
+  for (auto _ : st) {
+    b.step();
+    benchmark::DoNotOptimize(b.out[1].position);
+  }
+  st.counters["ns_per_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes),
+                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+void BM_StepGearReal(benchmark::State& st) { gear_bench(st, false); }
+void BM_StepGearFractional(benchmark::State& st) { gear_bench(st, true); }
+
 // plan_move for an S-curve from a moving state (a merge): the planning maths alone
 void BM_PlanSCurveMoveFromMotion(benchmark::State& st) {
   Limits l{100, 1000, 800, 20000, 15000};
@@ -134,6 +155,8 @@ void BM_ParseAndBindMam(benchmark::State& st) {
 BENCHMARK(BM_StepMoveTrapezoidal);
 BENCHMARK(BM_StepMoveSCurve);
 BENCHMARK(BM_StepJog);
+BENCHMARK(BM_StepGearReal);
+BENCHMARK(BM_StepGearFractional);
 BENCHMARK(BM_PlanSCurveMoveFromMotion);
 BENCHMARK(BM_PlanSCurveMoveRestToRest);
 BENCHMARK(BM_StartSCurveMam);

@@ -253,7 +253,13 @@ TEST(RtSetup, RealSyscallsOnAThread) {
   s.lock_memory = false;  // would lock the whole test process
   s.prefault_stack_bytes = 128 * 1024;
   s.priority = 10;
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  ASSERT_EQ(sched_getaffinity(0, sizeof(allowed), &allowed), 0);
   s.cpu = 0;
+  while (s.cpu < CPU_SETSIZE && !CPU_ISSET(s.cpu, &allowed)) {
+    ++s.cpu;  // the first CPU this process may use (containers restrict the set)
+  }
   RtSetupReport r;
   int policy = -1;
   sched_param param{};

@@ -67,7 +67,11 @@ bool draw_plot(const std::string& out, const std::vector<PlotSeries>& all, const
   }
   g += "set output " + q(out) + "\n";
   g += "set datafile separator ','\nset datafile missing ''\n";
-  g += "set grid xtics ytics lc rgb '#dddddd'\nset border lw 1\nset key top left box opaque\n";
+  g += "set grid xtics ytics lc rgb '#dddddd'\nset border lw 1\nset lmargin 12\nset rmargin 3\nset key at graph 1, graph 1.02 right bottom horizontal nobox\n";
+  // One time axis for every time panel, so they line up.
+  if (jitter != nullptr && jitter->bus().t_last > jitter->bus().t_first) {
+    g += fmt::format("set xrange [0:{:.9f}]\n", static_cast<double>(jitter->bus().t_last - jitter->bus().t_first) / 1e9);
+  }
   g += "set format y '%.6g'\n";
   g += fmt::format("set multiplot layout {},1 title 'cantrace: positions, following error and SYNC jitter' font ',13'\n", rows);
   for (const PlotSeries& s : series) {
@@ -93,7 +97,7 @@ bool draw_plot(const std::string& out, const std::vector<PlotSeries>& all, const
                      esc(fmt::format("{}: SYNC period jitter ({} periods, nominal {:.1f} us from {}, {} outside the range)",
                                      jitter_iface, b.period_ns.n, static_cast<double>(b.nominal_period_ns) / 1000.0,
                                      b.nominal_source, b.jitter.below + b.jitter.above)));
-    g += "set xlabel 'SYNC period - nominal period [us]'\nset ylabel 'SYNC periods'\n";
+    g += "set xlabel 'SYNC period - nominal period [us]'\nset ylabel 'SYNC periods'\nset xrange [*:*]\n";
     g += "set datafile separator whitespace\nset style fill solid 0.6 border -1\nset yrange [0:*]\n";
     g += fmt::format("set boxwidth {:.3f}\n", static_cast<double>(b.jitter.bin_width_ns) / 1000.0 * 0.9);
     g += fmt::format("plot {} using 1:2 with boxes lc rgb '#9467bd' title 'periods per bin'\n", q(jitter_dat));

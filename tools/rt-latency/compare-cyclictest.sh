@@ -2,6 +2,8 @@
 # Side-by-side wake-up latency of canmotion's cyclic executive (rt-latency)
 # and cyclictest (rt-tests) at the same period and priority, in one run.
 # Prints p50/p99/p99.9/max of both and the ratio rt-latency / cyclictest.
+# With -x, any program that prints canmotion's statistics summary (e.g.
+# canmotiond --stats) is measured instead of rt-latency.
 set -euo pipefail
 
 usage() {
@@ -18,6 +20,10 @@ Options:
   -l LOOPS       cycles per program (default 20000)
   -m MODE        parallel (both at once, same load; default) or sequential
   -b PATH        rt-latency binary (default: build*/tools/rt-latency/rt-latency)
+  -x 'COMMAND'   measure COMMAND instead of rt-latency: any program that prints
+                 canmotion's statistics summary (rt::format_summary), e.g.
+                 'canmotiond --config demo.yaml --duration 20 --stats --quiet'
+                 (give it the same period and priority as -i/-p)
   -o DIR         keep the raw outputs in DIR (default: a temporary folder)
   -h             this help
 
@@ -29,18 +35,20 @@ upper edge of its log-linear bucket (at most 1/64 above the exact value).
 USAGE
 }
 
-interval=1000 prio=80 loops=20000 mode=parallel bin="" outdir=""
-while getopts "i:p:l:m:b:o:h" opt; do
+interval=1000 prio=80 loops=20000 mode=parallel bin="" outdir="" cmd=""
+while getopts "i:p:l:m:b:o:x:h" opt; do
   case $opt in
     i) interval=$OPTARG ;; p) prio=$OPTARG ;; l) loops=$OPTARG ;; m) mode=$OPTARG ;;
-    b) bin=$OPTARG ;; o) outdir=$OPTARG ;; h) usage; exit 0 ;; *) usage >&2; exit 1 ;;
+    b) bin=$OPTARG ;; o) outdir=$OPTARG ;; x) cmd=$OPTARG ;; h) usage; exit 0 ;; *) usage >&2; exit 1 ;;
   esac
 done
 here=$(cd "$(dirname "$0")" && pwd)
 if [[ -z $bin ]]; then
   bin=$(ls -t "$here"/../../build*/tools/rt-latency/rt-latency 2>/dev/null | head -1 || true)
 fi
-[[ -x $bin ]] || { echo "compare-cyclictest.sh: rt-latency not found (build it, or pass -b PATH)" >&2; exit 1; }
+if [[ -z $cmd ]]; then
+  [[ -x $bin ]] || { echo "compare-cyclictest.sh: rt-latency not found (build it, or pass -b PATH)" >&2; exit 1; }
+fi
 command -v cyclictest >/dev/null || { echo "compare-cyclictest.sh: cyclictest not found (apt install rt-tests)" >&2; exit 1; }
 [[ $mode == parallel || $mode == sequential ]] || { echo "compare-cyclictest.sh: -m parallel|sequential" >&2; exit 1; }
 if [[ -z $outdir ]]; then outdir=$(mktemp -d); fi
@@ -48,10 +56,16 @@ mkdir -p "$outdir"
 
 histmax=$(( interval * 20 ))  # cyclictest histogram range in us; beyond it counts as overflow
 ct_cmd=(cyclictest -m -p "$prio" -i "$interval" -l "$loops" -q -h "$histmax")
-rl_cmd=("$bin" -q -p "$prio" -i "$interval" -l "$loops" --histogram "$outdir/rt-latency.hist")
+if [[ -n $cmd ]]; then
+  read -r -a rl_cmd <<<"$cmd"
+  name=$(basename "${rl_cmd[0]}")
+else
+  rl_cmd=("$bin" -q -p "$prio" -i "$interval" -l "$loops" --histogram "$outdir/rt-latency.hist")
+  name=rt-latency
+fi
 echo "# $(date -u +%FT%TZ) $(uname -r), $(nproc) CPUs, mode $mode"
 echo "# cyclictest: ${ct_cmd[*]}"
-echo "# rt-latency: ${rl_cmd[*]}"
+echo "# $name: ${rl_cmd[*]}"
 if [[ $mode == parallel ]]; then
   "${ct_cmd[@]}" >"$outdir/cyclictest.txt" 2>&1 &
   ct_pid=$!
@@ -80,14 +94,19 @@ read -r ct_p50 ct_p99 ct_p999 ct_max ct_n < <(awk -v hm="$histmax" '
     print out[1], out[2], out[3], max, total
   }' "$outdir/cyclictest.txt")
 
-result=$(grep '^RESULT' "$outdir/rt-latency.txt") || { cat "$outdir/rt-latency.txt" >&2; exit 1; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$result"; }
-rl_p50=$(field p50_us) rl_p99=$(field p99_us) rl_p999=$(field p999_us) rl_max=$(field max_us) rl_n=$(field cycles)
+# The measured program prints rt::format_summary():
+#   cycles N  overruns ...
+#   latency  min A  mean B  p50 C  p99 D  p99.9 E  max F us
+summary=$(grep -E '^(cycles [0-9]+ |latency  min )' "$outdir/rt-latency.txt" | tail -2) \
+  || { echo "compare-cyclictest.sh: no statistics summary in the output of $name:" >&2; cat "$outdir/rt-latency.txt" >&2; exit 1; }
+kw() { awk -v k="$1" '{ for (i = 1; i < NF; i++) if ($i == k) { print $(i + 1); exit } }' <<<"$summary"; }
+rl_p50=$(kw p50) rl_p99=$(kw p99) rl_p999=$(kw p99.9) rl_max=$(kw max) rl_n=$(kw cycles)
+[[ -n $rl_p99 ]] || { echo "compare-cyclictest.sh: cannot parse: $summary" >&2; exit 1; }
 
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b + 0 > 0) printf "%.2f", a / b; else print "n/a" }'; }
 printf '\n%-12s %10s %10s %10s %10s %8s\n' "program" "p50_us" "p99_us" "p99.9_us" "max_us" "cycles"
 printf '%-12s %10s %10s %10s %10s %8s\n' cyclictest "$ct_p50" "$ct_p99" "$ct_p999" "$ct_max" "$ct_n"
-printf '%-12s %10s %10s %10s %10s %8s\n' rt-latency "$rl_p50" "$rl_p99" "$rl_p999" "$rl_max" "$rl_n"
-printf '%-12s %10s %10s %10s %10s\n' "ratio rt/ct" "$(ratio "$rl_p50" "$ct_p50")" "$(ratio "$rl_p99" "$ct_p99")" \
+printf '%-12s %10s %10s %10s %10s %8s\n' "$name" "$rl_p50" "$rl_p99" "$rl_p999" "$rl_max" "$rl_n"
+printf '%-12s %10s %10s %10s %10s\n' "ratio" "$(ratio "$rl_p50" "$ct_p50")" "$(ratio "$rl_p99" "$ct_p99")" \
   "$(ratio "$rl_p999" "$ct_p999")" "$(ratio "$rl_max" "$ct_max")"
 echo "# raw outputs: $outdir"
