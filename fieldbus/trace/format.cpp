@@ -243,7 +243,11 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
 }
 
 void describe_pdo(const Decoded& d, fmt::memory_buffer& out) {
-  fmt::format_to(fmt::appender(out), "{}{} node {}: ", d.pdo_tx ? "TPDO" : "RPDO", d.pdo_number, d.node);
+  put(out, d.pdo_tx ? "TPDO" : "RPDO");
+  put_dec(out, d.pdo_number);
+  put(out, " node ");
+  put_dec(out, d.node);
+  put(out, ": ");
   if (d.layout == LayoutSource::kNone || d.tf.frame.remote()) {
     if (d.tf.frame.remote()) {
       put(out, "remote request");

@@ -31,7 +31,9 @@ awk -v p="$cycle_us" '$2 == "080#" { if (last != "") { s += ($1 - last); n++ } l
 # One RPDO and one TPDO per node per cycle while operational: count them between
 # the first and the last TPDO of each node and compare with the SYNCs there.
 for n in 2 3; do
+  # (only the master program's part: up to the raw cansend requests)
   awk -v r="20$n" -v tp="18$n" '
+    $2 == "602#4000100000000000" { exit }
     { split($2, a, "#"); id = a[1] }
     id == tp { if (first == "") first = NR; last = NR }
     { ids[NR] = id }
@@ -45,4 +47,8 @@ done
 grep -n ' 602#4000100000000000$' "$trace" >/dev/null || fail "the cansend request is not in the trace"
 awk '$3 == "602#4000100000000000" { req = NR } req && NR > req && $3 == "582#4300100092010200" { ok = 1 }
   END { exit ok ? 0 : 1 }' "$trace" || fail "no reply 582#4300100092010200 to the 0x1000 upload"
-echo "vcan-check: boot-up, SDO configuration, NMT start, SYNC period, PDOs per cycle and the raw SDO upload all present"
+# The cansend-only master: node 3 rebooted, was enabled and reached 100100.
+awk '$3 == "000#8103" { r = NR } r && NR > r && $3 == "703#00" { b = 1 } b && $3 == "183#371204870100" { ok = 1 }
+  END { exit ok ? 0 : 1 }' "$trace" ||
+  fail "node 3 driven by plain cansend did not report Operation enabled at 100100 (183#371204870100)"
+echo "vcan-check: boot-up, SDO configuration, NMT start, SYNC period, PDOs per cycle, the raw SDO upload and the cansend-only CSP move all present"
