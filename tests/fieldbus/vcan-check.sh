@@ -23,13 +23,16 @@ for n in 2 3; do
   ! grep -q " 58$n#80" "$trace" || fail "node $n: an SDO transfer was aborted: $(grep " 58$n#80" "$trace" | head -1)"
 done
 # SYNC at the period (mean interval; the VM's timing is loose, so be generous).
-awk -v p="$cycle_us" '$2 == "080#" { if (last != "") { s += ($1 - last); n++ } last = $1 }
+# (the master program's part only: up to the raw cansend requests)
+awk -v p="$cycle_us" '$2 == "602#4000100000000000" { exit } $2 == "080#" { if (last != "") { s += ($1 - last); n++ } last = $1 }
   END { if (n < 100) { print "only " n " SYNC intervals"; exit 1 }
         m = s / n * 1e6; printf "vcan-check: %d SYNCs, mean interval %.0f us (period %d us)\n", n + 1, m, p
         if (m < 0.8 * p || m > 3 * p) { print "mean SYNC interval out of range"; exit 1 } }' "$frames" ||
   fail "SYNC period check failed"
 # One RPDO and one TPDO per node per cycle while operational: count them between
-# the first and the last TPDO of each node and compare with the SYNCs there.
+# the first and the last TPDO of each node and compare with the SYNCs there
+# (+-5 for the window edges: under emulation candump may log a TPDO a few
+# microseconds before the SYNC it answers).
 for n in 2 3; do
   # (only the master program's part: up to the raw cansend requests)
   awk -v r="20$n" -v tp="18$n" '
@@ -40,7 +43,7 @@ for n in 2 3; do
     END {
       for (i = first; i <= last; i++) { if (ids[i] == "080") s++; if (ids[i] == r) rp++; if (ids[i] == tp) t++ }
       printf "vcan-check: node %s: %d SYNC, %d RPDO, %d TPDO while operational\n", substr(tp, 3), s, rp, t
-      if (s < 100 || rp < s - 2 || rp > s + 2 || t < s - 2 || t > s + 2) { print "not one RPDO and one TPDO per cycle"; exit 1 }
+      if (s < 100 || rp < s - 5 || rp > s + 5 || t < s - 5 || t > s + 5) { print "not one RPDO and one TPDO per cycle"; exit 1 }
     }' "$frames" || fail "node $n: PDO count check failed"
 done
 # The raw cansend upload of 0x1000 and the emulator's expedited reply.
