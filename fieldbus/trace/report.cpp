@@ -37,7 +37,7 @@ std::string_view kind_label(std::size_t k) {
 double us(double ns) { return ns / 1000.0; }
 
 std::string_view emcy_text(std::uint16_t code) {
-  return code == 0 ? std::string_view{"error reset / no error"} : co::emcy_code_text(code);
+  return co::emcy_code_text(code);
 }
 
 void node_label(Out& out, std::uint8_t n, const NodeSettings& s) {
