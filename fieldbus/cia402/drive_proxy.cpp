@@ -389,6 +389,8 @@ void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
     return;
   }
   if (state_ != State::kOperationEnabled) follow_actual();
+  // A quick stop with 0x605A = 0..4 completes in Switch on disabled (12).
+  if (wanted_ == State::kQuickStopActive && state_ == State::kSwitchOnDisabled) wanted_ = State::kSwitchOnDisabled;
   if (state_ == wanted_) {
     in_flight_ = false;
     reset_requested_ = false;

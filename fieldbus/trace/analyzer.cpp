@@ -31,6 +31,19 @@ double NodeSummary::ferr_rms() const noexcept {
   return ferr_count != 0 ? std::sqrt(ferr_sum_sq / static_cast<double>(ferr_count)) : 0.0;
 }
 
+double NodeSummary::lag_rms(std::size_t lag) const noexcept {
+  return lag < kLagFit && lag_count[lag] != 0 ? std::sqrt(lag_sum_sq[lag] / static_cast<double>(lag_count[lag])) : 0.0;
+}
+
+std::size_t NodeSummary::best_lag() const noexcept {
+  std::size_t best = kLagFit;
+  for (std::size_t l = 0; l < kLagFit; ++l) {
+    if (lag_count[l] == 0) continue;
+    if (best == kLagFit || lag_rms(l) < lag_rms(best)) best = l;
+  }
+  return best;
+}
+
 std::uint32_t frame_bits_worst_case(const can::Frame& f) noexcept {
   if (f.error()) return 0;  // reported by the controller, not a frame on the wire
   const std::uint32_t s = f.remote() ? 0U : std::min<std::uint32_t>(f.len, 8U);
@@ -330,6 +343,15 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
       ns.ferr_max_abs = a;
       ns.ferr_at_max = s.following_error;
       ns.ferr_t_max = t;
+    }
+  }
+  if (d.has_actual && l.has_sw && l.state == cia402::State::kOperationEnabled) {
+    const auto n = static_cast<std::uint32_t>(l.history.size());
+    for (std::uint32_t lag = 0; lag < NodeSummary::kLagFit && lag < l.history_len; ++lag) {
+      const std::int64_t e = l.history[(l.history_head + n - lag) % n] - d.actual_position;
+      ++ns.lag_count[lag];
+      ns.lag_sum_sq[lag] += static_cast<double>(e) * static_cast<double>(e);
+      ns.lag_max_abs[lag] = std::max(ns.lag_max_abs[lag], e < 0 ? -e : e);
     }
   }
   if (sample != nullptr) *sample = s;

@@ -123,6 +123,15 @@ struct NodeSummary {
   std::int64_t ferr_at_max = 0;       ///< signed value at the maximum
   std::int64_t ferr_t_max = 0;
   [[nodiscard]] double ferr_rms() const noexcept;
+  /// The same statistics for lags 0..kLagFit-1 SYNC cycles, to tell which
+  /// lag the drive actually has (see AnalyzerOptions::ferr_lag_cycles).
+  static constexpr std::size_t kLagFit = 4;
+  std::array<std::uint64_t, kLagFit> lag_count{};
+  std::array<double, kLagFit> lag_sum_sq{};
+  std::array<std::int64_t, kLagFit> lag_max_abs{};
+  [[nodiscard]] double lag_rms(std::size_t lag) const noexcept;
+  /// Lag with the smallest RMS following error (kLagFit if no samples).
+  [[nodiscard]] std::size_t best_lag() const noexcept;
 };
 
 struct ErrorFrameRecord {

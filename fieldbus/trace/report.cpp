@@ -252,6 +252,13 @@ void format_summary_text(std::string_view iface, const Analyzer& a, const Report
                        s.unit.empty() ? "units" : s.unit, ns.ferr_rms() / s.counts_per_unit, s.unit.empty() ? "units" : s.unit);
       }
       put(out, "\n");
+      const std::size_t best = ns.best_lag();
+      if (best < NodeSummary::kLagFit && best != ao.ferr_lag_cycles && ns.lag_rms(best) < ns.ferr_rms()) {
+        fmt::format_to(fmt::appender(out),
+                       "  note: the actual position matches the target applied {} SYNC(s) earlier better "
+                       "(max |e| {} counts, RMS {:.2f} counts): try --lag {}\n",
+                       best, ns.lag_max_abs[best], ns.lag_rms(best), best);
+      }
     }
   }
 }
@@ -379,6 +386,12 @@ void format_summary_json(std::string_view iface, const Analyzer& a, const Report
       put(out, ",\"t_max\":");
       t(ns.ferr_t_max);
     }
+    fmt::format_to(fmt::appender(out), ",\"lag_cycles\":{},\"lag_fit\":[", ao.ferr_lag_cycles);
+    for (std::size_t l = 0; l < NodeSummary::kLagFit; ++l) {
+      fmt::format_to(fmt::appender(out), "{}{{\"lag\":{},\"samples\":{},\"max_abs_counts\":{},\"rms_counts\":{:.3f}}}", l ? "," : "", l,
+                     ns.lag_count[l], ns.lag_max_abs[l], ns.lag_rms(l));
+    }
+    put(out, "]");
     if (s.counts_per_unit > 0) {
       fmt::format_to(fmt::appender(out), ",\"unit\":");
       append_json_string(out, s.unit);
