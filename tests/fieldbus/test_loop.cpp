@@ -322,3 +322,38 @@ TEST(Loop, EmulatorFailAfterNSyncs) {
   EXPECT_EQ(rig.emulator(2).counters().syncs, 302u);
   EXPECT_EQ(d.last_emcy_code(), 0x4310);
 }
+
+TEST(Loop, HomingMethod35SetsHomeOffset) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.initial_position = 777;
+  cfg.drive.extra_writes = {cia402::SdoWrite{0x607C, 0, 4, 5000}, cia402::SdoWrite{0x6098, 0, 1, 35}};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  EXPECT_FALSE(d.start_homing());  // CSP: not homing
+  ASSERT_TRUE(d.set_mode(cia402::Mode::kHoming));
+  ASSERT_TRUE(rig.run_until([&] { return rig.emulator(2).mode_display() == 6; }, 50));
+  ASSERT_TRUE(d.start_homing());
+  ASSERT_TRUE(rig.run_until([&] { return d.homing_status() == cia402::HomingStatus::kCompleted; }, 50));
+  EXPECT_EQ(d.feedback().position, 5000);
+  for (int i = 0; i < 3; ++i) rig.step();
+  EXPECT_EQ(d.controlword() & cia402::cw::kHomingStart, 0);  // bit 4 released after completion
+  EXPECT_TRUE(d.enabled());
+}
+
+TEST(Loop, HomingSearchMovesToTheSwitch) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.initial_position = 2000;
+  cfg.drive.mode = cia402::Mode::kHoming;
+  cfg.drive.extra_writes = {cia402::SdoWrite{0x6098, 0, 1, 17}, cia402::SdoWrite{0x6099, 1, 4, 100'000}};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(d.start_homing());
+  for (int i = 0; i < 5; ++i) rig.step();
+  EXPECT_EQ(d.homing_status(), cia402::HomingStatus::kInProgress);
+  ASSERT_TRUE(rig.run_until([&] { return d.homing_status() == cia402::HomingStatus::kCompleted; }, 200));
+  EXPECT_EQ(d.feedback().position, 0);  // home offset 0
+}
