@@ -176,6 +176,9 @@ void Analyzer::on_sync(const Decoded& d, const Decoder& decoder) {
   for (std::uint8_t n = 1; n <= kMaxNode; ++n) {
     Live& l = live_[n];
     if (!l.producing) continue;
+    // Misses of earlier cycles not made up by late TPDOs in this cycle are final.
+    if (l.tpdos_this_cycle != 0) l.unconfirmed_missing = 0;
+    l.tpdos_this_cycle = 0;
     ++l.syncs_since_tpdo;
     std::uint8_t every = 1;
     const std::uint8_t tt = decoder.tpdo_transmission_type(n, 1);
@@ -191,6 +194,7 @@ void Analyzer::on_sync(const Decoded& d, const Decoder& decoder) {
     ++ns.missing_tpdo;
     if (ns.missing_times.size() < opt_.list_cap) ns.missing_times.push_back(last_sync_);
     l.syncs_since_tpdo = every;  // count each silent cycle once
+    if (every == 1 && l.unconfirmed_missing < 8) ++l.unconfirmed_missing;
   }
   const std::uint32_t lag = std::min(opt_.ferr_lag_cycles, AnalyzerOptions::kMaxLag);
   for (Live& l : live_) {
@@ -289,6 +293,14 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
       if (d.pdo_tx) {
         ++ns.tpdos;
         if (d.pdo_number == 1) {
+          if (l.tpdos_this_cycle != 0 && l.unconfirmed_missing != 0) {
+            // A second TPDO in one cycle: the one counted missing came late.
+            --l.unconfirmed_missing;
+            if (ns.missing_tpdo <= ns.missing_times.size() && !ns.missing_times.empty()) ns.missing_times.pop_back();
+            --ns.missing_tpdo;
+            ++ns.late_tpdo;
+          }
+          ++l.tpdos_this_cycle;
           l.producing = true;
           l.syncs_since_tpdo = 0;
         }

@@ -115,7 +115,8 @@ struct NodeSummary {
   std::vector<AbortRecord> aborts;
   std::uint64_t abort_count = 0;
   std::uint64_t syncs_checked = 0;   ///< SYNC cycles in which a TPDO was expected
-  std::uint64_t missing_tpdo = 0;    ///< of those, cycles without a TPDO
+  std::uint64_t missing_tpdo = 0;    ///< of those, cycles without a TPDO (late ones excluded)
+  std::uint64_t late_tpdo = 0;       ///< TPDOs that came one cycle late (two in the next cycle)
   std::vector<std::int64_t> missing_times;  ///< SYNC times that got no TPDO (capped)
   std::uint64_t ferr_count = 0;
   double ferr_sum_sq = 0;
@@ -208,6 +209,8 @@ class Analyzer {
     std::uint32_t history_head = 0;
     bool producing = false;      // TPDOs expected on SYNC
     std::uint32_t syncs_since_tpdo = 0;
+    std::uint32_t tpdos_this_cycle = 0;     // TPDO1s since the last SYNC
+    std::uint32_t unconfirmed_missing = 0;  // misses a late TPDO may still make up
     canopen::NmtState nmt = canopen::NmtState::kUnknown;
   };
   void on_sync(const Decoded& d, const Decoder& decoder);

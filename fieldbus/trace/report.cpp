@@ -226,7 +226,9 @@ void format_summary_text(std::string_view iface, const Analyzer& a, const Report
                        r.code, co::sdo_abort_text(r.code), r.by_server ? "by drive" : "by master");
       }
     }
-    fmt::format_to(fmt::appender(out), "SYNC cycles without TPDO: {} of {} checked\n", ns.missing_tpdo, ns.syncs_checked);
+    fmt::format_to(fmt::appender(out), "SYNC cycles without TPDO: {} of {} checked", ns.missing_tpdo, ns.syncs_checked);
+    if (ns.late_tpdo != 0) fmt::format_to(fmt::appender(out), " ({} more TPDOs came late, in the next cycle)", ns.late_tpdo);
+    put(out, "\n");
     for (std::size_t i = 0; i < ns.missing_times.size() && i < 10; ++i) {
       put(out, "    after SYNC at ");
       time_at(out, opt, ns.missing_times[i], t0);
@@ -374,8 +376,8 @@ void format_summary_json(std::string_view iface, const Analyzer& a, const Report
       append_json_string(out, co::sdo_abort_text(r.code));
       put(out, "}");
     }
-    fmt::format_to(fmt::appender(out), "],\"syncs_checked\":{},\"missing_tpdo\":{},\"missing_tpdo_times\":[", ns.syncs_checked,
-                   ns.missing_tpdo);
+    fmt::format_to(fmt::appender(out), "],\"syncs_checked\":{},\"missing_tpdo\":{},\"late_tpdo\":{},\"missing_tpdo_times\":[", ns.syncs_checked,
+                   ns.missing_tpdo, ns.late_tpdo);
     for (std::size_t i = 0; i < ns.missing_times.size(); ++i) {
       if (i) out.push_back(',');
       t(ns.missing_times[i]);

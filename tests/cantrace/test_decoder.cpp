@@ -392,3 +392,29 @@ TEST(TraceAnalyzer, LagFitFindsTheDriveDelay) {
     EXPECT_EQ(n.ferr_max_abs, lag == 1 ? 0 : 100) << "lag " << lag;
   }
 }
+
+// A TPDO that misses its cycle but arrives in the next one (two TPDOs there)
+// is counted as late, not missing; a TPDO that never comes stays missing.
+TEST(TraceAnalyzer, LateTpdoIsNotMissing) {
+  tr::Decoder dec;
+  tr::Analyzer an{tr::AnalyzerOptions{}};
+  std::int64_t t = 0;
+  for (int k = 0; k < 20; ++k) {
+    an.feed(dec.decode(tf(0x080, {}, t)), dec, nullptr);
+    if (k == 5) {
+      // nothing in cycle 5 ...
+    } else if (k == 6) {
+      // ... and two in cycle 6: the first was late
+      an.feed(dec.decode(tf(0x181, {0x37, 0x02, 0, 0, 0, 0}, t + 1000)), dec, nullptr);
+      an.feed(dec.decode(tf(0x181, {0x37, 0x02, 0, 0, 0, 0}, t + 2000)), dec, nullptr);
+    } else if (k != 12) {  // cycle 12: lost for good
+      an.feed(dec.decode(tf(0x181, {0x37, 0x02, 0, 0, 0, 0}, t + 1000)), dec, nullptr);
+    }
+    t += 1'000'000;
+  }
+  an.finish(dec);
+  EXPECT_EQ(an.node(1).late_tpdo, 1U);
+  EXPECT_EQ(an.node(1).missing_tpdo, 1U);
+  ASSERT_EQ(an.node(1).missing_times.size(), 1U);
+  EXPECT_EQ(an.node(1).missing_times[0], 12'000'000);
+}
