@@ -388,6 +388,10 @@ Err Planner::start_mso(const Request& r, AxisRt& a) noexcept {
     c.set(flag::DN, true);
     return Err::None;
   }
+  // [RM002H p.78] ERR 22 if the (servo-off) axis is moving: a drive coasting
+  // faster than 0.1 % of max speed (at least 1e-6 units/s)
+  if (a.cfg.type == AxisType::CipDrive && std::fabs(a.fb_vel) > std::max(1e-6, 1e-3 * a.cfg.max_speed))
+    return Err::AxisInMotion;
   a.enable_req = true;
   if (a.cfg.type == AxisType::Virtual) {
     a.servo = true;
