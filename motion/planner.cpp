@@ -1,5 +1,9 @@
 #include "motion/planner.hpp"
 
+#include <type_traits>
+
+#include "motion/instructions.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,8 +15,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// before ERR 12 (Servo Message Failure, EXERR 16 device in wrong state).
 constexpr double kDriveTimeout = 5.0;
 
-inline int ival(const Request& r, int i) noexcept { return static_cast<int>(r.op[static_cast<std::size_t>(i)].value); }
-inline double dval(const Request& r, int i) noexcept { return r.op[static_cast<std::size_t>(i)].value; }
 
 // Operand indices, looked up once in THE signature table (motion/signatures.cpp).
 struct Idx {
@@ -84,22 +86,22 @@ struct Dyn {
   double jerk_pct_a = 0, jerk_pct_d = 0;  // % of time (applied once the start speed is known)
 };
 
-Err decode_dynamics(const Request& r, int is, const AxisConfig& cfg, double last_speed, Dyn& d,
-                    std::int8_t& exerr) noexcept {
-  const int su = ival(r, is + 1), au = ival(r, is + 3), du = ival(r, is + 5);
-  const int prof = ival(r, is + 6), ju = ival(r, is + 9);
-  d.scurve = prof == 1;
-  d.merge = ival(r, is + 10) == 1;
-  d.merge_current = ival(r, is + 11) == 1;
-  const int lockdir = ival(r, is + 13);
+Err decode_dynamics(const Dynamics& y, const AxisConfig& cfg, double last_speed, Dyn& d, std::int8_t& exerr) noexcept {
+  const int is = y.first_operand;
+  const int su = y.speed_units, au = y.accel_units, du = y.decel_units;
+  const int ju = y.jerk_units;
+  d.scurve = y.profile == ProfileType::SCurve;
+  d.merge = y.merge == Merge::Enabled;
+  d.merge_current = y.merge_speed == MergeSpeed::Current;
+  const int lockdir = static_cast<int>(y.lock_direction);
   const bool md = is_master_driven(static_cast<std::uint8_t>(su));
   if (is_master_driven(static_cast<std::uint8_t>(au)) != md || is_master_driven(static_cast<std::uint8_t>(du)) != md ||
       (d.scurve && is_md_jerk(ju) != md))
     return Err::MdscUnitsConflict;
   if (md) return Err::MdscNotActivated;  // no MDAC link exists (issue 5)
   if (lockdir != 0) return Err::MdscLockDirConflict;  // time-driven needs LockDirection none
-  const double speed = dval(r, is), accel = dval(r, is + 2), decel = dval(r, is + 4);
-  const double ajerk = dval(r, is + 7), djerk = dval(r, is + 8);
+  const double speed = y.speed, accel = y.accel, decel = y.decel;
+  const double ajerk = y.accel_jerk, djerk = y.decel_jerk;
   if (su == 3 || au == 3 || du == 3 || (d.scurve && ju == 3)) {  // seconds: all or nothing
     if (su != 3) { exerr = static_cast<std::int8_t>(is + 1); return Err::ParameterOutOfRange; }
     if (au != 3) { exerr = static_cast<std::int8_t>(is + 3); return Err::ParameterOutOfRange; }
@@ -160,7 +162,10 @@ Err decode_dynamics(const Request& r, int is, const AxisConfig& cfg, double last
 
 }  // namespace
 
-Planner::Planner(double cycle_period) noexcept : T_(cycle_period > 0 ? cycle_period : 0.001) { (void)idx(); }
+Planner::Planner(double cycle_period) noexcept : T_(cycle_period > 0 ? cycle_period : 0.001) {
+  (void)idx();
+  init_instruction_tables();  // operand positions, looked up once outside the cycle
+}
 
 std::uint32_t Planner::reset_grace_cycles() const noexcept {
   // 100 ms (at least 3 cycles) for the drive to leave Fault after a reset
@@ -337,25 +342,29 @@ Err Planner::execute(const Request& r) noexcept {
     }
   }
   if (e == Err::None) {
-    const AxisId ax = r.op[0].ref;
-    switch (r.instr) {
-      case Instr::MSO: e = start_mso(r, axes_[ax]); break;
-      case Instr::MSF: e = start_msf(r, axes_[ax]); break;
-      case Instr::MASD: e = start_masd(r, axes_[ax]); break;
-      case Instr::MASR: e = start_masr(r, axes_[ax]); break;
-      case Instr::MAFR: e = start_mafr(r, axes_[ax]); break;
-      case Instr::MAS: e = start_mas(r, axes_[ax], exerr); break;
-      case Instr::MAH: e = start_mah(r, axes_[ax]); break;
-      case Instr::MAJ: e = start_maj(r, axes_[ax], exerr); break;
-      case Instr::MAM: e = start_mam(r, axes_[ax], exerr); break;
-      case Instr::MCD: e = start_mcd(r, axes_[ax], exerr); break;
-      case Instr::MRP: e = start_mrp(r, axes_[ax]); break;
-      case Instr::MAG: e = start_mag(r, axes_[ax], exerr); break;
-      case Instr::MGS:
-      case Instr::MGSD:
-      case Instr::MGSR: e = start_group(r, exerr); break;
-      default: e = Err::InstructionNotSupported; break;
-    }
+    // params (typed, from the table-checked request) -> the instruction's start
+    const Params prm = decode(r);
+    e = std::visit(
+        [&](const auto& p) noexcept -> Err {
+          using P = std::decay_t<decltype(p)>;
+          if constexpr (std::is_same_v<P, MsoParams>) return start_mso(r, axes_[p.axis]);
+          else if constexpr (std::is_same_v<P, MsfParams>) return start_msf(r, axes_[p.axis]);
+          else if constexpr (std::is_same_v<P, MasdParams>) return start_masd(r, axes_[p.axis]);
+          else if constexpr (std::is_same_v<P, MasrParams>) return start_masr(r, axes_[p.axis]);
+          else if constexpr (std::is_same_v<P, MafrParams>) return start_mafr(r, axes_[p.axis]);
+          else if constexpr (std::is_same_v<P, MahParams>) return start_mah(r, axes_[p.axis]);
+          else if constexpr (std::is_same_v<P, MasParams>) return start_mas(r, p, axes_[p.axis], exerr);
+          else if constexpr (std::is_same_v<P, MajParams>) return start_maj(r, p, axes_[p.axis], exerr);
+          else if constexpr (std::is_same_v<P, MamParams>) return start_mam(r, p, axes_[p.axis], exerr);
+          else if constexpr (std::is_same_v<P, McdParams>) return start_mcd(r, p, axes_[p.axis], exerr);
+          else if constexpr (std::is_same_v<P, MrpParams>) return start_mrp(r, p, axes_[p.axis]);
+          else if constexpr (std::is_same_v<P, MagParams>) return start_mag(r, p, axes_[p.slave], exerr);
+          else if constexpr (std::is_same_v<P, MgsParams>) return start_group(r, p.group, p.mode, exerr);
+          else if constexpr (std::is_same_v<P, MgsdParams> || std::is_same_v<P, MgsrParams>)
+            return start_group(r, p.group, GroupStopMode::Programmed, exerr);
+          else return Err::InstructionNotSupported;  // issue 5 / coordinated: parsed, not run yet
+        },
+        prm);
   }
   if (e != Err::None) {
     c.reject(e, exerr);
@@ -379,6 +388,10 @@ Err Planner::start_mso(const Request& r, AxisRt& a) noexcept {
     c.set(flag::DN, true);
     return Err::None;
   }
+  // [RM002H p.78] ERR 22 if the (servo-off) axis is moving: a drive coasting
+  // faster than 0.1 % of max speed (at least 1e-6 units/s)
+  if (a.cfg.type == AxisType::CipDrive && std::fabs(a.fb_vel) > std::max(1e-6, 1e-3 * a.cfg.max_speed))
+    return Err::AxisInMotion;
   a.enable_req = true;
   if (a.cfg.type == AxisType::Virtual) {
     a.servo = true;
@@ -448,11 +461,11 @@ Err Planner::start_mafr(const Request& r, AxisRt& a) noexcept {
 }
 
 // --- MAS
-Err Planner::start_mas(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
   const Idx& I = idx();
-  const auto type = static_cast<StopType>(ival(r, I.mas_type));
+  const auto type = p.stop_type;
   std::uint32_t mask = 0;
   switch (type) {
     case StopType::All: mask = (1u << kSlots) - 1u; break;
@@ -466,10 +479,10 @@ Err Planner::start_mas(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   }
   // decel
   double d = a.cfg.max_decel;
-  if (ival(r, I.mas_chg_decel) == 1) {
-    const double rate = dval(r, I.mas_decel);
+  if (p.change_decel) {
+    const double rate = p.decel_rate;
     if (!(rate > 0)) { exerr = static_cast<std::int8_t>(I.mas_decel); return Err::ParameterOutOfRange; }
-    d = ival(r, I.mas_decel_units) == 1 ? rate / 100.0 * a.cfg.max_decel : rate;
+    d = p.decel_units == 1 ? rate / 100.0 * a.cfg.max_decel : rate;
   }
   if (!(d > 0)) return Err::ZeroMaxDecel;
   // S-curve stop if any motion being stopped is S-curve
@@ -482,9 +495,9 @@ Err Planner::start_mas(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   }
   speed = std::fabs(speed);
   double jd = a.cfg.max_decel_jerk;
-  if (ival(r, I.mas_chg_jerk) == 1) {
-    const double j = dval(r, I.mas_jerk);
-    const int ju = ival(r, I.mas_jerk_units);
+  if (p.change_decel_jerk) {
+    const double j = p.decel_jerk;
+    const int ju = p.jerk_units;
     if (ju == 2) {
       if (!(j >= 0) || j > 100) { exerr = static_cast<std::int8_t>(I.mas_jerk); return Err::ParameterOutOfRange; }
       jd = jerk_from_percent_of_time(d, speed, j);
@@ -545,15 +558,15 @@ Err Planner::start_mah(const Request& r, AxisRt& a) noexcept {
 }
 
 // --- MAJ
-Err Planner::start_maj(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
   if (a.homing) return Err::HomeInProcess;
   if (any_stopping(a)) return Err::NotAllowedWhileStopping;
   const Idx& I = idx();
   Dyn dy;
-  if (Err e = decode_dynamics(r, I.maj_speed, a.cfg, a.last_speed, dy, exerr); e != Err::None) return e;
+  if (Err e = decode_dynamics(p.dyn, a.cfg, a.last_speed, dy, exerr); e != Err::None) return e;
   if (dy.seconds) { exerr = static_cast<std::int8_t>(I.maj_speed + 1); return Err::ParameterOutOfRange; }
-  const double dir = ival(r, I.maj_dir) == 1 ? -1.0 : 1.0;
+  const double dir = p.reverse ? -1.0 : 1.0;
   if (dir > 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitPositive & 1u)) return Err::OvertravelCondition;
   if (dir < 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitNegative & 1u)) return Err::OvertravelCondition;
   Kin start{};
@@ -598,15 +611,15 @@ Err Planner::start_maj(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
 }
 
 // --- MAM
-Err Planner::start_mam(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
   if (a.homing) return Err::HomeInProcess;
   if (any_stopping(a)) return Err::NotAllowedWhileStopping;
   const Idx& I = idx();
   Dyn dy;
-  if (Err e = decode_dynamics(r, I.mam_speed, a.cfg, a.last_speed, dy, exerr); e != Err::None) return e;
-  const auto mt = static_cast<MoveType>(ival(r, I.mam_type));
-  const double pos = dval(r, I.mam_pos);
+  if (Err e = decode_dynamics(p.dyn, a.cfg, a.last_speed, dy, exerr); e != Err::None) return e;
+  const auto mt = p.move_type;
+  const double pos = p.position;
   if (mt == MoveType::AbsoluteMasterOffset || mt == MoveType::IncrementalMasterOffset)
     return Err::FeatureNotSupported;  // runs with gearing/camming (issue 5)
   const bool rot_type = mt == MoveType::RotaryShortest || mt == MoveType::RotaryPositive || mt == MoveType::RotaryNegative;
@@ -717,15 +730,13 @@ Err Planner::start_mam(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
 }
 
 // --- MCD
-Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+Err Planner::start_mcd(const Request& r, const McdParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
   const Idx& I = idx();
-  const bool jog = ival(r, I.mcd_type) == 0;
-  const bool chs = ival(r, I.mcd_chg_speed) == 1, cha = ival(r, I.mcd_chg_accel) == 1,
-             chd = ival(r, I.mcd_chg_decel) == 1, chja = ival(r, I.mcd_chg_ajerk) == 1,
-             chjd = ival(r, I.mcd_chg_djerk) == 1;
-  const int su = ival(r, I.mcd_speed_units), au = ival(r, I.mcd_accel_units), du = ival(r, I.mcd_decel_units),
-            ju = ival(r, I.mcd_jerk_units);
+  const bool jog = p.jog;
+  const bool chs = p.change_speed, cha = p.change_accel, chd = p.change_decel, chja = p.change_accel_jerk,
+             chjd = p.change_decel_jerk;
+  const int su = p.speed_units, au = p.accel_units, du = p.decel_units, ju = p.jerk_units;
   const bool md = (chs && su == 4) || (cha && au == 4) || (chd && du == 4) || ((chja || chjd) && is_md_jerk(ju));
   const bool td = (chs && su != 4) || (cha && au != 4) || (chd && du != 4) || ((chja || chjd) && !is_md_jerk(ju));
   if (md && td) return Err::MdscUnitsConflict;
@@ -739,14 +750,14 @@ Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
   if (g->seconds) return Err::IllegalDynamicChange;
   Limits lim = g->lim;
   double V = g->speed;
-  if (chs) V = su == 1 ? dval(r, I.mcd_speed) / 100.0 * a.cfg.max_speed : dval(r, I.mcd_speed);
+  if (chs) V = su == 1 ? p.speed / 100.0 * a.cfg.max_speed : p.speed;
   if (cha) {
-    const double v = dval(r, I.mcd_accel);
+    const double v = p.accel;
     if (!(v > 0)) { exerr = static_cast<std::int8_t>(I.mcd_accel); return Err::ParameterOutOfRange; }
     lim.a = au == 1 ? v / 100.0 * a.cfg.max_accel : v;
   }
   if (chd) {
-    const double v = dval(r, I.mcd_decel);
+    const double v = p.decel;
     if (!(v > 0)) { exerr = static_cast<std::int8_t>(I.mcd_decel); return Err::ParameterOutOfRange; }
     if (du == 1 && !(a.cfg.max_decel > 0)) return Err::ZeroMaxDecel;
     lim.d = du == 1 ? v / 100.0 * a.cfg.max_decel : v;
@@ -764,8 +775,8 @@ Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
       }
       return Err::None;
     };
-    if (chja) if (Err e = conv(dval(r, I.mcd_ajerk), true, I.mcd_ajerk, lim.ja); e != Err::None) return e;
-    if (chjd) if (Err e = conv(dval(r, I.mcd_djerk), false, I.mcd_djerk, lim.jd); e != Err::None) return e;
+    if (chja) if (Err e = conv(p.accel_jerk, true, I.mcd_ajerk, lim.ja); e != Err::None) return e;
+    if (chjd) if (Err e = conv(p.decel_jerk, false, I.mcd_djerk, lim.jd); e != Err::None) return e;
   }
   Profile prof;
   bool ok;
@@ -803,14 +814,13 @@ Err Planner::start_mcd(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
 }
 
 // --- MRP
-Err Planner::start_mrp(const Request& r, AxisRt& a) noexcept {
+Err Planner::start_mrp(const Request& r, const MrpParams& prm, AxisRt& a) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
   if (a.homing) return Err::HomeInProcess;
-  const Idx& I = idx();
-  const bool relative = ival(r, I.mrp_type) == 1;
-  const bool command = ival(r, I.mrp_select) == 1;
-  const double p = dval(r, I.mrp_pos);
+  const bool relative = prm.relative;
+  const bool command = prm.command;
+  const double p = prm.position;
   double delta = p;
   if (!relative) {
     double sel = command ? user_command(a) : (a.cfg.type == AxisType::Virtual ? user_command(a) : a.fb_pos + a.frame_offset);
@@ -823,8 +833,8 @@ Err Planner::start_mrp(const Request& r, AxisRt& a) noexcept {
 }
 
 // --- MGS / MGSD / MGSR
-Err Planner::start_group(const Request& r, std::int8_t& exerr) noexcept {
-  const std::uint8_t grp = static_cast<std::uint8_t>(r.op[0].ref);
+Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mode, std::int8_t& exerr) noexcept {
+  const std::uint8_t grp = static_cast<std::uint8_t>(group);
   ControlTag& c = controls_[r.control];
   (void)exerr;
   if (r.instr == Instr::MGSD || r.instr == Instr::MGSR) {
@@ -845,7 +855,6 @@ Err Planner::start_group(const Request& r, std::int8_t& exerr) noexcept {
     c.set(flag::DN, true);
     return Err::None;
   }
-  const auto mode = static_cast<GroupStopMode>(ival(r, idx().mgs_mode));
   bool ramping = false;
   for (std::size_t i = 0; i < axis_count_; ++i) {
     AxisRt& a = axes_[i];
@@ -1140,11 +1149,11 @@ void Planner::update_status(AxisRt& a) noexcept {
 }
 
 // --- MAG
-Err Planner::start_mag(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept {
+Err Planner::start_mag(const Request& r, const MagParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
   if (a.homing) return Err::HomeInProcess;
-  const AxisId slave_id = r.op[0].ref;
-  const AxisId master_id = r.op[1].ref;
+  const AxisId slave_id = p.slave;
+  const AxisId master_id = p.master;
   const AxisRt& m = axes_[master_id];
   if (!m.cfg.configured) return Err::AxisNotConfigured;
   if (m.cfg.inhibited) return Err::AxisIsInhibited;
@@ -1157,40 +1166,37 @@ Err Planner::start_mag(const Request& r, AxisRt& a, std::int8_t& exerr) noexcept
     if (g->master == slave_id) return Err::MasterAxisConflict;
     c = g->master;
   }
-  static const int iDir = operand_index(Instr::MAG, "Direction"), iRatio = operand_index(Instr::MAG, "Ratio"),
-                   iSc = operand_index(Instr::MAG, "SlaveCounts"), iMc = operand_index(Instr::MAG, "MasterCounts"),
-                   iRef = operand_index(Instr::MAG, "MasterReference"), iFmt = operand_index(Instr::MAG, "RatioFormat"),
-                   iClutch = operand_index(Instr::MAG, "Clutch"), iAcc = operand_index(Instr::MAG, "AccelRate"),
-                   iAccU = operand_index(Instr::MAG, "AccelUnits");
+  static const int iRatio = operand_index(Instr::MAG, "Ratio"), iSc = operand_index(Instr::MAG, "SlaveCounts"),
+                   iMc = operand_index(Instr::MAG, "MasterCounts"), iAcc = operand_index(Instr::MAG, "AccelRate");
   // Direction: same/opposite, or reverse/unchanged relative to the last gearing
   // direction (first use: reverse = opposite, unchanged = same) [seed 003].
-  const int d = ival(r, iDir);
+  const int d = static_cast<int>(p.direction);
   const int dir = d == 0 ? 1 : d == 1 ? -1 : d == 2 ? (a.gear_dir == 0 ? -1 : -a.gear_dir) : (a.gear_dir == 0 ? 1 : a.gear_dir);
   GearGen g;
   g.master = master_id;
-  g.fractional = ival(r, iFmt) == 1;
+  g.fractional = p.fractional;
   g.cc_master = m.cfg.conversion_constant;
   g.cc_slave = a.cfg.conversion_constant;
   // a virtual master has no actual position: it always gives command [seed 000]
-  g.use_actual = ival(r, iRef) == 0 && m.cfg.type == AxisType::CipDrive;
+  g.use_actual = p.master_reference == MasterReference::Actual && m.cfg.type == AxisType::CipDrive;
   if (g.fractional) {
-    const double sc = dval(r, iSc), mc = dval(r, iMc);
+    const double sc = p.slave_counts, mc = p.master_counts;
     if (!(sc > 0) || sc > 2147483647.0) { exerr = static_cast<std::int8_t>(iSc); return Err::ParameterOutOfRange; }
     if (!(mc > 0) || mc > 2147483647.0) { exerr = static_cast<std::int8_t>(iMc); return Err::ParameterOutOfRange; }
     g.slave_counts = dir * static_cast<std::int64_t>(sc);
     g.master_counts = static_cast<std::int64_t>(mc);
   } else {
-    const double ratio = dval(r, iRatio);
+    const double ratio = p.ratio;
     const double mag = std::fabs(ratio);
     // 0.00001 .. 9.99999 inclusive, sign-sensitive [seed 003]
     if (!(mag >= 0.00001 - 1e-12) || !(mag <= 9.99999 + 1e-12)) { exerr = static_cast<std::int8_t>(iRatio); return Err::ParameterOutOfRange; }
     g.ratio = dir * ratio;
   }
-  const bool clutch = ival(r, iClutch) == 0;
+  const bool clutch = p.clutch;
   if (clutch) {
-    const double acc = dval(r, iAcc);
+    const double acc = p.accel_rate;
     if (!(acc > 0)) { exerr = static_cast<std::int8_t>(iAcc); return Err::ParameterOutOfRange; }
-    g.clutch_accel = ival(r, iAccU) == 1 ? acc / 100.0 * a.cfg.max_accel : acc;
+    g.clutch_accel = p.accel_units == 1 ? acc / 100.0 * a.cfg.max_accel : acc;
     if (!(g.clutch_accel > 0)) { exerr = static_cast<std::int8_t>(iAcc); return Err::ParameterOutOfRange; }
   }
   // commit: a new MAG supersedes the active one (ratio, direction or master change)

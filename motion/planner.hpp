@@ -164,6 +164,14 @@ inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
 /// The closed set of generator states. Issue 5 adds cam and direct states here.
 using Generator = std::variant<std::monostate, ProfileGen, GearGen>;
 
+// typed instruction parameters (motion/instructions.hpp)
+struct MasParams;
+struct MajParams;
+struct MamParams;
+struct McdParams;
+struct MrpParams;
+struct MagParams;
+
 // ------------------------------------------------------------------ planner
 /// The planner. All state is inside (fixed arrays); update() is noexcept,
 /// allocation-free and realtime-safe. Configuration calls are not RT.
@@ -241,14 +249,14 @@ class Planner {
   Err start_masd(const Request&, AxisRt&) noexcept;
   Err start_masr(const Request&, AxisRt&) noexcept;
   Err start_mafr(const Request&, AxisRt&) noexcept;
-  Err start_mas(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mas(const Request&, const MasParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mah(const Request&, AxisRt&) noexcept;
-  Err start_maj(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
-  Err start_mam(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
-  Err start_mcd(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
-  Err start_mrp(const Request&, AxisRt&) noexcept;
-  Err start_mag(const Request&, AxisRt&, std::int8_t& exerr) noexcept;
-  Err start_group(const Request&, std::int8_t& exerr) noexcept;
+  Err start_maj(const Request&, const MajParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mam(const Request&, const MamParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mcd(const Request&, const McdParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mrp(const Request&, const MrpParams&, AxisRt&) noexcept;
+  Err start_mag(const Request&, const MagParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_group(const Request&, std::uint16_t group, GroupStopMode mode, std::int8_t& exerr) noexcept;
 
   // helpers
   Err common_checks(const AxisRt& a, bool need_servo) const noexcept;

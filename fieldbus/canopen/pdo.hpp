@@ -85,6 +85,11 @@ struct PdoMap {
 /// Write `bits` of `value` little-endian at `bit_offset` (bit-exact, any
 /// alignment). Realtime-safe.
 constexpr void pack_bits(std::span<std::uint8_t> payload, unsigned bit_offset, unsigned bits, std::uint64_t value) noexcept {
+  if ((bit_offset % 8) == 0 && (bits % 8) == 0) {  // byte-aligned fast path (all CiA 402 objects)
+    for (unsigned i = 0; i < bits / 8 && bit_offset / 8 + i < payload.size(); ++i)
+      payload[bit_offset / 8 + i] = static_cast<std::uint8_t>(value >> (8 * i));
+    return;
+  }
   for (unsigned i = 0; i < bits; ++i) {
     const unsigned b = bit_offset + i;
     if (b / 8 >= payload.size()) return;

@@ -361,8 +361,15 @@ void DriveProxy::fault_reset() noexcept {
   if (failure_.kind == FailureKind::kDriveFault) failure_ = Failure{};
 }
 
+bool DriveProxy::start_homing() noexcept {
+  if (mode_ != Mode::kHoming) return false;
+  homing_requested_ = true;
+  return true;
+}
+
 bool DriveProxy::set_mode(Mode m) noexcept {
-  if (!is_cyclic(m)) return false;
+  if (!is_cyclic(m) && m != Mode::kHoming) return false;
+  homing_requested_ = false;
   if (mode_slot_.pdo < 0) {
     if (!master_.sdo(cfg_.node).download_value<std::int8_t>(obj::kModesOfOperation, 0, static_cast<std::int8_t>(m), kModeWriteTag))
       return false;
@@ -389,11 +396,23 @@ void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
     return;
   }
   if (state_ != State::kOperationEnabled) follow_actual();
+  // A quick stop with 0x605A = 0..4 completes in Switch on disabled (12).
+  if (wanted_ == State::kQuickStopActive && state_ == State::kSwitchOnDisabled) wanted_ = State::kSwitchOnDisabled;
   if (state_ == wanted_) {
     in_flight_ = false;
     reset_requested_ = false;
     switch (wanted_) {
-      case State::kOperationEnabled: cw_ = cia402::controlword(Command::kEnableOperation); break;
+      case State::kOperationEnabled:
+        cw_ = cia402::controlword(Command::kEnableOperation);
+        if (homing_requested_ && mode_ == Mode::kHoming) {
+          const HomingStatus h = homing_status();
+          if (h == HomingStatus::kCompleted || h == HomingStatus::kErrorMoving || h == HomingStatus::kErrorStopped) {
+            homing_requested_ = false;  // done: bit 4 back to 0
+          } else {
+            cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
+          }
+        }
+        break;
       case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
       case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
       case State::kQuickStopActive: cw_ = cia402::controlword(Command::kQuickStop); break;

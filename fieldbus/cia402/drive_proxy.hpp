@@ -149,10 +149,17 @@ class DriveProxy {
   void quick_stop() noexcept;
   /// Reset a fault (15, with the 0 -> 1 edge of bit 7); ends in Switch on disabled.
   void fault_reset() noexcept;
-  /// Switch between CSP, CSV and CST (through RPDO2 with PdoProfile::kCspCsvCst,
-  /// otherwise an SDO write of 0x6060). The new mode's target starts at the
-  /// actual value. False for other modes or a full SDO queue.
+  /// Switch between CSP, CSV, CST and homing (through RPDO2 with
+  /// PdoProfile::kCspCsvCst, otherwise an SDO write of 0x6060). The new
+  /// mode's target starts at the actual value. False for other modes or a
+  /// full SDO queue.
   bool set_mode(Mode m) noexcept;
+  /// Homing (mode 6, after set_mode(Mode::kHoming) or DriveConfig::mode):
+  /// sets controlword bit 4 while Operation enabled until the drive reports
+  /// homing completed or a homing error. False if the mode is not homing.
+  bool start_homing() noexcept;
+  /// Homing status from statusword bits 13, 12, 10.
+  [[nodiscard]] HomingStatus homing_status() const noexcept { return decode_homing_status(fb_.statusword); }
   /// Targets in drive units; used only while Operation enabled.
   void set_target_position(std::int32_t counts) noexcept { target_position_ = counts; }
   void set_target_velocity(std::int32_t counts_per_s) noexcept { target_velocity_ = counts_per_s; }
@@ -206,6 +213,7 @@ class DriveProxy {
   State state_ = State::kUnknown;
   State wanted_ = State::kSwitchOnDisabled;
   bool reset_requested_ = false;
+  bool homing_requested_ = false;
   // The transition in progress.
   bool in_flight_ = false;
   PlanStep flight_{Command::kShutdown, kNoTransition, State::kUnknown};

@@ -31,6 +31,19 @@ double NodeSummary::ferr_rms() const noexcept {
   return ferr_count != 0 ? std::sqrt(ferr_sum_sq / static_cast<double>(ferr_count)) : 0.0;
 }
 
+double NodeSummary::lag_rms(std::size_t lag) const noexcept {
+  return lag < kLagFit && lag_count[lag] != 0 ? std::sqrt(lag_sum_sq[lag] / static_cast<double>(lag_count[lag])) : 0.0;
+}
+
+std::size_t NodeSummary::best_lag() const noexcept {
+  std::size_t best = kLagFit;
+  for (std::size_t l = 0; l < kLagFit; ++l) {
+    if (lag_count[l] == 0) continue;
+    if (best == kLagFit || lag_rms(l) < lag_rms(best)) best = l;
+  }
+  return best;
+}
+
 std::uint32_t frame_bits_worst_case(const can::Frame& f) noexcept {
   if (f.error()) return 0;  // reported by the controller, not a frame on the wire
   const std::uint32_t s = f.remote() ? 0U : std::min<std::uint32_t>(f.len, 8U);
@@ -163,6 +176,9 @@ void Analyzer::on_sync(const Decoded& d, const Decoder& decoder) {
   for (std::uint8_t n = 1; n <= kMaxNode; ++n) {
     Live& l = live_[n];
     if (!l.producing) continue;
+    // Misses of earlier cycles not made up by late TPDOs in this cycle are final.
+    if (l.tpdos_this_cycle != 0) l.unconfirmed_missing = 0;
+    l.tpdos_this_cycle = 0;
     ++l.syncs_since_tpdo;
     std::uint8_t every = 1;
     const std::uint8_t tt = decoder.tpdo_transmission_type(n, 1);
@@ -178,6 +194,7 @@ void Analyzer::on_sync(const Decoded& d, const Decoder& decoder) {
     ++ns.missing_tpdo;
     if (ns.missing_times.size() < opt_.list_cap) ns.missing_times.push_back(last_sync_);
     l.syncs_since_tpdo = every;  // count each silent cycle once
+    if (every == 1 && l.unconfirmed_missing < 8) ++l.unconfirmed_missing;
   }
   const std::uint32_t lag = std::min(opt_.ferr_lag_cycles, AnalyzerOptions::kMaxLag);
   for (Live& l : live_) {
@@ -276,6 +293,14 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
       if (d.pdo_tx) {
         ++ns.tpdos;
         if (d.pdo_number == 1) {
+          if (l.tpdos_this_cycle != 0 && l.unconfirmed_missing != 0) {
+            // A second TPDO in one cycle: the one counted missing came late.
+            --l.unconfirmed_missing;
+            if (ns.missing_tpdo <= ns.missing_times.size() && !ns.missing_times.empty()) ns.missing_times.pop_back();
+            --ns.missing_tpdo;
+            ++ns.late_tpdo;
+          }
+          ++l.tpdos_this_cycle;
           l.producing = true;
           l.syncs_since_tpdo = 0;
         }
@@ -330,6 +355,15 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
       ns.ferr_max_abs = a;
       ns.ferr_at_max = s.following_error;
       ns.ferr_t_max = t;
+    }
+  }
+  if (d.has_actual && l.has_sw && l.state == cia402::State::kOperationEnabled) {
+    const auto n = static_cast<std::uint32_t>(l.history.size());
+    for (std::uint32_t lag = 0; lag < NodeSummary::kLagFit && lag < l.history_len; ++lag) {
+      const std::int64_t e = l.history[(l.history_head + n - lag) % n] - d.actual_position;
+      ++ns.lag_count[lag];
+      ns.lag_sum_sq[lag] += static_cast<double>(e) * static_cast<double>(e);
+      ns.lag_max_abs[lag] = std::max(ns.lag_max_abs[lag], e < 0 ? -e : e);
     }
   }
   if (sample != nullptr) *sample = s;

@@ -115,7 +115,8 @@ struct NodeSummary {
   std::vector<AbortRecord> aborts;
   std::uint64_t abort_count = 0;
   std::uint64_t syncs_checked = 0;   ///< SYNC cycles in which a TPDO was expected
-  std::uint64_t missing_tpdo = 0;    ///< of those, cycles without a TPDO
+  std::uint64_t missing_tpdo = 0;    ///< of those, cycles without a TPDO (late ones excluded)
+  std::uint64_t late_tpdo = 0;       ///< TPDOs that came one cycle late (two in the next cycle)
   std::vector<std::int64_t> missing_times;  ///< SYNC times that got no TPDO (capped)
   std::uint64_t ferr_count = 0;
   double ferr_sum_sq = 0;
@@ -123,6 +124,15 @@ struct NodeSummary {
   std::int64_t ferr_at_max = 0;       ///< signed value at the maximum
   std::int64_t ferr_t_max = 0;
   [[nodiscard]] double ferr_rms() const noexcept;
+  /// The same statistics for lags 0..kLagFit-1 SYNC cycles, to tell which
+  /// lag the drive actually has (see AnalyzerOptions::ferr_lag_cycles).
+  static constexpr std::size_t kLagFit = 4;
+  std::array<std::uint64_t, kLagFit> lag_count{};
+  std::array<double, kLagFit> lag_sum_sq{};
+  std::array<std::int64_t, kLagFit> lag_max_abs{};
+  [[nodiscard]] double lag_rms(std::size_t lag) const noexcept;
+  /// Lag with the smallest RMS following error (kLagFit if no samples).
+  [[nodiscard]] std::size_t best_lag() const noexcept;
 };
 
 struct ErrorFrameRecord {
@@ -199,6 +209,8 @@ class Analyzer {
     std::uint32_t history_head = 0;
     bool producing = false;      // TPDOs expected on SYNC
     std::uint32_t syncs_since_tpdo = 0;
+    std::uint32_t tpdos_this_cycle = 0;     // TPDO1s since the last SYNC
+    std::uint32_t unconfirmed_missing = 0;  // misses a late TPDO may still make up
     canopen::NmtState nmt = canopen::NmtState::kUnknown;
   };
   void on_sync(const Decoded& d, const Decoder& decoder);

@@ -243,7 +243,11 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
 }
 
 void describe_pdo(const Decoded& d, fmt::memory_buffer& out) {
-  fmt::format_to(fmt::appender(out), "{}{} node {}: ", d.pdo_tx ? "TPDO" : "RPDO", d.pdo_number, d.node);
+  put(out, d.pdo_tx ? "TPDO" : "RPDO");
+  put_dec(out, d.pdo_number);
+  put(out, " node ");
+  put_dec(out, d.node);
+  put(out, ": ");
   if (d.layout == LayoutSource::kNone || d.tf.frame.remote()) {
     if (d.tf.frame.remote()) {
       put(out, "remote request");
@@ -413,7 +417,7 @@ void format_description(const Decoded& d, fmt::memory_buffer& out) {
       break;
     case EventKind::kEmcy:
       fmt::format_to(fmt::appender(out), "EMCY node {}: 0x{:04X} {}; error register 0x{:02X}", d.node, d.emcy_code,
-                     d.emcy_code == 0 ? std::string_view{"error reset / no error"} : co::emcy_code_text(d.emcy_code),
+                     co::emcy_code_text(d.emcy_code),
                      d.emcy_register);
       if (d.emcy_register != 0) {
         put(out, " (");
@@ -529,8 +533,7 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
       break;
     case EventKind::kEmcy:
       fmt::format_to(fmt::appender(out), ",\"code\":{},\"error_register\":{},\"text\":", d.emcy_code, d.emcy_register);
-      append_json_string(out, d.emcy_code == 0 ? std::string_view{"error reset / no error"}
-                                               : co::emcy_code_text(d.emcy_code));
+      append_json_string(out, co::emcy_code_text(d.emcy_code));
       break;
     case EventKind::kBootUp:
     case EventKind::kHeartbeat:

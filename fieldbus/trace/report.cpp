@@ -37,7 +37,7 @@ std::string_view kind_label(std::size_t k) {
 double us(double ns) { return ns / 1000.0; }
 
 std::string_view emcy_text(std::uint16_t code) {
-  return code == 0 ? std::string_view{"error reset / no error"} : co::emcy_code_text(code);
+  return co::emcy_code_text(code);
 }
 
 void node_label(Out& out, std::uint8_t n, const NodeSettings& s) {
@@ -226,7 +226,9 @@ void format_summary_text(std::string_view iface, const Analyzer& a, const Report
                        r.code, co::sdo_abort_text(r.code), r.by_server ? "by drive" : "by master");
       }
     }
-    fmt::format_to(fmt::appender(out), "SYNC cycles without TPDO: {} of {} checked\n", ns.missing_tpdo, ns.syncs_checked);
+    fmt::format_to(fmt::appender(out), "SYNC cycles without TPDO: {} of {} checked", ns.missing_tpdo, ns.syncs_checked);
+    if (ns.late_tpdo != 0) fmt::format_to(fmt::appender(out), " ({} more TPDOs came late, in the next cycle)", ns.late_tpdo);
+    put(out, "\n");
     for (std::size_t i = 0; i < ns.missing_times.size() && i < 10; ++i) {
       put(out, "    after SYNC at ");
       time_at(out, opt, ns.missing_times[i], t0);
@@ -252,6 +254,13 @@ void format_summary_text(std::string_view iface, const Analyzer& a, const Report
                        s.unit.empty() ? "units" : s.unit, ns.ferr_rms() / s.counts_per_unit, s.unit.empty() ? "units" : s.unit);
       }
       put(out, "\n");
+      const std::size_t best = ns.best_lag();
+      if (best < NodeSummary::kLagFit && best != ao.ferr_lag_cycles && ns.lag_rms(best) < ns.ferr_rms()) {
+        fmt::format_to(fmt::appender(out),
+                       "  note: the actual position matches the target applied {} SYNC(s) earlier better "
+                       "(max |e| {} counts, RMS {:.2f} counts): try --lag {}\n",
+                       best, ns.lag_max_abs[best], ns.lag_rms(best), best);
+      }
     }
   }
 }
@@ -367,8 +376,8 @@ void format_summary_json(std::string_view iface, const Analyzer& a, const Report
       append_json_string(out, co::sdo_abort_text(r.code));
       put(out, "}");
     }
-    fmt::format_to(fmt::appender(out), "],\"syncs_checked\":{},\"missing_tpdo\":{},\"missing_tpdo_times\":[", ns.syncs_checked,
-                   ns.missing_tpdo);
+    fmt::format_to(fmt::appender(out), "],\"syncs_checked\":{},\"missing_tpdo\":{},\"late_tpdo\":{},\"missing_tpdo_times\":[", ns.syncs_checked,
+                   ns.missing_tpdo, ns.late_tpdo);
     for (std::size_t i = 0; i < ns.missing_times.size(); ++i) {
       if (i) out.push_back(',');
       t(ns.missing_times[i]);
@@ -379,6 +388,12 @@ void format_summary_json(std::string_view iface, const Analyzer& a, const Report
       put(out, ",\"t_max\":");
       t(ns.ferr_t_max);
     }
+    fmt::format_to(fmt::appender(out), ",\"lag_cycles\":{},\"lag_fit\":[", ao.ferr_lag_cycles);
+    for (std::size_t l = 0; l < NodeSummary::kLagFit; ++l) {
+      fmt::format_to(fmt::appender(out), "{}{{\"lag\":{},\"samples\":{},\"max_abs_counts\":{},\"rms_counts\":{:.3f}}}", l ? "," : "", l,
+                     ns.lag_count[l], ns.lag_max_abs[l], ns.lag_rms(l));
+    }
+    put(out, "]");
     if (s.counts_per_unit > 0) {
       fmt::format_to(fmt::appender(out), ",\"unit\":");
       append_json_string(out, s.unit);

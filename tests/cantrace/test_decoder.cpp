@@ -363,3 +363,58 @@ TEST(TraceDecoder, RandomFramesNeverBreakTheDecoder) {
   an.finish(dec);
   EXPECT_EQ(an.bus().frames, static_cast<std::uint64_t>(count)) << "seed " << seed;
 }
+
+// A drive that reports the position of the previous cycle's target: the lag
+// fit finds 1, and --lag 1 gives a zero following error.
+TEST(TraceAnalyzer, LagFitFindsTheDriveDelay) {
+  for (std::uint32_t lag : {0U, 1U}) {
+    tr::Decoder dec;
+    tr::AnalyzerOptions ao;
+    ao.ferr_lag_cycles = lag;
+    tr::Analyzer an(ao);
+    std::int64_t t = 0;
+    std::int32_t target = 0, previous = 0;
+    const auto b = [](std::int32_t v, int i) { return static_cast<std::uint8_t>(static_cast<std::uint32_t>(v) >> (8 * i)); };
+    for (int k = 0; k < 50; ++k) {
+      previous = target;
+      target += 100;
+      an.feed(dec.decode(tf(0x201, {0x0F, 0x00, b(target, 0), b(target, 1), b(target, 2), b(target, 3)}, t)), dec, nullptr);
+      an.feed(dec.decode(tf(0x080, {}, t + 100'000)), dec, nullptr);
+      an.feed(dec.decode(tf(0x181, {0x37, 0x02, b(previous, 0), b(previous, 1), b(previous, 2), b(previous, 3)}, t + 200'000)),
+              dec, nullptr);
+      t += 1'000'000;
+    }
+    an.finish(dec);
+    const tr::NodeSummary& n = an.node(1);
+    EXPECT_EQ(n.best_lag(), 1U);
+    EXPECT_EQ(n.lag_max_abs[1], 0);
+    EXPECT_EQ(n.lag_max_abs[0], 100);
+    EXPECT_EQ(n.ferr_max_abs, lag == 1 ? 0 : 100) << "lag " << lag;
+  }
+}
+
+// A TPDO that misses its cycle but arrives in the next one (two TPDOs there)
+// is counted as late, not missing; a TPDO that never comes stays missing.
+TEST(TraceAnalyzer, LateTpdoIsNotMissing) {
+  tr::Decoder dec;
+  tr::Analyzer an{tr::AnalyzerOptions{}};
+  std::int64_t t = 0;
+  for (int k = 0; k < 20; ++k) {
+    an.feed(dec.decode(tf(0x080, {}, t)), dec, nullptr);
+    if (k == 5) {
+      // nothing in cycle 5 ...
+    } else if (k == 6) {
+      // ... and two in cycle 6: the first was late
+      an.feed(dec.decode(tf(0x181, {0x37, 0x02, 0, 0, 0, 0}, t + 1000)), dec, nullptr);
+      an.feed(dec.decode(tf(0x181, {0x37, 0x02, 0, 0, 0, 0}, t + 2000)), dec, nullptr);
+    } else if (k != 12) {  // cycle 12: lost for good
+      an.feed(dec.decode(tf(0x181, {0x37, 0x02, 0, 0, 0, 0}, t + 1000)), dec, nullptr);
+    }
+    t += 1'000'000;
+  }
+  an.finish(dec);
+  EXPECT_EQ(an.node(1).late_tpdo, 1U);
+  EXPECT_EQ(an.node(1).missing_tpdo, 1U);
+  ASSERT_EQ(an.node(1).missing_times.size(), 1U);
+  EXPECT_EQ(an.node(1).missing_times[0], 12'000'000);
+}

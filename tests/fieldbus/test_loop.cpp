@@ -171,3 +171,189 @@ TEST(Loop, Deterministic) {
   };
   EXPECT_EQ(run(), run());
 }
+
+TEST(Loop, RejectedConfigurationWriteExplainsItself) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.drive.extra_writes = {cia402::SdoWrite{0x6060, 0, 1, 5}};  // mode 5 is reserved
+  SimRig rig(cfg);
+  rig.power_on();
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(rig.run_until([&] { return d.failed(); }, 500));
+  EXPECT_EQ(d.phase(), cia402::Phase::kFailed);
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kSdoAbort);
+  EXPECT_EQ(d.failure().sdo_abort, 0x06090030u);
+  const std::string text = d.failure().to_string();
+  EXPECT_NE(text.find("node 2: configuration write to 0x6060:0 (Modes of operation) aborted with 0x06090030"),
+            std::string::npos)
+      << text;
+}
+
+TEST(Loop, TransitionTimeoutExplainsItself) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.drive.transition_timeout_ns = 50'000'000;
+  SimRig rig(cfg);
+  rig.power_on();
+  ASSERT_TRUE(rig.run_until([&] { return rig.network().all_operational(); }, 500));
+  rig.bus().add_fault(can::SimFault{0x202, can::SimFault::Action::kDrop, 0, 0});  // the drive never hears us
+  auto& d = rig.drive(2);
+  d.enable();
+  ASSERT_TRUE(rig.run_until([&] { return d.failed(); }, 500));
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kTransitionTimeout);
+  EXPECT_EQ(d.failure().transition, 2);
+  EXPECT_EQ(d.failure().reached, State::kSwitchOnDisabled);
+  EXPECT_EQ(d.failure().wanted, State::kOperationEnabled);
+  EXPECT_GT(d.failure().waited_ns, 50'000'000);
+  EXPECT_LT(d.failure().waited_ns, 53'000'000);
+  EXPECT_NE(d.failure().to_string().find("transition 2 (Switch on disabled -> Ready to switch on)"), std::string::npos)
+      << d.failure().to_string();
+  // It stopped pushing; enable() tries again and succeeds once the bus heals.
+  rig.bus().clear_faults();
+  d.enable();
+  EXPECT_FALSE(d.failed());
+  ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 100));
+}
+
+TEST(Loop, LostBootUpLeadsToNmtResetNode) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.drive.boot_timeout_ns = 100'000'000;
+  SimRig rig(cfg);
+  rig.bus().add_fault(can::SimFault{0x702, can::SimFault::Action::kDrop, 0, 1});  // first boot-up lost
+  int resets = 0;
+  rig.bus().set_tap([&](const can::TimedFrame& f, std::string_view) {
+    if (f.frame == can::Frame{0x000, {0x81, 0x02}}) ++resets;
+  });
+  rig.power_on();
+  ASSERT_TRUE(rig.run_until([&] { return rig.network().all_operational() || rig.network().any_failed(); }, 1000));
+  EXPECT_FALSE(rig.network().any_failed());
+  EXPECT_EQ(resets, 1);
+  EXPECT_GE(rig.now_ns(), 100'000'000);
+}
+
+TEST(Loop, SilentNodeGivesBootTimeout) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.drive.boot_timeout_ns = 100'000'000;
+  SimRig rig(cfg);
+  rig.disconnect(2);  // never powered, never answers
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(rig.run_until([&] { return d.failed(); }, 1000));
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kBootTimeout);
+  EXPECT_NE(d.failure().to_string().find("even after NMT reset node"), std::string::npos);
+}
+
+TEST(Loop, CsvAndCstModeSwitching) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.drive.pdo_profile = cia402::PdoProfile::kCspCsvCst;
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(d.set_mode(cia402::Mode::kCsv));
+  d.set_target_velocity(50'000);
+  for (int i = 0; i < 100; ++i) rig.step();
+  EXPECT_EQ(d.feedback().mode_display, 9);
+  EXPECT_EQ(d.feedback().velocity, 50'000);
+  EXPECT_TRUE(d.enabled());
+  const std::int32_t p0 = d.feedback().position;
+  for (int i = 0; i < 100; ++i) rig.step();
+  EXPECT_NEAR(d.feedback().position - p0, 5'000, 2);  // 50 000 counts/s for 100 ms
+  ASSERT_TRUE(d.set_mode(cia402::Mode::kCst));
+  EXPECT_EQ(d.target_torque(), d.feedback().torque);  // bumpless: starts at the actual torque
+  d.set_target_torque(-100);
+  for (int i = 0; i < 10; ++i) rig.step();
+  EXPECT_EQ(d.feedback().mode_display, 10);
+  EXPECT_EQ(d.feedback().torque, -100);
+  EXPECT_LT(d.feedback().velocity, 50'000);  // negative torque decelerates
+  ASSERT_TRUE(d.set_mode(cia402::Mode::kCsp));
+  EXPECT_EQ(d.target_position(), d.feedback().position);  // bumpless
+  for (int i = 0; i < 200; ++i) rig.step();
+  EXPECT_EQ(d.feedback().mode_display, 8);
+  EXPECT_FALSE(d.failed()) << d.failure().to_string();
+}
+
+TEST(Loop, ModeSwitchOverSdoWithMinimalMapping) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(d.set_mode(cia402::Mode::kCsv));
+  ASSERT_TRUE(rig.run_until([&] { return d.feedback().mode_display == 9; }, 50));
+  EXPECT_EQ(rig.emulator(2).read_int(0x6060), 9);
+}
+
+TEST(Loop, QuickStopThenReenable) {
+  SimRig rig(rig_config());
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  // Moving at 100 000 counts/s, then quick stop: 0x605A = 2 (default) stops
+  // on the quick-stop ramp, then Switch on disabled (12).
+  for (int i = 1; i <= 100; ++i) {
+    d.set_target_position(d.target_position() + 100);
+    rig.step();
+  }
+  d.quick_stop();
+  bool saw_qsa = false;
+  ASSERT_TRUE(rig.run_until([&] {
+    saw_qsa = saw_qsa || d.state() == State::kQuickStopActive;
+    return d.state() == State::kSwitchOnDisabled || d.failed();
+  }, 100));
+  EXPECT_TRUE(saw_qsa);
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kNone);
+  EXPECT_TRUE(d.settled());
+  EXPECT_EQ(rig.emulator(2).velocity(), 0.0);
+  d.enable();
+  ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 50));
+}
+
+TEST(Loop, EmulatorFailAfterNSyncs) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.fail_after_syncs = 300;
+  cfg.emulator.fail_emcy_code = 0x4310;
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 400));
+  // Fault reaction at SYNC 300, Fault at 301, seen by the master one cycle later.
+  EXPECT_EQ(rig.emulator(2).counters().syncs, 302u);
+  EXPECT_EQ(d.last_emcy_code(), 0x4310);
+}
+
+TEST(Loop, HomingMethod35SetsHomeOffset) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.initial_position = 777;
+  cfg.drive.extra_writes = {cia402::SdoWrite{0x607C, 0, 4, 5000}, cia402::SdoWrite{0x6098, 0, 1, 35}};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  EXPECT_FALSE(d.start_homing());  // CSP: not homing
+  ASSERT_TRUE(d.set_mode(cia402::Mode::kHoming));
+  ASSERT_TRUE(rig.run_until([&] { return rig.emulator(2).mode_display() == 6; }, 50));
+  ASSERT_TRUE(d.start_homing());
+  ASSERT_TRUE(rig.run_until([&] { return d.homing_status() == cia402::HomingStatus::kCompleted; }, 50));
+  EXPECT_EQ(d.feedback().position, 5000);
+  for (int i = 0; i < 3; ++i) rig.step();
+  EXPECT_EQ(d.controlword() & cia402::cw::kHomingStart, 0);  // bit 4 released after completion
+  EXPECT_TRUE(d.enabled());
+}
+
+TEST(Loop, HomingSearchMovesToTheSwitch) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.initial_position = 2000;
+  cfg.drive.mode = cia402::Mode::kHoming;
+  cfg.drive.extra_writes = {cia402::SdoWrite{0x6098, 0, 1, 17}, cia402::SdoWrite{0x6099, 1, 4, 100'000}};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(d.start_homing());
+  for (int i = 0; i < 5; ++i) rig.step();
+  EXPECT_EQ(d.homing_status(), cia402::HomingStatus::kInProgress);
+  ASSERT_TRUE(rig.run_until([&] { return d.homing_status() == cia402::HomingStatus::kCompleted; }, 200));
+  EXPECT_EQ(d.feedback().position, 0);  // home offset 0
+}

@@ -22,11 +22,26 @@ cat "$art/master.log"
 # A raw SDO upload of 0x1000 (device type) from node 2, like any CANopen tool.
 echo "CANSEND-MARK" > "$art/cansend.mark"
 cansend vcan0 602#4000100000000000
+# An independent CANopen tool (plain can-utils cansend, no canmotion code)
+# drives node 3 in CSP: reset node, NMT start, the default RPDO1 (controlword
+# + target position) through Shutdown / Switch on / Enable operation, each
+# applied at a SYNC, then a target of 100100 counts (the drive is at 100000).
+cansend vcan0 000#8103
+sleep 0.3
+cansend vcan0 000#0103
+for cw in 0600 0700 0F00; do
+  cansend vcan0 203#${cw}A0860100
+  cansend vcan0 080#
+done
+for ((i = 0; i < 12; i++)); do
+  cansend vcan0 203#0F0004870100
+  cansend vcan0 080#
+done
 # candump runs slower than the test under emulation and drops what is still
 # queued when it is stopped: wait until it has written the reply (everything
 # before it is then in the trace too).
-for ((i = 0; i < 300; i++)); do
-  grep -q ' 582#4300100092010200$' "$CANMOTION_TRACE" && break
+for ((i = 0; i < 600; i++)); do
+  grep -q ' 582#4300100092010200$' "$CANMOTION_TRACE" && grep -q ' 183#371204870100$' "$CANMOTION_TRACE" && break
   sleep 0.1
 done
 kill -TERM $epid

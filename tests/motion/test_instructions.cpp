@@ -115,6 +115,21 @@ TEST(Mso, CipDriveFaultWhileEnablingIsServoMessageFailure) {
   EXPECT_EQ(r.tag("mso1").exerr, 16);
 }
 
+TEST(Mso, CipAxisCoastingIsAxisInMotion) {
+  Rig r;
+  AxisConfig c = virt();
+  c.type = AxisType::CipDrive;
+  r.add_axis("D", c);
+  r.fb[0].velocity = 5.0;  // coasting, servo off
+  r.step();
+  EXPECT_EQ(r.exec("MSO(D, m);"), Err::AxisInMotion);
+  EXPECT_EQ(r.tag("m").err, 22);
+  EXPECT_FALSE(r.out[0].enable);
+  r.fb[0].velocity = 0.0;
+  r.step();
+  EXPECT_EQ(r.exec("MSO(D, m);"), Err::None);
+}
+
 TEST(Msf, CancelsMotionAndDisables) {
   Rig r = servo_rig();
   r.exec(maj("X", "j1", 0, 10));

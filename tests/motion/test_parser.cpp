@@ -5,6 +5,7 @@
 #include <cctype>
 #include <string>
 
+#include "motion/instructions.hpp"
 #include "motion/st_parser.hpp"
 
 using namespace canmotion::motion;
@@ -227,4 +228,50 @@ TEST(Signatures, CheckOperandsGivesTheOperandIndex) {
   const auto c = check_operands(Instr::MAS, v);
   EXPECT_FALSE(c.ok);
   EXPECT_EQ(c.index, 2);
+}
+
+TEST(Decode, TypedParamsFromTheBoundRequest) {
+  const Symbols sym = syms();
+  Request q;
+  ASSERT_FALSE(parse_and_bind("MAM(ax1, ctl, rotarynegative, 12.5, 30, %ofmaximum, 400, unitspersec2, 300, "
+                              "unitspersec2, scurve, 60, 40, %oftime, enabled, current, 0, none, arr, 0);",
+                              sym, q));
+  const Params p = decode(q);
+  ASSERT_TRUE(std::holds_alternative<MamParams>(p));
+  const auto& m = std::get<MamParams>(p);
+  EXPECT_EQ(m.axis, 0);
+  EXPECT_EQ(m.move_type, MoveType::RotaryNegative);
+  EXPECT_EQ(m.position, 12.5);
+  EXPECT_EQ(m.dyn.speed, 30);
+  EXPECT_EQ(m.dyn.speed_units, 1);
+  EXPECT_EQ(m.dyn.accel, 400);
+  EXPECT_EQ(m.dyn.decel, 300);
+  EXPECT_EQ(m.dyn.profile, ProfileType::SCurve);
+  EXPECT_EQ(m.dyn.accel_jerk, 60);
+  EXPECT_EQ(m.dyn.decel_jerk, 40);
+  EXPECT_EQ(m.dyn.jerk_units, 2);
+  EXPECT_EQ(m.dyn.merge, Merge::Enabled);
+  EXPECT_EQ(m.dyn.merge_speed, MergeSpeed::Current);
+  EXPECT_EQ(m.dyn.first_operand, 4);
+  EXPECT_EQ(m.event_distance, 1);
+  EXPECT_EQ(m.calculated_data, 0xFFFF);
+  ASSERT_FALSE(parse_and_bind("MAG(ax1, Ax2, ctl, reverse, 0.5, 1, 3, command, fraction_slave_master_counts, enabled, 20, %ofmaximum);", sym, q));
+  const auto g = std::get<MagParams>(decode(q));
+  EXPECT_EQ(g.slave, 0);
+  EXPECT_EQ(g.master, 1);
+  EXPECT_EQ(g.direction, CamDirection::Reverse);
+  EXPECT_TRUE(g.fractional);
+  EXPECT_TRUE(g.clutch);
+  EXPECT_EQ(g.master_counts, 3);
+  EXPECT_EQ(g.accel_units, 1);
+  ASSERT_FALSE(parse_and_bind("MDS(ax1, ctl, 10, unitspersec);", sym, q));
+  EXPECT_FALSE(std::get<MdsParams>(decode(q)).percent_of_maximum);  // seed numbering: unitspersec = 1
+  ASSERT_FALSE(parse_and_bind("MATC(ax1, ctl, same, prof[0], 2, 3, continuous, pending, 0, immediateforwardonly, masterdrivenmode);", sym, q));
+  const auto t = std::get<MatcParams>(decode(q));
+  EXPECT_EQ(t.cam_profile, 4);
+  EXPECT_EQ(t.time_scaling, 3);
+  EXPECT_EQ(t.execution_mode, 1);
+  EXPECT_EQ(t.execution_schedule, 1);
+  EXPECT_EQ(t.lock_direction, LockDirection::ImmediateForwardOnly);
+  EXPECT_TRUE(t.master_driven);
 }

@@ -23,6 +23,7 @@
 #include "fieldbus/can/candump_format.hpp"
 #include "fieldbus/canopen/emcy.hpp"
 #include "rt/clock.hpp"
+#include "rt/controller/command_server.hpp"
 #include "rt/controller/host.hpp"
 #include "rt/controller/script.hpp"
 #include "rt/cyclic_executive.hpp"
@@ -44,6 +45,7 @@ struct Options {
   std::string csv;
   bool stats = false;
   std::string socket;
+  std::string socket_group;
   bool quiet = false;
 };
 
@@ -308,6 +310,23 @@ int run(const Options& o) {
   rt::Clock& clock = sim ? static_cast<rt::Clock&>(vclock) : static_cast<rt::Clock&>(mclock);
   rt::CyclicExecutive exec(ec, clock);
 
+  // canmotionctl's socket (rt/controller/command_server.hpp), served from housekeeping.
+  std::unique_ptr<rt::CommandServer> server;
+  if (!o.socket.empty()) {
+    rt::CommandServerOptions so;
+    so.path = o.socket;
+    so.group = o.socket_group;
+    so.io_interval_s = sim ? 0.001 : 0.0;  // --sim: housekeeping runs every cycle; poll the socket once per ms
+    so.log = [](const std::string& l) { fmt::print(stderr, "canmotiond: socket: {}\n", l); };
+    if (!sim) so.cycle_stats = [&exec] { return exec.statistics().snapshot(); };
+    try {
+      server = std::make_unique<rt::CommandServer>(ctl, std::move(so));
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "canmotiond: {}\n", e.what());
+      return 1;
+    }
+  }
+
   fmt::print("canmotiond: {} axes, {} buses ({}), period {} ms{}\n", ctl.axis_count(), cfg.buses.size(),
              sim ? "simulated, virtual time" : "real time", ctl.period_s() * 1e3,
              script ? ", script " + o.script : std::string());
@@ -322,6 +341,7 @@ int run(const Options& o) {
   auto housekeeping = [&](std::uint64_t cycle) -> bool {
     const double now = static_cast<double>(cycle) * ctl.period_s();
     out->drain(o.quiet);
+    if (server) server->poll(now);
     if (runner && shutdown.phase() == Shutdown::Phase::kNone) {
       const auto st = runner->step(now);
       if (st == rt::script::Runner::Status::kFailed) {
@@ -422,7 +442,8 @@ int main(int argc, char** argv) {
   app.add_option("--trace", o.trace, "write every frame on every bus to FILE in candump -L format");
   app.add_option("--csv", o.csv, "write one row per axis per cycle to FILE");
   app.add_flag("--stats", o.stats, "print cycle statistics once a second and at the end");
-  app.add_option("--socket", o.socket, "UNIX socket for canmotionctl");
+  app.add_option("--socket", o.socket, "serve canmotionctl on this UNIX socket (mode 0660; see tools/canmotionctl/README.md)");
+  app.add_option("--socket-group", o.socket_group, "group owning the --socket file and allowed to use it (default: the daemon's group)");
   app.add_flag("-q,--quiet", o.quiet, "no progress lines or summary");
   app.footer(
       "Examples:\n"
@@ -433,10 +454,6 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
-  }
-  if (!o.socket.empty()) {
-    fmt::print(stderr, "canmotiond: --socket is not available in this build yet\n");
-    return 2;
   }
   return run(o);
 }

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# End to end: canmotiond --sim --socket with the demo configuration, driven by
+# canmotionctl: status, an instruction, get/set, a script, a watch, stats; then
+# SIGTERM and a clean exit 0. --sim runs faster than real time, so the daemon
+# gets a long --duration and is stopped by the signal when the checks are done.
+# Usage: daemon-e2e.sh CANMOTIOND CANMOTIONCTL CONFIG
+set -u
+daemon=$1 ctl=$2 config=$3
+dir=$(mktemp -d /tmp/canmotion-e2e-XXXXXX)
+sock=$dir/canmotiond.sock
+pid=
+cleanup() {
+  [ -n "$pid" ] && kill -KILL "$pid" 2>/dev/null
+  rm -rf "$dir"
+}
+trap cleanup EXIT
+fail() {
+  echo "FAIL: $*" >&2
+  echo "--- canmotiond stderr:" >&2
+  cat "$dir/daemon.err" >&2
+  exit 1
+}
+
+"$daemon" --config "$config" --sim --socket "$sock" --duration 1000000 --quiet >"$dir/daemon.out" 2>"$dir/daemon.err" &
+pid=$!
+for _ in $(seq 1 200); do
+  [ -S "$sock" ] && break
+  kill -0 "$pid" 2>/dev/null || fail "canmotiond exited before creating $sock"
+  sleep 0.05
+done
+[ -S "$sock" ] || fail "no socket $sock after 10 s"
+mode=$(stat -c %a "$sock")
+[ "$mode" = 660 ] || fail "socket mode is $mode, not 660"
+
+export CANMOTIOND_SOCKET=$sock
+out=$("$ctl" status) || fail "status: $out"
+echo "$out"
+grep -q '^Gear ' <<<"$out" || fail "status has no Gear row"
+grep -q '^Master ' <<<"$out" || fail "status has no Master row"
+
+out=$("$ctl" 'MSO(Mover, e2e_mso)') || fail "MSO: $out"
+grep -q '^e2e_mso EN=1 ' <<<"$out" || fail "MSO reply: $out"
+
+"$ctl" set E2eTarget 7.5 || fail "set"
+[ "$("$ctl" get E2eTarget)" = 7.5 ] || fail "get E2eTarget"
+
+cat >"$dir/e2e.script" <<'SCRIPT'
+WAIT UNTIL e2e_mso.DN TIMEOUT 5;
+MAM(Mover, e2e_mam, 0, 7.5, 100, unitspersec, 1000, unitspersec2, 1000, unitspersec2, trapezoidal, 100, 100,
+    %oftime, disabled, programmed, 0, none, 0, 0);
+WAIT UNTIL e2e_mam.PC TIMEOUT 5;
+PRINT Mover.CommandPosition;
+SCRIPT
+out=$("$ctl" run "$dir/e2e.script") || fail "run: $out"
+echo "$out"
+grep -q 'Mover.CommandPosition=7.5$' <<<"$out" || fail "script output: $out"
+
+out=$("$ctl" watch Controller.Time --interval 0.5 --count 3) || fail "watch: $out"
+[ "$(wc -l <<<"$out")" = 3 ] || fail "watch printed: $out"
+
+out=$("$ctl" stats) || fail "stats: $out"
+grep -q '^cycles ' <<<"$out" || fail "stats: $out"
+
+if out=$("$ctl" 'MSO(Nope, x)' 2>&1); then fail "an unknown axis was accepted: $out"; fi
+grep -q "Nope" <<<"$out" || fail "error does not name the axis: $out"
+
+kill -TERM "$pid"
+wait "$pid"
+rc=$?
+pid=
+[ "$rc" = 0 ] || fail "canmotiond exited $rc after SIGTERM"
+[ ! -e "$sock" ] || fail "the socket file was left behind"
+grep -q 'socket: client .* connected: pid' "$dir/daemon.err" || fail "connections are not logged"
+echo "PASS"
