@@ -53,6 +53,7 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       if (!rt.sim) rt.sim = std::make_unique<rt::SimWorld>();
       bs.transport = &rt.sim->add_bus(b.name);
       rt.trace_names.push_back(b.name);
+      rt.is_socket.push_back(false);
     } else {
       // Receive only what a CANopen master needs: the nodes' EMCY, TPDOs,
       // SDO responses and heartbeats (0x080 + node .. 0x700 + node).
@@ -70,6 +71,7 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       bs.transport = sock.get();
       rt.sockets.push_back(std::move(sock));
       rt.trace_names.push_back(b.interface);
+      rt.is_socket.push_back(true);
     }
     spec.buses.push_back(bs);
   }

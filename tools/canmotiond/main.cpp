@@ -65,9 +65,10 @@ class Outputs {
       std::fputs("cycle,time,axis,cmd_pos,act_pos,cmd_vel,act_vel,motion_status,axis_status\n", csv_);
       rt.controller->set_telemetry(true);
     }
-    // Real time: transmit records carry CLOCK_MONOTONIC, kernel receive stamps
-    // CLOCK_REALTIME; put both on the realtime scale like candump.
-    if (!rt.all_simulated()) {
+    // Real time: transmit records and simulated buses carry CLOCK_MONOTONIC,
+    // SocketCAN receive stamps CLOCK_REALTIME; put all on the realtime scale
+    // like candump. In --sim every stamp is virtual time.
+    if (!o.sim) {
       timespec m{}, r{};
       clock_gettime(CLOCK_MONOTONIC, &m);
       clock_gettime(CLOCK_REALTIME, &r);
@@ -84,9 +85,8 @@ class Outputs {
     char line[can::kCandumpLineMax + 2];
     while (c.pop_trace(tr)) {
       if (!trace_) continue;
-      const bool simulated = rt_.all_simulated() || rt_.sockets.empty();
       std::int64_t t = tr.frame.t_ns;
-      if (tr.tx && !simulated) t += mono_to_real_;
+      if (tr.tx || !rt_.is_socket[tr.bus]) t += mono_to_real_;  // 0 in --sim
       const std::size_t n = can::format_candump_line(line, tr.frame.frame, t, rt_.trace_names[tr.bus]);
       if (n > 0) {
         line[n] = '\n';
@@ -267,7 +267,7 @@ int run(const Options& o) {
   }
   rt::Controller& ctl = *rt.controller;
   rt::ControllerHost host(ctl);
-  const bool sim = rt.all_simulated();
+  const bool sim = o.sim;  // virtual time only with --sim; `interface: sim` alone runs in real time
 
   // 3. Script, checked against the controller before anything runs.
   std::optional<rt::script::Script> script;
@@ -365,7 +365,7 @@ int run(const Options& o) {
     return shutdown.step(now);
   };
 
-  if (rt.sim) rt.sim->power_on(0);
+  if (rt.sim) rt.sim->power_on(sim ? 0 : clock.now().count());  // boot-up frames at the run's start time
   if (sim) {
     // --sim: the same cycle code on a virtual clock, with the non-RT work
     // inline between cycles so that runs are deterministic.
@@ -394,7 +394,7 @@ int run(const Options& o) {
       if (rt.sim) rt.sim->end_cycle(t);
     });
     if (auto e = exec.start(); e) {
-      fmt::print(stderr, "canmotiond: cannot start the cyclic thread: {}\n", e.message());
+      fmt::print(stderr, "canmotiond: cannot start the cyclic thread: {}\n", exec.setup_report().error_message());
       return 1;
     }
     rt::SdNotifier::ready();
