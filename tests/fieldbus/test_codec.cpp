@@ -359,6 +359,19 @@ TEST(FieldbusBusBudget, DefaultCspMapping) {
   EXPECT_EQ(canopen::max_axes(axis, 1'000'000, 1'000'000), 4u);
   EXPECT_EQ(canopen::max_axes(axis, 2'000'000, 1'000'000), 8u);
   EXPECT_EQ(canopen::max_axes(axis, 4'000'000, 1'000'000), 17u);
+  // The same from the profile the proxy configures.
+  const auto t = cia402::node_traffic(cia402::PdoProfile::kCsp);
+  EXPECT_EQ(t.rpdo_count, 1);
+  EXPECT_EQ(t.rpdo_bytes[0], 6);
+  EXPECT_EQ(t.tpdo_bytes[0], 6);
+  const auto full = cia402::node_traffic(cia402::PdoProfile::kCspCsvCst, 100);
+  EXPECT_EQ(full.rpdo_count + full.tpdo_count, 4);
+  EXPECT_EQ(canopen::max_axes(full, 2'000'000, 1'000'000), 4u);
+  // Heartbeats are averaged over their period: 65 bits every 100 ms at 1 ms = 0.65 bits.
+  const canopen::NodeTraffic one[] = {full};
+  canopen::BusBudgetInput hb;
+  hb.nodes = one;
+  EXPECT_DOUBLE_EQ(canopen::bus_budget(hb).heartbeat_bits, 0.65);
 }
 
 // ---- SimBus -----------------------------------------------------------------------
