@@ -537,3 +537,25 @@ TEST(CommandServer, HalfClosedClientGetsItsAnswersThenEof) {
 
 }  // namespace
 }  // namespace canmotion::rt::ctltest
+
+namespace canmotion::rt::ctltest {
+namespace {
+
+TEST(CommandServer, EndOfInputInsideRunIsAnError) {
+  Rig r;
+  Client c(r.sock);
+  c.send("RUN\nWAIT 0.1;\n");
+  ASSERT_EQ(::shutdown(c.fd(), SHUT_WR), 0);
+  std::vector<std::string> lines;
+  ASSERT_TRUE(r.run_until(
+      [&] {
+        while (auto l = c.line()) lines.push_back(*l);
+        return c.eof();
+      },
+      1000));
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0], "ERR end of input inside RUN: the script text must end with a line END");
+}
+
+}  // namespace
+}  // namespace canmotion::rt::ctltest
