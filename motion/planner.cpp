@@ -84,6 +84,9 @@ struct Dyn {
   double t_total = 0, t_acc = 0, t_dec = 0, tj_acc = 0, tj_dec = 0;  // seconds units
   int jerk_units = 0;
   double jerk_pct_a = 0, jerk_pct_d = 0;  // % of time (applied once the start speed is known)
+  bool master_driven = false;  ///< units per master unit / master units: MDSC
+  LockDirection lock = LockDirection::None;
+  double lock_pos = 0.0;
 };
 
 Err decode_dynamics(const Dynamics& y, const AxisConfig& cfg, double last_speed, Dyn& d, std::int8_t& exerr) noexcept {
@@ -98,15 +101,21 @@ Err decode_dynamics(const Dynamics& y, const AxisConfig& cfg, double last_speed,
   if (is_master_driven(static_cast<std::uint8_t>(au)) != md || is_master_driven(static_cast<std::uint8_t>(du)) != md ||
       (d.scurve && is_md_jerk(ju) != md))
     return Err::MdscUnitsConflict;
-  if (md) return Err::MdscNotActivated;  // no MDAC link exists (issue 5)
-  if (lockdir != 0) return Err::MdscLockDirConflict;  // time-driven needs LockDirection none
+  // LockDirection: none in time-driven mode, not none in master-driven mode [RM002H p.512]
+  if (md == (lockdir == 0)) return Err::MdscLockDirConflict;
+  d.master_driven = md;
+  d.lock = y.lock_direction;
+  d.lock_pos = y.lock_position;
   const double speed = y.speed, accel = y.accel, decel = y.decel;
   const double ajerk = y.accel_jerk, djerk = y.decel_jerk;
-  if (su == 3 || au == 3 || du == 3 || (d.scurve && ju == 3)) {  // seconds: all or nothing
-    if (su != 3) { exerr = static_cast<std::int8_t>(is + 1); return Err::ParameterOutOfRange; }
-    if (au != 3) { exerr = static_cast<std::int8_t>(is + 3); return Err::ParameterOutOfRange; }
-    if (du != 3) { exerr = static_cast<std::int8_t>(is + 5); return Err::ParameterOutOfRange; }
-    if (d.scurve && ju != 3) { exerr = static_cast<std::int8_t>(is + 9); return Err::ParameterOutOfRange; }
+  // seconds (3) or, master driven, master units (7): the distance over which
+  // the move happens; all or nothing
+  const int tu = md ? 7 : 3;
+  if (su == tu || au == tu || du == tu || (d.scurve && ju == tu)) {
+    if (su != tu) { exerr = static_cast<std::int8_t>(is + 1); return Err::ParameterOutOfRange; }
+    if (au != tu) { exerr = static_cast<std::int8_t>(is + 3); return Err::ParameterOutOfRange; }
+    if (du != tu) { exerr = static_cast<std::int8_t>(is + 5); return Err::ParameterOutOfRange; }
+    if (d.scurve && ju != tu) { exerr = static_cast<std::int8_t>(is + 9); return Err::ParameterOutOfRange; }
     d.seconds = true;
     d.t_total = speed; d.t_acc = accel; d.t_dec = decel;
     if (!(speed > 0)) { exerr = static_cast<std::int8_t>(is); return Err::ParameterOutOfRange; }
@@ -130,6 +139,7 @@ Err decode_dynamics(const Dynamics& y, const AxisConfig& cfg, double last_speed,
   if (d.scurve) {
     switch (ju) {
       case 0:
+      case 4:  // units per master unit^3
         if (!(ajerk > 0)) { exerr = static_cast<std::int8_t>(is + 7); return Err::ParameterOutOfRange; }
         if (!(djerk > 0)) { exerr = static_cast<std::int8_t>(is + 8); return Err::ParameterOutOfRange; }
         d.lim.ja = ajerk; d.lim.jd = djerk;
@@ -142,7 +152,8 @@ Err decode_dynamics(const Dynamics& y, const AxisConfig& cfg, double last_speed,
         d.lim.ja = ajerk / 100.0 * cfg.max_accel_jerk;
         d.lim.jd = djerk / 100.0 * cfg.max_decel_jerk;
         break;
-      case 2: {
+      case 2:
+      case 6: {  // % of time (master driven: over master distance)
         if (!(ajerk >= 0) || ajerk > 100) { exerr = static_cast<std::int8_t>(is + 7); return Err::ParameterOutOfRange; }
         if (!(djerk >= 0) || djerk > 100) { exerr = static_cast<std::int8_t>(is + 8); return Err::ParameterOutOfRange; }
         d.jerk_pct_a = ajerk; d.jerk_pct_d = djerk;
@@ -215,6 +226,9 @@ bool Planner::any_stopping(const AxisRt& a) const noexcept {
 
 void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
   auto& slot = a.gen[static_cast<std::size_t>(s)];
+  if (auto* p = std::get_if<ProfileGen>(&slot); p && p->master_driven) {
+    if (ControlTag* m = owner_tag(p->mdac, p->mdac_gen)) m->set(flag::AC, false);
+  }
   if (const GenRef g = gen_ref(slot); g.k) {
     a.base += g.k->p;
     if (clear_owner_ip) {
@@ -248,6 +262,121 @@ void Planner::servo_off(AxisRt& a) noexcept {
 void Planner::do_shutdown(AxisRt& a) noexcept {
   servo_off(a);
   a.shutdown = true;
+  break_links(a);  // MASD/MGSD on a slave ...
+  break_links_of_master(static_cast<AxisId>(&a - axes_.data()));  // ... and on a master
+}
+
+void Planner::break_links(AxisRt& a) noexcept {
+  for (auto* arr : {&a.mdac, &a.mdac_pending}) {
+    for (auto& l : *arr) {
+      if (!l.valid()) continue;
+      if (ControlTag* c = owner_tag(l.ctl, l.gen)) {
+        c->set(flag::IP, false);
+        c->set(flag::AC, false);
+      }
+      l = MdacLink{};
+    }
+  }
+}
+
+void Planner::break_links_of_master(AxisId master) noexcept {
+  for (std::size_t i = 0; i < axis_count_; ++i) {
+    bool uses = false;
+    for (const auto& l : axes_[i].mdac) uses = uses || l.master == master;
+    for (const auto& l : axes_[i].mdac_pending) uses = uses || l.master == master;
+    if (uses) break_links(axes_[i]);
+  }
+}
+
+void Planner::promote_pending(AxisRt& a, int ti) noexcept {
+  MdacLink& p = a.mdac_pending[static_cast<std::size_t>(ti)];
+  if (!p.valid()) return;
+  MdacLink& l = a.mdac[static_cast<std::size_t>(ti)];
+  if (l.valid() && (l.ctl != p.ctl || l.gen != p.gen)) {
+    bool still_used = false;  // an "All" MDAC tag may still hold other motion types
+    for (std::size_t k = 0; k < a.mdac.size(); ++k)
+      if (static_cast<int>(k) != ti && a.mdac[k].ctl == l.ctl && a.mdac[k].gen == l.gen) still_used = true;
+    if (!still_used)
+      if (ControlTag* c = owner_tag(l.ctl, l.gen)) { c->set(flag::IP, false); c->set(flag::AC, false); }
+  }
+  l = p;
+  p = MdacLink{};
+}
+
+Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, bool& ok) noexcept {
+  ok = false;
+  const std::size_t k = static_cast<std::size_t>(ti);
+  const MdacLink& l = a.mdac_pending[k].valid() ? a.mdac_pending[k] : a.mdac[k];
+  if (!l.valid()) return Err::MdscNotActivated;
+  const AxisRt& m = axes_[l.master];
+  const double mp = l.use_actual ? m.fb_pos : m.cmd.p;
+  const double mv = l.use_actual ? m.fb_vel : m.cmd.v;
+  const bool immediate = g.lock == LockDirection::ImmediateForwardOnly || g.lock == LockDirection::ImmediateReverseOnly;
+  const bool fwd = g.lock == LockDirection::ImmediateForwardOnly || g.lock == LockDirection::PositionForwardOnly;
+  const double udot = immediate ? std::max(0.0, fwd ? mv : -mv) : 0.0;
+  if (start.v != 0 || start.a != 0) {
+    // the slave's present motion, per unit of master travel
+    if (!(udot > 1e-9)) return Err::MdscIdleMasterSlaveMoving;
+    start = Kin{0, start.v / udot, 0};
+  }
+  g.master_driven = true;
+  g.master = l.master;
+  g.use_actual = l.use_actual;
+  g.locked = immediate;
+  g.prev_mp = mp;
+  g.u = 0;
+  g.mdac = l.ctl;
+  g.mdac_gen = l.gen;
+  ok = true;
+  return Err::None;
+}
+
+// --- MDAC
+Err Planner::start_mdac(const Request& r, const MdacParams& p, AxisRt& a, std::int8_t&) noexcept {
+  if (!a.cfg.configured) return Err::AxisNotConfigured;
+  if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  if (a.shutdown) return Err::ShutdownState;
+  const AxisRt& m = axes_[p.master];
+  if (!m.cfg.configured) return Err::AxisNotConfigured;
+  if (m.cfg.inhibited) return Err::AxisIsInhibited;
+  if (p.slave == p.master) return Err::MasterAxisConflict;
+  if (a.homing || m.homing) return Err::HomeInProcess;
+  // a virtual master always gives command, a feedback-only/CIP master follows the operand [seed 000]
+  const bool use_actual = p.master_reference == MasterReference::Actual && m.cfg.type == AxisType::CipDrive;
+  const bool all = p.motion_type == 0;
+  const bool moving = a.cmd.v != 0 || a.cmd.a != 0;
+  bool any_all = false, any_single = false;
+  for (const auto& l : a.mdac) {
+    if (!l.valid()) continue;
+    if (l.all) any_all = true; else any_single = true;
+  }
+  if ((all && any_single) || (!all && any_all)) return Err::MdscMdacAllConflict;  // [seed 000]
+  const std::size_t first = all ? 0 : static_cast<std::size_t>(p.motion_type - 1);
+  const std::size_t last = all ? a.mdac.size() : first + 1;
+  for (std::size_t k = first; k < last; ++k) {
+    const MdacLink& l = a.mdac[k];
+    // changing the master reference of a moving slave errors; the original stays [seed 000]
+    if (l.valid() && l.master == p.master && l.use_actual != use_actual && moving) return Err::MdscInvalidModeOrMasterChange;
+  }
+  ControlTag& c = controls_[r.control];
+  const MdacLink nl{p.master, use_actual, all, r.control, c.generation};
+  for (std::size_t k = first; k < last; ++k) {
+    MdacLink& l = a.mdac[k];
+    if (l.valid() && (l.master != p.master || l.use_actual != use_actual)) {
+      // the new master is queued: it takes over when the next single-axis motion goes IP [seed 000]
+      MdacLink& q = a.mdac_pending[k];
+      if (q.valid() && (q.ctl != r.control || q.gen != c.generation))
+        if (ControlTag* o = owner_tag(q.ctl, q.gen)) o->set(flag::IP, false);  // a newer pending MDAC overrides
+      q = nl;
+    } else {
+      if (l.valid() && (l.ctl != r.control || l.gen != c.generation))
+        if (ControlTag* o = owner_tag(l.ctl, l.gen)) { o->set(flag::IP, false); o->set(flag::AC, false); }
+      l = nl;
+    }
+  }
+  c.set(flag::DN, true);
+  c.set(flag::IP, true);
+  return Err::None;
 }
 
 bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, ControlId owner,
@@ -359,6 +488,7 @@ Err Planner::execute(const Request& r) noexcept {
           else if constexpr (std::is_same_v<P, McdParams>) return start_mcd(r, p, axes_[p.axis], exerr);
           else if constexpr (std::is_same_v<P, MrpParams>) return start_mrp(r, p, axes_[p.axis]);
           else if constexpr (std::is_same_v<P, MagParams>) return start_mag(r, p, axes_[p.slave], exerr);
+          else if constexpr (std::is_same_v<P, MdacParams>) return start_mdac(r, p, axes_[p.slave], exerr);
           else if constexpr (std::is_same_v<P, MgsParams>) return start_group(r, p.group, p.mode, exerr);
           else if constexpr (std::is_same_v<P, MgsdParams> || std::is_same_v<P, MgsrParams>)
             return start_group(r, p.group, GroupStopMode::Programmed, exerr);
@@ -519,6 +649,7 @@ Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int
     }
   }
   const bool ramping = a.servo && mask != 0 && stop_slots(a, mask, d, jd, r.control, 0);
+  if (type == StopType::All) break_links(a);  // MAS All on the slave breaks its MDAC links
   if (ramping) c.set(flag::IP, true);
   else c.set(flag::PC, true);
   return Err::None;
@@ -575,7 +706,7 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
   else if (old) start = Kin{0, old->k.v, old->scurve ? old->k.a : 0.0};
   double V = dy.speed;
   if (dy.merge && dy.merge_current && std::fabs(start.v) > 0) V = std::fabs(start.v);
-  if (dy.scurve && dy.jerk_units == 2) {
+  if (dy.scurve && (dy.jerk_units == 2 || dy.jerk_units == 6)) {
     // [UM003F p.258]: decel jerk uses max(Speed, |StartSpeed - Speed|)
     const double vref = V > 0 ? V : a.last_speed;
     dy.lim.ja = jerk_from_percent_of_time(dy.lim.a, vref, dy.jerk_pct_a);
@@ -583,6 +714,12 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
   }
   ProfileGen g;
   g.role = GenRole::Jog;
+  if (dy.master_driven) {  // the profile runs over master travel
+    g.lock = dy.lock;
+    g.lock_pos = dy.lock_pos;
+    bool ok_md = true;
+    if (Err e = master_driven_setup(a, 1, g, start, ok_md); e != Err::None) return e;
+  }
   g.lim = dy.lim;
   g.lim.v = V > 0 ? V : 1.0;
   if (!plan_velocity(g.prof, start, dir * V, g.lim)) {
@@ -603,6 +740,11 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
   g.jog_velocity = dir * V;
   g.owner = r.control;
   g.owner_gen = c.generation;
+  promote_pending(a, 1);
+  if (g.master_driven) {
+    c.set(flag::AC, true);
+    if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
+  }
   a.gen[static_cast<std::size_t>(Slot::Jog)] = g;
   if (V > 0) a.last_speed = V;
   c.set(flag::DN, true);
@@ -665,6 +807,12 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   if (L < 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitNegative & 1u)) return Err::OvertravelCondition;
   ProfileGen g;
   g.role = GenRole::Move;
+  if (dy.master_driven) {  // the profile runs over master travel
+    g.lock = dy.lock;
+    g.lock_pos = dy.lock_pos;
+    bool ok_md = true;
+    if (Err e = master_driven_setup(a, 0, g, start, ok_md); e != Err::None) return e;
+  }
   if (dy.seconds) {
     const double Ld = std::fabs(L);
     const double V = Ld / (dy.t_total - dy.t_acc / 2 - dy.t_dec / 2);
@@ -689,7 +837,7 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
     g.lim = dy.lim;
     g.lim.v = V;
     g.speed = V;
-    if (dy.scurve && dy.jerk_units == 2 && V > 0) {
+    if (dy.scurve && (dy.jerk_units == 2 || dy.jerk_units == 6) && V > 0) {
       g.lim.ja = jerk_from_percent_of_time(g.lim.a, V, dy.jerk_pct_a);
       g.lim.jd = jerk_from_percent_of_time(g.lim.d, V, dy.jerk_pct_d);
     }
@@ -722,6 +870,11 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   g.scurve = dy.scurve;
   g.owner = r.control;
   g.owner_gen = c.generation;
+  promote_pending(a, 0);
+  if (g.master_driven) {
+    c.set(flag::AC, true);
+    if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
+  }
   a.gen[static_cast<std::size_t>(Slot::Move)] = g;
   if (g.speed > 0) a.last_speed = g.speed;
   c.set(flag::DN, true);
@@ -866,6 +1019,7 @@ Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mo
       a.homing = false;
       if (ControlTag* h = owner_tag(a.mah, a.mah_gen)) h->set(flag::IP, false);
     }
+    break_links(a);  // MGS breaks the MDAC links of its slaves
     if (m == ProgrammedStopMode::HardDisable) { servo_off(a); continue; }
     if (m == ProgrammedStopMode::HardShutdown) { do_shutdown(a); continue; }
     const std::uint8_t post = m == ProgrammedStopMode::FastDisable ? 1 : (m == ProgrammedStopMode::FastShutdown ? 2 : 0);
@@ -1009,6 +1163,7 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
     case ExceptionAction::StopDrive:
       servo_off(a);
       a.faulted = true;
+      break_links(a);  // an axis fault breaks the MDAC link
       break;
     case ExceptionAction::Shutdown:
       do_shutdown(a);
@@ -1038,9 +1193,31 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
     }
     auto* g = std::get_if<ProfileGen>(&a.gen[s]);
     if (!g) continue;
-    const double t = static_cast<double>(cycle_ - g->t0_cycle) * T_;
-    g->k = g->prof.sample(t, g->hint);
-    const bool done = g->role != GenRole::Jog && g->prof.finite() && t >= g->prof.duration();
+    bool done;
+    if (g->master_driven) {
+      // abscissa = master travel in the lock direction [RM002H p.512]
+      const AxisRt& m = axes_[g->master];
+      const double mp = g->use_actual ? m.fb_pos : m.cmd.p;
+      double dm = mp - g->prev_mp;
+      const bool fwd = g->lock == LockDirection::ImmediateForwardOnly || g->lock == LockDirection::PositionForwardOnly;
+      if (!g->locked) {
+        const bool crossed = fwd ? (g->prev_mp < g->lock_pos && mp >= g->lock_pos)
+                                 : (g->prev_mp > g->lock_pos && mp <= g->lock_pos);
+        if (crossed) { g->locked = true; dm = mp - g->lock_pos; } else { dm = 0; }
+      }
+      g->prev_mp = mp;
+      const double du = g->locked ? std::max(0.0, fwd ? dm : -dm) : 0.0;
+      g->following = du > 0;
+      g->u += du;
+      const Kin ku = g->prof.sample(g->u, g->hint);
+      const double udot = du / T_;
+      g->k = Kin{ku.p, ku.v * udot, ku.a * udot * udot};
+      done = g->role != GenRole::Jog && g->prof.finite() && g->u >= g->prof.duration();
+    } else {
+      const double t = static_cast<double>(cycle_ - g->t0_cycle) * T_;
+      g->k = g->prof.sample(t, g->hint);
+      done = g->role != GenRole::Jog && g->prof.finite() && t >= g->prof.duration();
+    }
     ControlTag* c = owner_tag(g->owner, g->owner_gen);
     if (done) {
       if (g->role == GenRole::Move) {
@@ -1105,6 +1282,11 @@ void Planner::update_status(AxisRt& a) noexcept {
   const auto* jg = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Jog)]);
   setb(MoveStatus, mv && mv->role == GenRole::Move);
   setb(JogStatus, jg && jg->role == GenRole::Jog);
+  setb(MoveLockStatus, mv && mv->role == GenRole::Move && mv->master_driven && mv->locked && mv->following);
+  setb(JogLockStatus, jg && jg->role == GenRole::Jog && jg->master_driven && jg->locked && jg->following);
+  bool linked = false;
+  for (const auto& l : a.mdac) linked = linked || l.valid();
+  setb(CoordinatedMotionStatus, linked);
   const auto* gr = std::get_if<GearGen>(&a.gen[static_cast<std::size_t>(Slot::Gear)]);
   setb(GearingStatus, gr != nullptr);
   setb(GearingLockStatus, gr && gr->locked);
@@ -1264,23 +1446,47 @@ void Planner::step_gear(GearGen& g) noexcept {
 }
 
 void Planner::compute_order() noexcept {
-  // depth-first: an axis after its gear master (MAG refuses cycles: ERR 10)
-  std::array<std::uint8_t, kMaxAxes> mark{};
+  // depth-first: every axis after the masters it follows (gear, master-driven
+  // motion). MAG refuses gear cycles (ERR 10); a cycle through master-driven
+  // motion is broken arbitrarily (the stack below bounds the walk).
+  std::array<std::uint8_t, kMaxAxes> mark{};  // 0 new, 1 on stack, 2 emitted
   order_n_ = 0;
+  auto masters_of = [this](AxisId i, std::array<AxisId, kSlots>& out) noexcept {
+    std::size_t n = 0;
+    for (const auto& s : axes_[i].gen) {
+      AxisId m = kNoAxis;
+      if (auto* g = std::get_if<GearGen>(&s)) m = g->master;
+      if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) m = p->master;
+      if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
+    }
+    for (std::size_t k = n; k < kSlots; ++k) out[k] = kNoAxis;
+  };
+  struct Frame { AxisId axis; std::uint8_t next; };
+  std::array<Frame, kMaxAxes> stack{};
   for (std::size_t i = 0; i < axis_count_; ++i) {
     if (!axes_[i].present || mark[i]) continue;
-    // walk up the master chain iteratively, then emit from the top down
-    std::array<AxisId, kMaxAxes> chain{};
-    std::size_t n = 0;
-    AxisId c = static_cast<AxisId>(i);
-    while (n < kMaxAxes && !mark[c]) {
-      mark[c] = 1;
-      chain[n++] = c;
-      const auto* g = std::get_if<GearGen>(&axes_[c].gen[static_cast<std::size_t>(Slot::Gear)]);
-      if (!g || g->master >= kMaxAxes || !axes_[g->master].present) break;
-      c = g->master;
+    std::size_t sp = 0;
+    stack[sp++] = Frame{static_cast<AxisId>(i), 0};
+    mark[i] = 1;
+    while (sp > 0) {
+      Frame& f = stack[sp - 1];
+      std::array<AxisId, kSlots> ms{};
+      masters_of(f.axis, ms);
+      bool pushed = false;
+      while (f.next < kSlots) {
+        const AxisId m = ms[f.next++];
+        if (m != kNoAxis && mark[m] == 0 && sp < kMaxAxes) {
+          mark[m] = 1;
+          stack[sp++] = Frame{m, 0};
+          pushed = true;
+          break;
+        }
+      }
+      if (pushed) continue;
+      mark[f.axis] = 2;
+      order_[order_n_++] = f.axis;
+      --sp;
     }
-    while (n > 0) order_[order_n_++] = chain[--n];
   }
 }
 

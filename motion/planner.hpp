@@ -132,6 +132,28 @@ struct ProfileGen {
   ControlId owner = kNoControl;
   std::uint32_t owner_gen = 0;
   std::uint8_t post_stop = 0;  ///< stop ramps of MGS: 0 none, 1 disable, 2 shutdown
+  // master driven (MDSC): the profile's abscissa is master travel, not time
+  bool master_driven = false;
+  AxisId master = kNoAxis;
+  bool use_actual = false;
+  LockDirection lock = LockDirection::None;
+  double lock_pos = 0.0;
+  bool locked = false;         ///< lock condition met (position locks: master crossed LockPosition)
+  bool following = false;      ///< master moved in the lock direction this cycle (Move/JogLockStatus)
+  double u = 0.0;              ///< master travel counted so far (profile abscissa)
+  double prev_mp = 0.0;        ///< master position last cycle
+  ControlId mdac = kNoControl; ///< the MDAC whose AC bit this motion sets
+  std::uint32_t mdac_gen = 0;
+};
+
+/// One MDAC link of a slave (per motion type).
+struct MdacLink {
+  AxisId master = kNoAxis;
+  bool use_actual = false;
+  bool all = false;            ///< set by MDAC MotionType All
+  ControlId ctl = kNoControl;
+  std::uint32_t gen = 0;
+  constexpr bool valid() const noexcept { return master != kNoAxis; }
 };
 
 /// State of an MAG (electronic gearing). The slave offset follows the master
@@ -171,6 +193,7 @@ struct MamParams;
 struct McdParams;
 struct MrpParams;
 struct MagParams;
+struct MdacParams;
 
 // ------------------------------------------------------------------ planner
 /// The planner. All state is inside (fixed arrays); update() is noexcept,
@@ -231,6 +254,8 @@ class Planner {
     std::uint64_t mso_deadline = 0;
     ControlId mah = kNoControl;
     std::uint32_t mah_gen = 0;
+    /// MDAC links per motion type (0 move, 1 jog, 2 time cam, 3 master offset move) and the queued masters
+    std::array<MdacLink, 4> mdac{}, mdac_pending{};
     int gear_dir = 0;           ///< last gearing direction (+1 same, -1 opposite, 0 never geared)
     bool homing = false;        ///< drive homing (mode 6) in progress
     bool homing_started = false;
@@ -256,6 +281,11 @@ class Planner {
   Err start_mcd(const Request&, const McdParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mrp(const Request&, const MrpParams&, AxisRt&) noexcept;
   Err start_mag(const Request&, const MagParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mdac(const Request&, const MdacParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  void break_links(AxisRt& slave) noexcept;
+  void break_links_of_master(AxisId master) noexcept;
+  void promote_pending(AxisRt& a, int type_index) noexcept;
+  Err master_driven_setup(AxisRt& a, int type_index, ProfileGen& g, Kin& start_u, bool& ok) noexcept;
   Err start_group(const Request&, std::uint16_t group, GroupStopMode mode, std::int8_t& exerr) noexcept;
 
   // helpers

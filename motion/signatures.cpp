@@ -182,7 +182,7 @@ constexpr std::array<InstrSig, kInstrCount> kTable{{
     {Instr::MCCP, "MCCP", kMccp, false},
     {Instr::MAPC, "MAPC", kMapc, false},
     {Instr::MATC, "MATC", kMatc, false},
-    {Instr::MDAC, "MDAC", kMdac, false},
+    {Instr::MDAC, "MDAC", kMdac, true},
     {Instr::MDS, "MDS", kMds, false},
     {Instr::MGS, "MGS", kMgs, true},
     {Instr::MGSD, "MGSD", kGroupCtl, true},

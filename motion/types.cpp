@@ -52,6 +52,8 @@ std::string_view err_name(Err e) noexcept {
     case Err::MdscUnitsConflict: return "MDSC Units Conflict";
     case Err::MdscLockDirConflict: return "MDSC Lock Direction Conflict";
     case Err::MdscMdacAllConflict: return "MDSC MDAC All Conflict";
+    case Err::MdscIdleMasterSlaveMoving: return "MDSC Idle Master And Slave Moving";
+    case Err::MdscInvalidModeOrMasterChange: return "MDSC Invalid Mode Or Master Change";
     case Err::FeatureNotSupported: return "Feature Not Supported";
     case Err::AxisNotAtRest: return "Axis Not At Rest";
   }

@@ -160,8 +160,10 @@ enum class Err : std::int16_t {
   MdscUnitsConflict = 94,
   MdscLockDirConflict = 95,
   MdscMdacAllConflict = 96,
+  MdscIdleMasterSlaveMoving = 97,
   FeatureNotSupported = 99,
   AxisNotAtRest = 100,
+  MdscInvalidModeOrMasterChange = 105,
 };
 
 /// Human-readable name of an ERR code (for logs and the command line; not RT-relevant).

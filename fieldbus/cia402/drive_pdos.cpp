@@ -36,4 +36,13 @@ DrivePdoSet default_drive_pdos(PdoProfile profile, std::uint8_t node) noexcept {
   return s;
 }
 
+canopen::NodeTraffic node_traffic(PdoProfile profile, std::uint32_t heartbeat_ms) noexcept {
+  const DrivePdoSet s = default_drive_pdos(profile, 1);
+  canopen::NodeTraffic t;
+  for (std::uint8_t i = 0; i < s.rpdo_count && i < 4; ++i) t.rpdo_bytes[t.rpdo_count++] = s.rpdo[i].size_bytes;
+  for (std::uint8_t i = 0; i < s.tpdo_count && i < 4; ++i) t.tpdo_bytes[t.tpdo_count++] = s.tpdo[i].size_bytes;
+  t.heartbeat_ms = heartbeat_ms;
+  return t;
+}
+
 }  // namespace canmotion::cia402

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 
+#include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/pdo.hpp"
 
 namespace canmotion::cia402 {
@@ -31,5 +32,10 @@ struct DrivePdoSet {
 
 /// Build the default maps. Realtime-safe (constexpr data only).
 [[nodiscard]] DrivePdoSet default_drive_pdos(PdoProfile profile, std::uint8_t node) noexcept;
+
+/// The cyclic bus traffic of one drive with `profile` (for
+/// canopen::bus_budget / canopen::max_axes), with the drive's heartbeat
+/// period (0x1017, 0 = none). Realtime-safe.
+[[nodiscard]] canopen::NodeTraffic node_traffic(PdoProfile profile, std::uint32_t heartbeat_ms = 0) noexcept;
 
 }  // namespace canmotion::cia402

@@ -790,8 +790,15 @@ struct CommandServer::Impl {
         if (re & (POLLHUP | POLLERR)) c.dead = true;  // the peer closed its socket: nobody to answer
       }
     }
-    for (auto& c : clients)
-      if (!c->dead) handle_input(*c);
+    for (auto& c : clients) {
+      if (c->dead) continue;
+      handle_input(*c);
+      if (c->eof && c->mode == Mode::kScriptText && c->in.find('\n') == std::string::npos) {
+        c->mode = Mode::kIdle;
+        c->script_text.clear();
+        fail_and_close(*c, "end of input inside RUN: the script text must end with a line END");
+      }
+    }
     for (auto& c : clients)
       if (!c->dead && !c->out.empty()) flush(*c);
     if (r > 0 && (pfds[0].revents & POLLIN)) accept_all();  // new clients are read at the next poll

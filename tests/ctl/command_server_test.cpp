@@ -509,3 +509,53 @@ TEST(CommandServer, PeerCredentialsAreChecked) {
 
 }  // namespace
 }  // namespace canmotion::rt::ctltest
+
+namespace canmotion::rt::ctltest {
+namespace {
+
+TEST(CommandServer, HalfClosedClientGetsItsAnswersThenEof) {
+  // `printf 'GET ...\n' | socat - UNIX-CONNECT:...` sends, then shuts down its
+  // sending side: every request is still answered, then the server closes.
+  Rig r;
+  Client c(r.sock);
+  c.send("GET Controller.Cycle\nMSO(Master, mso1)\nSTATUS\n");
+  ASSERT_EQ(::shutdown(c.fd(), SHUT_WR), 0);
+  std::vector<std::string> lines;
+  ASSERT_TRUE(r.run_until(
+      [&] {
+        while (auto l = c.line()) lines.push_back(*l);
+        return c.eof();
+      },
+      1000));
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[0].rfind("OK Controller.Cycle=", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[1].rfind("OK mso1 EN=1", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[4].rfind("OK 2 axes", 0), 0u) << lines[4];
+  r.step();
+  EXPECT_EQ(r.server->client_count(), 0u);
+}
+
+}  // namespace
+}  // namespace canmotion::rt::ctltest
+
+namespace canmotion::rt::ctltest {
+namespace {
+
+TEST(CommandServer, EndOfInputInsideRunIsAnError) {
+  Rig r;
+  Client c(r.sock);
+  c.send("RUN\nWAIT 0.1;\n");
+  ASSERT_EQ(::shutdown(c.fd(), SHUT_WR), 0);
+  std::vector<std::string> lines;
+  ASSERT_TRUE(r.run_until(
+      [&] {
+        while (auto l = c.line()) lines.push_back(*l);
+        return c.eof();
+      },
+      1000));
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0], "ERR end of input inside RUN: the script text must end with a line END");
+}
+
+}  // namespace
+}  // namespace canmotion::rt::ctltest

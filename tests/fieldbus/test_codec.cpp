@@ -34,7 +34,7 @@ int test_count(int dflt) {
 }  // namespace
 
 // ---- master frames -------------------------------------------------------------
-TEST(Golden, MasterNmtSyncHeartbeat) {
+TEST(FieldbusGolden, MasterNmtSyncHeartbeat) {
   canopen::MasterConfig mc;
   mc.node_id = 127;
   mc.heartbeat_period_ms = 100;
@@ -57,7 +57,7 @@ TEST(Golden, MasterNmtSyncHeartbeat) {
   EXPECT_EQ(got, expected);
 }
 
-TEST(Golden, SyncCounterWraps) {
+TEST(FieldbusGolden, SyncCounterWraps) {
   canopen::MasterConfig mc;
   mc.sync_counter_overflow = 3;
   mc.heartbeat_period_ms = 0;
@@ -69,7 +69,7 @@ TEST(Golden, SyncCounterWraps) {
   EXPECT_EQ(got, (std::vector<std::string>{"080#01", "080#02", "080#03", "080#01"}));
 }
 
-TEST(Golden, MasterRpdosAndBootConfiguration) {
+TEST(FieldbusGolden, MasterRpdosAndBootConfiguration) {
   cia402::NetworkConfig nc;
   cia402::DriveNetwork net(nc);
   cia402::DriveConfig dc;
@@ -92,7 +92,7 @@ TEST(Golden, MasterRpdosAndBootConfiguration) {
   EXPECT_EQ(pdos.tpdo[1].entries[2].raw(), 0x60610008u);
 }
 
-TEST(Golden, ProxyRpdoAndTpdoBytes) {
+TEST(FieldbusGolden, ProxyRpdoAndTpdoBytes) {
   cia402::DriveNetwork net;
   cia402::DriveConfig dc;
   dc.node = 3;
@@ -136,7 +136,7 @@ TEST(Golden, ProxyRpdoAndTpdoBytes) {
 }
 
 // ---- emulator frames -------------------------------------------------------
-TEST(Golden, EmulatorBootHeartbeatSdoTpdoEmcy) {
+TEST(FieldbusGolden, EmulatorBootHeartbeatSdoTpdoEmcy) {
   emulator::EmulatorConfig ec;
   ec.node = 2;
   ec.initial_position = 0x01020304;
@@ -181,7 +181,7 @@ TEST(Golden, EmulatorBootHeartbeatSdoTpdoEmcy) {
   EXPECT_EQ(got, (std::vector<std::string>{"082#0000000000000000", "182#600204030201"}));
 }
 
-TEST(Golden, EmulatorRpdoLengthErrorGivesEmcy8210) {
+TEST(FieldbusGolden, EmulatorRpdoLengthErrorGivesEmcy8210) {
   emulator::EmulatorConfig ec;
   ec.node = 2;
   emulator::Emulator emu(ec);
@@ -195,7 +195,7 @@ TEST(Golden, EmulatorRpdoLengthErrorGivesEmcy8210) {
 }
 
 // ---- CiA 402 state table, transition by transition ---------------------------
-TEST(StateTable, EveryCommandedTransition) {
+TEST(FieldbusStateTable, EveryCommandedTransition) {
   struct Row {
     State from;
     std::uint16_t cw;
@@ -236,7 +236,7 @@ TEST(StateTable, EveryCommandedTransition) {
   EXPECT_EQ(cia402::apply_controlword(State::kQuickStopActive, 0x0002, 0x000F, 2).transition, cia402::kNoTransition);
 }
 
-TEST(StateTable, CommandsWithoutTransitionLeaveTheStateAlone) {
+TEST(FieldbusStateTable, CommandsWithoutTransitionLeaveTheStateAlone) {
   const State all[] = {State::kSwitchOnDisabled, State::kReadyToSwitchOn, State::kSwitchedOn,
                        State::kOperationEnabled, State::kQuickStopActive};
   const std::uint16_t cws[] = {0x0000, 0x0002, 0x0006, 0x0007, 0x000F};
@@ -257,7 +257,7 @@ TEST(StateTable, CommandsWithoutTransitionLeaveTheStateAlone) {
   EXPECT_EQ(cia402::apply_controlword(State::kFaultReactionActive, 0, 0x0080).transition, cia402::kNoTransition);
 }
 
-TEST(StateTable, MasterPlanReachesEveryTargetThroughNumberedTransitions) {
+TEST(FieldbusStateTable, MasterPlanReachesEveryTargetThroughNumberedTransitions) {
   const State starts[] = {State::kSwitchOnDisabled, State::kReadyToSwitchOn, State::kSwitchedOn,
                           State::kOperationEnabled, State::kQuickStopActive, State::kFault};
   const State targets[] = {State::kOperationEnabled, State::kSwitchOnDisabled, State::kSwitchedOn,
@@ -281,7 +281,7 @@ TEST(StateTable, MasterPlanReachesEveryTargetThroughNumberedTransitions) {
   EXPECT_FALSE(cia402::next_step(State::kFaultReactionActive, State::kOperationEnabled).has_value());
 }
 
-TEST(StateTable, ProxyFailureExplainsItself) {
+TEST(FieldbusStateTable, ProxyFailureExplainsItself) {
   cia402::Failure f;
   f.kind = cia402::FailureKind::kTransitionTimeout;
   f.node = 2;
@@ -298,7 +298,7 @@ TEST(StateTable, ProxyFailureExplainsItself) {
 }
 
 // ---- PDO packing ----------------------------------------------------------------
-TEST(Pdo, OffsetsComputedAtConfiguration) {
+TEST(FieldbusPdo, OffsetsComputedAtConfiguration) {
   canopen::PdoMap m;
   m.add(0x6040, 0, 16);
   m.add(0x607A, 0, 32);
@@ -311,7 +311,7 @@ TEST(Pdo, OffsetsComputedAtConfiguration) {
   EXPECT_FALSE(m.finalize());  // 88 bits
 }
 
-TEST(Pdo, PackUnpackRoundTripProperty) {
+TEST(FieldbusPdo, PackUnpackRoundTripProperty) {
   const std::uint64_t seed = test_seed();
   const int count = test_count(20000);
   std::mt19937_64 rng(seed);
@@ -333,7 +333,7 @@ TEST(Pdo, PackUnpackRoundTripProperty) {
 }
 
 // ---- bus budget ------------------------------------------------------------------
-TEST(BusBudget, WorstCaseFrameLengths) {
+TEST(FieldbusBusBudget, WorstCaseFrameLengths) {
   EXPECT_EQ(canopen::frame_bits_worst_case(0), 55u);
   EXPECT_EQ(canopen::frame_bits_worst_case(1), 65u);
   EXPECT_EQ(canopen::frame_bits_worst_case(6), 115u);
@@ -342,7 +342,7 @@ TEST(BusBudget, WorstCaseFrameLengths) {
   EXPECT_EQ(canopen::frame_bits_no_stuffing(8), 111u);
 }
 
-TEST(BusBudget, DefaultCspMapping) {
+TEST(FieldbusBusBudget, DefaultCspMapping) {
   canopen::NodeTraffic axis;
   axis.rpdo_bytes[0] = 6;
   axis.rpdo_count = 1;
@@ -359,10 +359,23 @@ TEST(BusBudget, DefaultCspMapping) {
   EXPECT_EQ(canopen::max_axes(axis, 1'000'000, 1'000'000), 4u);
   EXPECT_EQ(canopen::max_axes(axis, 2'000'000, 1'000'000), 8u);
   EXPECT_EQ(canopen::max_axes(axis, 4'000'000, 1'000'000), 17u);
+  // The same from the profile the proxy configures.
+  const auto t = cia402::node_traffic(cia402::PdoProfile::kCsp);
+  EXPECT_EQ(t.rpdo_count, 1);
+  EXPECT_EQ(t.rpdo_bytes[0], 6);
+  EXPECT_EQ(t.tpdo_bytes[0], 6);
+  const auto full = cia402::node_traffic(cia402::PdoProfile::kCspCsvCst, 100);
+  EXPECT_EQ(full.rpdo_count + full.tpdo_count, 4);
+  EXPECT_EQ(canopen::max_axes(full, 2'000'000, 1'000'000), 4u);
+  // Heartbeats are averaged over their period: 65 bits every 100 ms at 1 ms = 0.65 bits.
+  const canopen::NodeTraffic one[] = {full};
+  canopen::BusBudgetInput hb;
+  hb.nodes = one;
+  EXPECT_DOUBLE_EQ(canopen::bus_budget(hb).heartbeat_bits, 0.65);
 }
 
 // ---- SimBus -----------------------------------------------------------------------
-TEST(SimBus, BroadcastDropDelayCorrupt) {
+TEST(FieldbusSimBus, BroadcastDropDelayCorrupt) {
   can::SimBus bus;
   auto& a = bus.add_endpoint("a");
   auto& b = bus.add_endpoint("b");
@@ -402,7 +415,7 @@ TEST(SimBus, BroadcastDropDelayCorrupt) {
   EXPECT_EQ(bus.counters().corrupted, 1u);
 }
 
-TEST(SimBus, OverflowAndBusOffAreEvents) {
+TEST(FieldbusSimBus, OverflowAndBusOffAreEvents) {
   can::SimBus bus;
   auto& a = bus.add_endpoint("a");
   auto& b = bus.add_endpoint("b", 2);

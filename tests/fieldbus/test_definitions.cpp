@@ -14,7 +14,7 @@
 using namespace canmotion;
 using canopen::FrameKind;
 
-TEST(CobId, ClassifiesPredefinedConnectionSet) {
+TEST(FieldbusCobId, ClassifiesPredefinedConnectionSet) {
   using canopen::classify;
   using canopen::CobInfo;
   EXPECT_EQ(classify(0x000), (CobInfo{FrameKind::kNmt, 0, 0}));
@@ -43,7 +43,7 @@ TEST(CobId, ClassifiesPredefinedConnectionSet) {
   }
 }
 
-TEST(Nmt, FramesAndNames) {
+TEST(FieldbusNmt, FramesAndNames) {
   const auto f = canopen::make_nmt_frame(canopen::NmtCommand::kStart, 2);
   EXPECT_EQ(f, (can::Frame{0x000, {0x01, 0x02}}));
   EXPECT_EQ(canopen::make_heartbeat_frame(3, canopen::NmtState::kPreOperational), (can::Frame{0x703, {0x7F}}));
@@ -52,7 +52,7 @@ TEST(Nmt, FramesAndNames) {
   EXPECT_EQ(canopen::nmt_command_name(std::uint8_t{0x33}), "unknown");
 }
 
-TEST(SdoAbort, EveryCodeHasItsOwnText) {
+TEST(FieldbusSdoAbort, EveryCodeHasItsOwnText) {
   std::set<std::string_view> texts;
   for (auto a : canopen::kAllSdoAborts) {
     const auto t = canopen::sdo_abort_text(a);
@@ -64,7 +64,7 @@ TEST(SdoAbort, EveryCodeHasItsOwnText) {
   EXPECT_EQ(canopen::sdo_abort_text(0x12345678u), "unknown SDO abort code");
 }
 
-TEST(SdoFrame, DecodesExpeditedAndSegments) {
+TEST(FieldbusSdoFrame, DecodesExpeditedAndSegments) {
   using namespace canopen::sdo;
   const auto up = decode(can::Frame{0x582, {0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00}}, true);
   EXPECT_EQ(up.kind, SdoFrameKind::kInitiateUploadResponse);
@@ -84,7 +84,7 @@ TEST(SdoFrame, DecodesExpeditedAndSegments) {
   EXPECT_EQ(ab.abort_code, 0x06020000u);
 }
 
-TEST(Emcy, DecodeEncodeAndTexts) {
+TEST(FieldbusEmcy, DecodeEncodeAndTexts) {
   const can::Frame f{0x082, {0x11, 0x86, 0x20, 1, 2, 3, 4, 5}};
   const auto e = canopen::decode_emcy(f);
   ASSERT_TRUE(e.has_value());
@@ -101,7 +101,7 @@ TEST(Emcy, DecodeEncodeAndTexts) {
   EXPECT_FALSE(canopen::decode_emcy(can::Frame{0x182, {0, 0}}).has_value());
 }
 
-TEST(ObjectNames, KnownObjectsAndRanges) {
+TEST(FieldbusObjectNames, KnownObjectsAndRanges) {
   EXPECT_EQ(canopen::object_name(0x6040, 0), "Controlword");
   EXPECT_EQ(canopen::object_name(0x1A01, 3), "TPDO mapping parameter: mapped object");
   EXPECT_EQ(canopen::object_name(0x1016, 1), "Consumer heartbeat time");
@@ -115,7 +115,7 @@ TEST(ObjectNames, KnownObjectsAndRanges) {
   EXPECT_EQ((canopen::MappingEntry{0x6040, 0, 16}).raw(), 0x60400010u);
 }
 
-TEST(Cia402, DecodeStateTable) {
+TEST(FieldbusCia402, DecodeStateTable) {
   using cia402::State;
   EXPECT_EQ(cia402::decode_state(0x0000), State::kNotReadyToSwitchOn);
   EXPECT_EQ(cia402::decode_state(0x0040), State::kSwitchOnDisabled);
@@ -135,7 +135,7 @@ TEST(Cia402, DecodeStateTable) {
   }
 }
 
-TEST(Cia402, CommandsDecodeToThemselves) {
+TEST(FieldbusCia402, CommandsDecodeToThemselves) {
   using cia402::Command;
   for (auto c : {Command::kShutdown, Command::kSwitchOn, Command::kEnableOperation, Command::kDisableVoltage,
                  Command::kQuickStop, Command::kFaultReset}) {
@@ -147,7 +147,7 @@ TEST(Cia402, CommandsDecodeToThemselves) {
   EXPECT_EQ(cia402::decode_command(0x000B), Command::kQuickStop);
 }
 
-TEST(Cia402, InterpolationPeriod) {
+TEST(FieldbusCia402, InterpolationPeriod) {
   using cia402::InterpolationPeriod;
   EXPECT_EQ(cia402::encode_interpolation_period(1'000'000), (InterpolationPeriod{1, -3}));
   EXPECT_EQ(cia402::encode_interpolation_period(2'000'000), (InterpolationPeriod{2, -3}));

@@ -30,7 +30,7 @@ void boot_and_enable(SimRig& rig) {
 }
 }  // namespace
 
-TEST(Loop, BootConfigureEnable) {
+TEST(FieldbusLoop, BootConfigureEnable) {
   SimRig rig(rig_config());
   boot_and_enable(rig);
   for (std::uint8_t n : kNodes) {
@@ -50,7 +50,7 @@ TEST(Loop, BootConfigureEnable) {
   EXPECT_EQ(rig.emulator(2).position(), 0);
 }
 
-TEST(Loop, CspRampFollowedWithinLag) {
+TEST(FieldbusLoop, CspRampFollowedWithinLag) {
   SimRigConfig cfg = rig_config();
   cfg.emulator.lag_cycles = 2;
   cfg.emulator.initial_position = 12345;
@@ -76,7 +76,7 @@ TEST(Loop, CspRampFollowedWithinLag) {
   EXPECT_FALSE(rig.network().any_failed());
 }
 
-TEST(Loop, InjectedFaultEmcyResetReenable) {
+TEST(FieldbusLoop, InjectedFaultEmcyResetReenable) {
   SimRig rig(rig_config());
   boot_and_enable(rig);
   // Inject over SDO: write 0x2310 to 0x2000 of node 3.
@@ -99,7 +99,7 @@ TEST(Loop, InjectedFaultEmcyResetReenable) {
   ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 100));
 }
 
-TEST(Loop, FollowingErrorFaultsWith8611) {
+TEST(FieldbusLoop, FollowingErrorFaultsWith8611) {
   SimRigConfig cfg = rig_config();
   cfg.emulator.following_error_window = 1000;
   SimRig rig(cfg);
@@ -110,7 +110,7 @@ TEST(Loop, FollowingErrorFaultsWith8611) {
   EXPECT_EQ(d.last_emcy_code(), 0x8611);
 }
 
-TEST(Loop, LostHeartbeatGivesNodeLost) {
+TEST(FieldbusLoop, LostHeartbeatGivesNodeLost) {
   SimRig rig(rig_config());
   boot_and_enable(rig);
   rig.disconnect(4);
@@ -126,7 +126,7 @@ TEST(Loop, LostHeartbeatGivesNodeLost) {
   EXPECT_FALSE(rig.drive(2).failed());
 }
 
-TEST(Loop, MasterHeartbeatLostFaultsDrive) {
+TEST(FieldbusLoop, MasterHeartbeatLostFaultsDrive) {
   SimRigConfig cfg = rig_config();
   SimRig rig(cfg);
   boot_and_enable(rig);
@@ -141,7 +141,7 @@ TEST(Loop, MasterHeartbeatLostFaultsDrive) {
   EXPECT_EQ(d.last_emcy_code(), 0x8130);
 }
 
-TEST(Loop, DroppedTpdoCounted) {
+TEST(FieldbusLoop, DroppedTpdoCounted) {
   SimRig rig(rig_config());
   boot_and_enable(rig);
   rig.bus().add_fault(can::SimFault{canopen::cob::tpdo(1, 3), can::SimFault::Action::kDrop, 5, 3});
@@ -151,7 +151,7 @@ TEST(Loop, DroppedTpdoCounted) {
   EXPECT_EQ(rig.bus().counters().dropped, 3u);
 }
 
-TEST(Loop, Deterministic) {
+TEST(FieldbusLoop, Deterministic) {
   auto run = [] {
     SimRig rig(rig_config());
     std::uint64_t hash = 1469598103934665603ull;
@@ -172,7 +172,7 @@ TEST(Loop, Deterministic) {
   EXPECT_EQ(run(), run());
 }
 
-TEST(Loop, RejectedConfigurationWriteExplainsItself) {
+TEST(FieldbusLoop, RejectedConfigurationWriteExplainsItself) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.drive.extra_writes = {cia402::SdoWrite{0x6060, 0, 1, 5}};  // mode 5 is reserved
@@ -189,7 +189,7 @@ TEST(Loop, RejectedConfigurationWriteExplainsItself) {
       << text;
 }
 
-TEST(Loop, TransitionTimeoutExplainsItself) {
+TEST(FieldbusLoop, TransitionTimeoutExplainsItself) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.drive.transition_timeout_ns = 50'000'000;
@@ -215,7 +215,7 @@ TEST(Loop, TransitionTimeoutExplainsItself) {
   ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 100));
 }
 
-TEST(Loop, LostBootUpLeadsToNmtResetNode) {
+TEST(FieldbusLoop, LostBootUpLeadsToNmtResetNode) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.drive.boot_timeout_ns = 100'000'000;
@@ -232,7 +232,7 @@ TEST(Loop, LostBootUpLeadsToNmtResetNode) {
   EXPECT_GE(rig.now_ns(), 100'000'000);
 }
 
-TEST(Loop, SilentNodeGivesBootTimeout) {
+TEST(FieldbusLoop, SilentNodeGivesBootTimeout) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.drive.boot_timeout_ns = 100'000'000;
@@ -244,7 +244,7 @@ TEST(Loop, SilentNodeGivesBootTimeout) {
   EXPECT_NE(d.failure().to_string().find("even after NMT reset node"), std::string::npos);
 }
 
-TEST(Loop, CsvAndCstModeSwitching) {
+TEST(FieldbusLoop, CsvAndCstModeSwitching) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.drive.pdo_profile = cia402::PdoProfile::kCspCsvCst;
@@ -274,7 +274,7 @@ TEST(Loop, CsvAndCstModeSwitching) {
   EXPECT_FALSE(d.failed()) << d.failure().to_string();
 }
 
-TEST(Loop, ModeSwitchOverSdoWithMinimalMapping) {
+TEST(FieldbusLoop, ModeSwitchOverSdoWithMinimalMapping) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   SimRig rig(cfg);
@@ -285,7 +285,7 @@ TEST(Loop, ModeSwitchOverSdoWithMinimalMapping) {
   EXPECT_EQ(rig.emulator(2).read_int(0x6060), 9);
 }
 
-TEST(Loop, QuickStopThenReenable) {
+TEST(FieldbusLoop, QuickStopThenReenable) {
   SimRig rig(rig_config());
   boot_and_enable(rig);
   auto& d = rig.drive(2);
@@ -309,7 +309,7 @@ TEST(Loop, QuickStopThenReenable) {
   ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 50));
 }
 
-TEST(Loop, EmulatorFailAfterNSyncs) {
+TEST(FieldbusLoop, EmulatorFailAfterNSyncs) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.emulator.fail_after_syncs = 300;
@@ -323,7 +323,7 @@ TEST(Loop, EmulatorFailAfterNSyncs) {
   EXPECT_EQ(d.last_emcy_code(), 0x4310);
 }
 
-TEST(Loop, HomingMethod35SetsHomeOffset) {
+TEST(FieldbusLoop, HomingMethod35SetsHomeOffset) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.emulator.initial_position = 777;
@@ -342,7 +342,7 @@ TEST(Loop, HomingMethod35SetsHomeOffset) {
   EXPECT_TRUE(d.enabled());
 }
 
-TEST(Loop, HomingSearchMovesToTheSwitch) {
+TEST(FieldbusLoop, HomingSearchMovesToTheSwitch) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.emulator.initial_position = 2000;

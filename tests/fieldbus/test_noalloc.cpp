@@ -30,7 +30,7 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 using namespace canmotion;
 
-TEST(NoAlloc, BootConfigureEnableAndRunWithoutAllocating) {
+TEST(FieldbusNoAlloc, BootConfigureEnableAndRunWithoutAllocating) {
   emulator::SimRigConfig cfg;
   cfg.drive.pdo_profile = cia402::PdoProfile::kCspCsvCst;
   emulator::SimRig rig(cfg);

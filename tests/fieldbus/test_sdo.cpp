@@ -57,7 +57,7 @@ struct Link {
 };
 }  // namespace
 
-TEST(Sdo, ExpeditedDownloadGoldenBytes) {
+TEST(FieldbusSdo, ExpeditedDownloadGoldenBytes) {
   Link l;
   ASSERT_TRUE(l.client.download_value<std::uint16_t>(0x1017, 0, 100, 5));
   const auto r = l.run();
@@ -69,7 +69,7 @@ TEST(Sdo, ExpeditedDownloadGoldenBytes) {
   EXPECT_EQ(l.emu.read_int(0x1017), 100);
 }
 
-TEST(Sdo, ExpeditedUploadGoldenBytes) {
+TEST(FieldbusSdo, ExpeditedUploadGoldenBytes) {
   Link l;
   ASSERT_TRUE(l.client.upload(0x1000, 0));
   const auto r = l.run();
@@ -86,7 +86,7 @@ TEST(Sdo, ExpeditedUploadGoldenBytes) {
   EXPECT_EQ(l.wire[4], "602#2365600004030201");
 }
 
-TEST(Sdo, SegmentedUploadOfDeviceName) {
+TEST(FieldbusSdo, SegmentedUploadOfDeviceName) {
   Link l;
   ASSERT_TRUE(l.client.upload(0x1008, 0));
   const auto r = l.run();
@@ -123,7 +123,7 @@ struct DomainBackend final : canopen::SdoServerBackend {
 };
 }  // namespace
 
-TEST(Sdo, SegmentedDownloadGoldenBytes) {
+TEST(FieldbusSdo, SegmentedDownloadGoldenBytes) {
   DomainBackend be;
   canopen::SdoServer server(2, be);
   canopen::SdoClient client(2, 100 * kMs);
@@ -151,7 +151,7 @@ TEST(Sdo, SegmentedDownloadGoldenBytes) {
   EXPECT_EQ(wire, expected);
 }
 
-TEST(Sdo, ClientAbortsOnToggleErrorInUpload) {
+TEST(FieldbusSdo, ClientAbortsOnToggleErrorInUpload) {
   canopen::SdoClient c(2, 100 * kMs);
   VecSink out;
   ASSERT_TRUE(c.upload(0x1008, 0));
@@ -168,7 +168,7 @@ TEST(Sdo, ClientAbortsOnToggleErrorInUpload) {
   EXPECT_FALSE(r.aborted_by_server);
 }
 
-TEST(Sdo, ClientAbortsOnToggleErrorInDownload) {
+TEST(FieldbusSdo, ClientAbortsOnToggleErrorInDownload) {
   canopen::SdoClient c(2, 100 * kMs);
   VecSink out;
   const std::uint8_t data[9] = {};
@@ -184,7 +184,7 @@ TEST(Sdo, ClientAbortsOnToggleErrorInDownload) {
   EXPECT_EQ(r.abort, SdoAbort::kToggleBit);
 }
 
-TEST(Sdo, ServerAbortsOnToggleError) {
+TEST(FieldbusSdo, ServerAbortsOnToggleError) {
   DomainBackend be;
   be.domain.assign(30, 0x55);
   canopen::SdoServer s(2, be);
@@ -203,7 +203,7 @@ TEST(Sdo, ServerAbortsOnToggleError) {
   EXPECT_EQ(hex(out.frames.back()), "582#8000300001000405");
 }
 
-TEST(Sdo, ClientReportsEveryServerAbortWithItsText) {
+TEST(FieldbusSdo, ClientReportsEveryServerAbortWithItsText) {
   for (const SdoAbort a : canopen::kAllSdoAborts) {
     canopen::SdoClient c(2, 100 * kMs);
     VecSink out;
@@ -221,7 +221,7 @@ TEST(Sdo, ClientReportsEveryServerAbortWithItsText) {
   }
 }
 
-TEST(Sdo, TimeoutOnVirtualClockThenNextTransferRuns) {
+TEST(FieldbusSdo, TimeoutOnVirtualClockThenNextTransferRuns) {
   canopen::SdoClient c(2, 100 * kMs);
   VecSink out;
   ASSERT_TRUE(c.upload(0x1000, 0, 1));
@@ -246,7 +246,7 @@ TEST(Sdo, TimeoutOnVirtualClockThenNextTransferRuns) {
   EXPECT_TRUE(r.ok());
 }
 
-TEST(Sdo, ServerTimesOutHangingSegmentedTransfer) {
+TEST(FieldbusSdo, ServerTimesOutHangingSegmentedTransfer) {
   DomainBackend be;
   be.domain.assign(30, 1);
   canopen::SdoServer s(2, be);
@@ -259,7 +259,7 @@ TEST(Sdo, ServerTimesOutHangingSegmentedTransfer) {
   EXPECT_EQ(hex(out.frames.back()), "582#8000300000000405");
 }
 
-TEST(Sdo, QueueCapacityIsEnforced) {
+TEST(FieldbusSdo, QueueCapacityIsEnforced) {
   canopen::SdoClient c(2);
   for (std::size_t i = 0; i < canopen::SdoClient::kQueueCapacity; ++i) ASSERT_TRUE(c.upload(0x1000, 0));
   EXPECT_FALSE(c.upload(0x1000, 0));
@@ -278,7 +278,7 @@ struct AbortCase {
 };
 }  // namespace
 
-TEST(Sdo, EmulatorAbortPaths) {
+TEST(FieldbusSdo, EmulatorAbortPaths) {
   const std::vector<AbortCase> cases = {
       {"no such object", {}, "602#4044440000000000", 0x06020000},
       {"no such sub-index", {}, "602#4018100900000000", 0x06090011},

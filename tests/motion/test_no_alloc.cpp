@@ -48,6 +48,10 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
       r.req(mam("X", "m2", 1, 5, 40, 300, 300, "trapezoidal", 0, 0, "%oftime", "enabled")),
       r.req("MAS(D, s, all, no, 0, unitspersec2, no, 0, unitspersec3);"),
       r.req("MRP(X, p, relative, command, 3);"),
+      r.req("MAG(D, X, gear, same, 0.5, 1, 3, command, fraction_slave_master_counts, enabled, 100, unitspersec2);"),
+      r.req("MDAC(X, D, link, move, command);"),
+      r.req("MAM(X,mdm,incremental,5,0.5,unitspermasterunit,1,unitspermasterunit2,1,unitspermasterunit2,scurve,10,10,"
+            "unitspermasterunit3,disabled,programmed,0,immediateforwardonly,0,0);"),
       r.req("MGS(g, gs, faststop);"),
   };
   r.queue.reserve(16);

@@ -74,6 +74,9 @@ struct Failure {
   std::string message;
 };
 
+volatile sig_atomic_t g_stop = 0;  ///< SIGINT during watch
+void on_sigint(int) { g_stop = 1; }
+
 std::string error_word(int e) {
   switch (e) {
     case ENOENT: return "no such file";
@@ -144,6 +147,7 @@ class Connection {
       }
       pollfd p{fd_, POLLIN, 0};
       const int r = ::poll(&p, 1, wait_ms);
+      if (r < 0 && errno == EINTR && g_stop) throw Failure{"interrupted"};
       if (r < 0 && errno == EINTR) continue;
       if (r < 0) throw Failure{fmt::format("poll: {}", std::strerror(errno))};
       if (r == 0) continue;  // the deadline check above reports it
@@ -239,9 +243,6 @@ void print_status_table(const std::vector<std::string>& lines, const std::string
   }
   if (!footer.empty()) fmt::print("({})\n", footer);
 }
-
-volatile sig_atomic_t g_stop = 0;
-void on_sigint(int) { g_stop = 1; }
 
 int run(const std::string& socket_path, double timeout, std::optional<double> user_timeout,
         const std::vector<std::string>& cmd, double interval, long count) {

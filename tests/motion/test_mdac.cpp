@@ -1,0 +1,210 @@
+// MDAC (Master Driven Axis Control) and master-driven MAM/MAJ, issue 5, from
+// seed 000: All conflicts, pending master queue, what breaks the link, AC bit,
+// lock directions, units per master unit and master units.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rig.hpp"
+
+using namespace canmotion::motion;
+using canmotion::motion::test::maj;
+using canmotion::motion::test::mam;
+using canmotion::motion::test::Rig;
+
+namespace {
+
+AxisConfig cfg() {
+  AxisConfig c;
+  c.max_speed = 1000;
+  c.max_accel = c.max_decel = 10000;
+  return c;
+}
+
+Rig rig3() {
+  Rig r;
+  r.add_axis("X", cfg());
+  r.add_axis("Y", cfg());
+  r.add_axis("Z", cfg());
+  for (const char* a : {"X", "Y", "Z"}) EXPECT_EQ(r.exec(std::string("MSO(") + a + ", on" + a + ");"), Err::None);
+  r.step();
+  return r;
+}
+
+/// Master-driven incremental MAM: speed in units per master unit.
+std::string md_mam(const std::string& ax, const std::string& c, double dist, double ratio, double acc,
+                   const std::string& lock = "immediateforwardonly", double lockpos = 0) {
+  return "MAM(" + ax + "," + c + ",incremental," + std::to_string(dist) + "," + std::to_string(ratio) +
+         ",unitspermasterunit," + std::to_string(acc) + ",unitspermasterunit2," + std::to_string(acc) +
+         ",unitspermasterunit2,trapezoidal,0,0,unitspermasterunit3,disabled,programmed," + std::to_string(lockpos) +
+         "," + lock + ",0,0);";
+}
+
+}  // namespace
+
+TEST(Mdac, LinkBitsAndMasterDrivenMoveFollowsMasterTravel) {
+  Rig r = rig3();
+  EXPECT_EQ(r.exec("MDAC(Z, X, mdac1, move, command);"), Err::None);
+  EXPECT_TRUE(r.tag("mdac1").dn());
+  EXPECT_TRUE(r.tag("mdac1").ip());
+  EXPECT_FALSE(r.tag("mdac1").ac());
+  r.step();
+  EXPECT_TRUE(r.axis("Z").motion(motion_status::CoordinatedMotionStatus));
+  // slave: 10 units at 0.5 units per master unit, accel 1 unit/mu^2
+  ASSERT_EQ(r.exec(md_mam("Z", "m", 10, 0.5, 1)), Err::None);
+  EXPECT_TRUE(r.tag("mdac1").ac());  // AC: a move went IP in master-driven mode
+  EXPECT_TRUE(r.tag("m").ip());
+  r.step(100);
+  EXPECT_EQ(r.axis("Z").command_position, 0.0);  // master at rest: slave waits
+  r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+  r.step(1);
+  r.step(300);  // master travels 3 units
+  EXPECT_TRUE(r.axis("Z").motion(motion_status::MoveLockStatus));
+  // trapezoid over master travel: 0.5 u/mu reached after 0.5 mu of master travel
+  EXPECT_NEAR(r.axis("Z").command_velocity, 0.5 * 10, 1e-6);
+  r.step_until([&] { return r.tag("m").pc(); });
+  EXPECT_NEAR(r.axis("Z").command_position, 10.0, 1e-9);
+  EXPECT_FALSE(r.tag("mdac1").ac());  // the master-driven motion ended
+  EXPECT_TRUE(r.tag("mdac1").ip());   // the link stays
+  // 10 units at 0.5 u/mu with 0.5 mu ramps each side: 20.5 master units
+  EXPECT_NEAR(r.axis("X").command_position, 20.5, 0.02);
+}
+
+TEST(Mdac, ForwardOnlySlaveStopsWhenTheMasterReverses) {
+  Rig r = rig3();
+  r.exec("MDAC(Z, X, l, jog, command);");
+  r.exec("MAJ(Z, j, forward, 1, unitspermasterunit, 100, unitspermasterunit2, 100, unitspermasterunit2, trapezoidal, 0, 0, unitspermasterunit3, disabled, programmed, 0, immediateforwardonly);");
+  r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+  r.step(200);
+  EXPECT_TRUE(r.axis("Z").motion(motion_status::JogLockStatus));
+  EXPECT_NEAR(r.axis("Z").command_velocity, 10.0, 1e-6);
+  r.exec(maj("X", "jx2", 1, 10, 1e6, 1e6));  // master reverses
+  r.step(5);
+  const double z = r.axis("Z").command_position;
+  r.step(100);
+  EXPECT_EQ(r.axis("Z").command_position, z);  // does not back up
+  EXPECT_FALSE(r.axis("Z").motion(motion_status::JogLockStatus));
+  r.exec(maj("X", "jx3", 0, 10, 1e6, 1e6));  // forward again: resumes
+  r.step(50);
+  EXPECT_GT(r.axis("Z").command_position, z);
+  EXPECT_TRUE(r.axis("Z").motion(motion_status::JogLockStatus));
+}
+
+TEST(Mdac, PositionLockStartsWhenTheMasterCrossesIt) {
+  Rig r = rig3();
+  r.exec("MDAC(Z, X, l, move, command);");
+  r.exec(md_mam("Z", "m", 5, 1, 100, "positionforwardonly", 2.0));
+  r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+  r.step(150);  // master at ~1.5
+  EXPECT_EQ(r.axis("Z").command_position, 0.0);
+  EXPECT_FALSE(r.axis("Z").motion(motion_status::MoveLockStatus));
+  r.step(100);  // master at ~2.5: 0.5 units past the lock
+  EXPECT_TRUE(r.axis("Z").motion(motion_status::MoveLockStatus));
+  EXPECT_GT(r.axis("Z").command_position, 0.3);
+}
+
+TEST(Mdac, MasterUnitsMoveCoversItsDistanceOverTheGivenMasterTravel) {
+  Rig r = rig3();
+  r.exec("MDAC(Z, X, l, move, command);");
+  // 6 units over 12 master units, with 2 master units of accel and decel
+  ASSERT_EQ(r.exec("MAM(Z,m,incremental,6,12,masterunits,2,masterunits,2,masterunits,trapezoidal,0,0,masterunits,disabled,programmed,0,immediateforwardonly,0,0);"),
+            Err::None);
+  r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+  r.step_until([&] { return r.tag("m").pc(); });
+  EXPECT_NEAR(r.axis("Z").command_position, 6.0, 1e-9);
+  EXPECT_NEAR(r.axis("X").command_position, 12.0, 0.02);
+}
+
+TEST(Mdac, AllConflictsAndErrors) {
+  Rig r = rig3();
+  ASSERT_EQ(r.exec("MDAC(Y, X, a1, move, command);"), Err::None);
+  // MDAC Move=MAM Master=X Slave=Y, then MDAC All Master=Z Slave=Y: error [seed 000]
+  EXPECT_EQ(r.exec("MDAC(Y, Z, a2, all, command);"), Err::MdscMdacAllConflict);
+  EXPECT_EQ(r.tag("a2").err, 96);
+  EXPECT_TRUE(r.tag("a1").ip());
+  Rig r2 = rig3();
+  ASSERT_EQ(r2.exec("MDAC(Y, X, b1, all, command);"), Err::None);
+  EXPECT_EQ(r2.exec("MDAC(Y, X, b2, jog, command);"), Err::MdscMdacAllConflict);
+  EXPECT_EQ(r2.exec("MDAC(Y, Y, b3, move, command);"), Err::MasterAxisConflict);
+  // master-driven units without a link for that motion type
+  Rig r3 = rig3();
+  r3.exec("MDAC(Y, X, c1, jog, command);");
+  EXPECT_EQ(r3.exec(md_mam("Y", "m", 1, 1, 1)), Err::MdscNotActivated);
+  // lock direction none in master-driven mode
+  r3.exec("MDAC(Y, X, c2, move, command);");
+  EXPECT_EQ(r3.exec(md_mam("Y", "m", 1, 1, 1, "none")), Err::MdscLockDirConflict);
+  EXPECT_EQ(r3.tag("m").err, 95);
+}
+
+TEST(Mdac, PendingMasterTakesOverAtTheNextMotion) {
+  // [seed 000] MDAC Move Master=X Slave=Z; MAM Z; MDAC Move Master=Y Slave=Z -> pending; MAM Z uses Y
+  Rig r = rig3();
+  r.exec("MDAC(Z, X, d1, move, command);");
+  r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+  r.exec(md_mam("Z", "m1", 2, 1, 100));
+  r.step(100);
+  EXPECT_GT(r.axis("Z").command_position, 0.5);
+  ASSERT_EQ(r.exec("MDAC(Z, Y, d2, move, command);"), Err::None);
+  EXPECT_TRUE(r.tag("d1").ip());  // both in process,
+  EXPECT_TRUE(r.tag("d2").ip());
+  EXPECT_TRUE(r.tag("d1").ac());  // only the active one is AC
+  EXPECT_FALSE(r.tag("d2").ac());
+  r.step_until([&] { return r.tag("m1").pc(); });
+  ASSERT_EQ(r.exec(md_mam("Z", "m2", 2, 1, 100)), Err::None);  // goes IP: Y becomes the master
+  EXPECT_FALSE(r.tag("d1").ip());
+  EXPECT_TRUE(r.tag("d2").ac());
+  const double z = r.axis("Z").command_position;
+  r.step(100);  // X moves, Y does not: the slave waits for Y
+  EXPECT_EQ(r.axis("Z").command_position, z);
+  r.exec(maj("Y", "jy", 0, 10, 1e6, 1e6));
+  r.step(100);
+  EXPECT_GT(r.axis("Z").command_position, z);
+}
+
+TEST(Mdac, WhatBreaksTheLink) {
+  {  // MAS All on the slave breaks it; MAS Move only clears AC
+    Rig r = rig3();
+    r.exec("MDAC(Z, X, l, move, command);");
+    r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+    r.exec(md_mam("Z", "m", 100, 1, 100));
+    r.step(50);
+    r.exec("MAS(Z, s1, move, no, 0, unitspersec2, no, 0, unitspersec3);");
+    EXPECT_FALSE(r.tag("l").ac());
+    EXPECT_TRUE(r.tag("l").ip());
+    r.step_until([&] { return r.tag("s1").pc(); });
+    r.exec("MAS(Z, s2, all, no, 0, unitspersec2, no, 0, unitspersec3);");
+    EXPECT_FALSE(r.tag("l").ip());
+    EXPECT_FALSE(r.axis("Z").motion(motion_status::CoordinatedMotionStatus));
+  }
+  {  // MAS of any type on the master does not; MASD on the master does
+    Rig r = rig3();
+    r.exec("MDAC(Z, X, l, all, command);");
+    r.exec("MAS(X, s, all, no, 0, unitspersec2, no, 0, unitspersec3);");
+    EXPECT_TRUE(r.tag("l").ip());
+    r.exec("MASD(X, sd);");
+    EXPECT_FALSE(r.tag("l").ip());
+  }
+  {  // MGS on the slave's group
+    Rig r = rig3();
+    r.exec("MDAC(Z, X, l, jog, command);");
+    r.exec("MGS(g, gs, faststop);");
+    EXPECT_FALSE(r.tag("l").ip());
+  }
+}
+
+TEST(Mdac, MasterReferenceChangeOfAMovingSlaveErrs) {
+  Rig r;
+  AxisConfig m = cfg();
+  m.type = AxisType::CipDrive;
+  r.add_axis("M", m);
+  r.add_axis("S", cfg());
+  r.fb[0].drive = DriveState::Enabled;
+  r.exec("MSO(M, a);");
+  r.exec("MSO(S, b);");
+  r.step();
+  ASSERT_EQ(r.exec("MDAC(S, M, l1, jog, command);"), Err::None);
+  r.exec(maj("S", "j", 0, 10));  // slave moving (time driven)
+  r.step(10);
+  EXPECT_EQ(r.exec("MDAC(S, M, l2, jog, actual);"), Err::MdscInvalidModeOrMasterChange);
+  EXPECT_TRUE(r.tag("l1").ip());  // the original stays
+}
