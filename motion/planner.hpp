@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <variant>
 
 #include "motion/axis.hpp"
@@ -41,6 +42,7 @@ struct Request {
   std::uint8_t count = 0;  ///< number of operands given
   std::array<Operand, kMaxOperands> op{};
 };
+static_assert(std::is_trivially_copyable_v<Request>, "Request travels through SPSC rings by copy");
 
 // ------------------------------------------------------------ cycle I/O
 /// Drive state as the runtime reports it for an AXIS_CIP_DRIVE (from the CiA
