@@ -551,6 +551,18 @@ void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept 
   for (auto& d : drives_) d->on_sync_sent();
 }
 
+std::vector<can::Filter> DriveNetwork::receive_filters() const {
+  std::vector<can::Filter> f;
+  for (const auto& d : drives_) {
+    const std::uint8_t n = d->node();
+    f.push_back(can::Filter{canopen::cob::emcy(n), 0x7FF, false});
+    for (std::uint8_t p = 1; p <= 4; ++p) f.push_back(can::Filter{canopen::cob::tpdo(p, n), 0x7FF, false});
+    f.push_back(can::Filter{canopen::cob::sdo_tx(n), 0x7FF, false});
+    f.push_back(can::Filter{canopen::cob::heartbeat(n), 0x7FF, false});
+  }
+  return f;
+}
+
 bool DriveNetwork::poll_event(canopen::NodeEvent& out) noexcept {
   if (ev_count_ == 0) return false;
   out = events_[ev_head_];

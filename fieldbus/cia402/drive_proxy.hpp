@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "fieldbus/can/frame.hpp"
+#include "fieldbus/can/socketcan_bus.hpp"  // can::Filter only (no socket header)
 #include "fieldbus/canopen/frame_sink.hpp"
 #include "fieldbus/canopen/master.hpp"
 #include "fieldbus/canopen/pdo.hpp"
@@ -279,6 +280,11 @@ class DriveNetwork {
   [[nodiscard]] bool any_failed() const noexcept;
   void enable_all() noexcept;
   void disable_all() noexcept;
+  /// The SocketCAN receive filters the master needs (set-up time): EMCY,
+  /// TPDO1..4, SDO responses and heartbeats of every drive (one exact-ID
+  /// filter each, so the kernel drops everything else, e.g. other masters'
+  /// RPDOs).
+  [[nodiscard]] std::vector<can::Filter> receive_filters() const;
   /// Master events (boot-up, heartbeat lost, EMCY, ...) for the application.
   bool poll_event(canopen::NodeEvent& out) noexcept;
 

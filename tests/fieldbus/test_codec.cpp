@@ -90,6 +90,14 @@ TEST(FieldbusGolden, MasterRpdosAndBootConfiguration) {
   EXPECT_EQ(pdos.rpdo[0].size_bytes, 6);
   EXPECT_EQ(pdos.rpdo[1].size_bytes, 7);
   EXPECT_EQ(pdos.tpdo[1].entries[2].raw(), 0x60610008u);
+  const auto filters = net.receive_filters();
+  ASSERT_EQ(filters.size(), 7u);
+  EXPECT_EQ(filters[0].id, 0x082u);
+  EXPECT_EQ(filters[1].id, 0x182u);
+  EXPECT_EQ(filters[4].id, 0x482u);
+  EXPECT_EQ(filters[5].id, 0x582u);
+  EXPECT_EQ(filters[6].id, 0x702u);
+  EXPECT_EQ(filters[6].mask, 0x7FFu);
 }
 
 TEST(FieldbusGolden, ProxyRpdoAndTpdoBytes) {

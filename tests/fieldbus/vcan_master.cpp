@@ -41,13 +41,6 @@ int main(int argc, char** argv) {
   std::vector<std::uint8_t> nodes;
   for (int i = 4; i < argc; ++i) nodes.push_back(static_cast<std::uint8_t>(std::atoi(argv[i])));
 
-  std::error_code ec;
-  std::string detail;
-  auto bus = can::SocketCanBus::open(iface, {}, ec, &detail);
-  if (!bus) {
-    std::fprintf(stderr, "fieldbus-vcan-master: %s\n", detail.c_str());
-    return 1;
-  }
   cia402::DriveNetwork net;
   for (auto n : nodes) {
     cia402::DriveConfig d;
@@ -63,6 +56,15 @@ int main(int argc, char** argv) {
     d.start_timeout_ns = 10'000'000'000;
     d.transition_timeout_ns = 5'000'000'000;
     net.add_drive(d);
+  }
+  // Only the frames the master needs (kernel filters from the network).
+  const auto filters = net.receive_filters();
+  std::error_code ec;
+  std::string detail;
+  auto bus = can::SocketCanBus::open(iface, filters, ec, &detail);
+  if (!bus) {
+    std::fprintf(stderr, "fieldbus-vcan-master: %s\n", detail.c_str());
+    return 1;
   }
   canopen::TransportSink sink(*bus);
   std::array<can::TimedFrame, 64> buf;
