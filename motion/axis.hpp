@@ -46,6 +46,10 @@ struct AxisConfig {
   double position_error_tolerance = 0.0;  ///< 0 disables the check
   HomingConfig homing{};
   ProgrammedStopMode programmed_stop_mode = ProgrammedStopMode::FastStop;
+  /// MDS: what the drive's direct command is (CIP drives): velocity (CSV) or torque (CST).
+  enum class DirectMode : std::uint8_t { Velocity = 0, Torque = 1 };
+  DirectMode direct_mode = DirectMode::Velocity;
+  double max_torque = 100.0;       ///< MDS torque mode: 100 % of maximum (drive torque units, e.g. per mille of rated)
   std::uint8_t group = 0;          ///< motion group index (< kMaxGroups)
   /// Exception action per ExceptionKind. Defaults: position error and drive
   /// fault stop the drive, lost node and bus-off shut down, soft overtravel stops the planner.

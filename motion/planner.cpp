@@ -251,6 +251,7 @@ void Planner::abort_all(AxisRt& a) noexcept {
 
 void Planner::servo_off(AxisRt& a) noexcept {
   abort_all(a);
+  end_direct(a, false);
   a.servo = false;
   a.enable_req = false;
   if (a.homing) {
@@ -436,6 +437,7 @@ Err Planner::common_checks(const AxisRt& a, bool need_servo) const noexcept {
   if (a.shutdown) return Err::ShutdownState;
   if (a.faulted) return Err::AxisInFaultedState;
   if (need_servo && !a.servo) return Err::ServoOffState;
+  if (need_servo && a.direct) return Err::NotAllowedWhileInDirectMotion;  // [RM002H p.578]
   return Err::None;
 }
 
@@ -489,6 +491,7 @@ Err Planner::execute(const Request& r) noexcept {
           else if constexpr (std::is_same_v<P, MrpParams>) return start_mrp(r, p, axes_[p.axis]);
           else if constexpr (std::is_same_v<P, MagParams>) return start_mag(r, p, axes_[p.slave], exerr);
           else if constexpr (std::is_same_v<P, MdacParams>) return start_mdac(r, p, axes_[p.slave], exerr);
+          else if constexpr (std::is_same_v<P, MdsParams>) return start_mds(r, p, axes_[p.axis], exerr);
           else if constexpr (std::is_same_v<P, MgsParams>) return start_group(r, p.group, p.mode, exerr);
           else if constexpr (std::is_same_v<P, MgsdParams> || std::is_same_v<P, MgsrParams>)
             return start_group(r, p.group, GroupStopMode::Programmed, exerr);
@@ -514,6 +517,11 @@ Err Planner::execute(const Request& r) noexcept {
 Err Planner::start_mso(const Request& r, AxisRt& a) noexcept {
   if (Err e = common_checks(a, false); e != Err::None) return e;
   ControlTag& c = controls_[r.control];
+  if (a.direct) {  // MSO is the way out of direct control [RM002H p.578]
+    end_direct(a, false);
+    a.base = a.fb_pos;
+    a.cmd = Kin{a.fb_pos, 0, 0};
+  }
   if (a.servo) {
     c.set(flag::DN, true);
     return Err::None;
@@ -650,6 +658,14 @@ Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int
   }
   const bool ramping = a.servo && mask != 0 && stop_slots(a, mask, d, jd, r.control, 0);
   if (type == StopType::All) break_links(a);  // MAS All on the slave breaks its MDAC links
+  if ((type == StopType::All || type == StopType::DirectControl) && a.direct_active) {
+    // direct command to zero; the drive ramps down; PC at standstill
+    end_direct(a, true);
+    a.mds_stop = r.control;
+    a.mds_stop_gen = c.generation;
+    c.set(flag::IP, true);
+    return Err::None;
+  }
   if (ramping) c.set(flag::IP, true);
   else c.set(flag::PC, true);
   return Err::None;
@@ -658,6 +674,7 @@ Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int
 // --- MAH
 Err Planner::start_mah(const Request& r, AxisRt& a) noexcept {
   if (Err e = common_checks(a, false); e != Err::None) return e;
+  if (a.direct) return Err::NotAllowedWhileInDirectMotion;
   if (a.homing) return Err::HomeInProcess;
   const HomingConfig& h = a.cfg.homing;
   if (a.cfg.rotary && (h.home_position < 0 || h.home_position >= a.cfg.unwind)) return Err::IllegalHomingConfig;
@@ -970,6 +987,7 @@ Err Planner::start_mcd(const Request& r, const McdParams& p, AxisRt& a, std::int
 Err Planner::start_mrp(const Request& r, const MrpParams& prm, AxisRt& a) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  if (a.direct) return Err::NotAllowedWhileInDirectMotion;
   if (a.homing) return Err::HomeInProcess;
   const bool relative = prm.relative;
   const bool command = prm.command;
@@ -1085,6 +1103,32 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
       a.msf = kNoControl;
     }
   }
+  // MDS waiting for the drive enable
+  if (a.mds_waiting) {
+    ControlTag* c = owner_tag(a.mds, a.mds_gen);
+    if (a.fb.drive == DriveState::Enabled) {
+      a.servo = true;
+      a.mds_waiting = false;
+      if (c) { c->state = 1; c->set(flag::DN, true); }
+    } else if (a.fb.drive == DriveState::Fault || cycle_ >= a.mso_deadline) {
+      a.mds_waiting = false;
+      end_direct(a, false);
+      a.enable_req = false;
+      if (c) c->reject(Err::ServoMessageFailure, 16);
+    } else if (c) {
+      c->state = 1;
+    }
+  }
+  if (a.mds_stop != kNoControl) {
+    ControlTag* c = owner_tag(a.mds_stop, a.mds_stop_gen);
+    if (!c || !a.direct) {
+      a.mds_stop = kNoControl;
+    } else if (std::fabs(a.fb_vel) <= std::max(1e-6, 1e-3 * a.cfg.max_speed)) {
+      c->set(flag::IP, false);
+      c->set(flag::PC, true);
+      a.mds_stop = kNoControl;
+    }
+  }
   // drive homing
   if (a.homing) {
     ControlTag* c = owner_tag(a.mah, a.mah_gen);
@@ -1102,12 +1146,12 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
     }
   }
   // servo off or homing: the command follows the actual position
-  if (!a.servo || a.homing) {
+  if (!a.servo || a.homing || a.direct) {
     a.base = a.fb_pos;
-    a.cmd = Kin{a.fb_pos, 0, 0};
+    a.cmd = Kin{a.fb_pos, a.direct ? a.fb_vel : 0.0, 0};
   }
   // a drive that dropped out of Operation Enabled switches the servo off
-  if (a.servo && a.fb.drive != DriveState::Enabled) servo_off(a);
+  if (a.servo && a.fb.drive != DriveState::Enabled && !a.mds_waiting) servo_off(a);
 }
 
 void Planner::handle_exceptions(AxisRt& a) noexcept {
@@ -1263,6 +1307,13 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
     out->shutdown = a.shutdown;
     out->fault_reset = a.fault_reset_pulse;
     out->mode = a.homing ? DriveMode::Homing : DriveMode::CyclicPosition;
+    if (a.direct) {  // MDS: CSV or CST following the axis configuration
+      const bool torque = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
+      out->mode = torque ? DriveMode::CyclicTorque : DriveMode::CyclicVelocity;
+      out->velocity = torque ? 0.0 : (a.direct_active ? a.direct_cmd : 0.0);
+      out->torque = torque && a.direct_active ? a.direct_cmd : 0.0;
+      out->acceleration = 0.0;
+    }
     out->homing_start = a.homing;
     if (a.homing) {
       const HomingConfig& h = a.cfg.homing;
@@ -1295,12 +1346,16 @@ void Planner::update_status(AxisRt& a) noexcept {
   setb(AxisHomedStatus, a.homed);
   setb(AccelStatus, a.cmd.v * a.cmd.a > 0 || (a.cmd.v == 0 && a.cmd.a != 0));
   setb(DecelStatus, a.cmd.v * a.cmd.a < 0);
+  const bool torque_mode = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
+  setb(DirectVelocityControlStatus, a.direct_active && !torque_mode);
+  setb(DirectTorqueControlStatus, a.direct_active && torque_mode);
   setb(MaximumSpeedExceeded, a.cfg.max_speed > 0 && std::fabs(a.cmd.v) > a.cfg.max_speed * (1 + 1e-9));
   t.motion_status = ms;
   std::uint32_t as = 0;
   if (a.servo) as |= (1u << axis_status::ServoActionStatus) | (1u << axis_status::DriveEnableStatus);
   if (a.shutdown) as |= 1u << axis_status::ShutdownStatus;
   if (a.cfg.inhibited) as |= 1u << axis_status::InhibitStatus;
+  if (a.direct) as |= 1u << axis_status::DirectControlStatus;
   as |= 1u << axis_status::AxisUpdateStatus;
   t.axis_status = as;
   if (!a.cfg.configured) t.state = AxisState::Ungrouped;
@@ -1443,6 +1498,61 @@ void Planner::step_gear(GearGen& g) noexcept {
   }
   g.k.v = target_v;
   g.k.a = k * ma;
+}
+
+// --- MDS
+Err Planner::start_mds(const Request& r, const MdsParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
+  if (Err e = common_checks(a, false); e != Err::None) return e;
+  if (a.cfg.type != AxisType::CipDrive) return Err::WrongAxisType;  // AXIS_CIP_DRIVE only [seed 002]
+  if (a.homing) return Err::HomeInProcess;
+  for (const auto& g : a.gen)
+    if (!std::holds_alternative<std::monostate>(g)) return Err::NotAllowedWhilePlannerActive;
+  const bool torque = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
+  const double full = torque ? a.cfg.max_torque : a.cfg.max_speed;
+  const double cmd = p.percent_of_maximum ? p.speed / 100.0 * full : p.speed;
+  if (!std::isfinite(cmd)) {
+    exerr = static_cast<std::int8_t>(operand_index(Instr::MDS, "Speed"));
+    return Err::ParameterOutOfRange;
+  }
+  ControlTag& c = controls_[r.control];
+  if (a.mds != kNoControl && (a.mds != r.control || a.mds_gen != c.generation))
+    if (ControlTag* o = owner_tag(a.mds, a.mds_gen)) o->set(flag::IP, false);  // superseded by this MDS
+  a.direct = true;
+  a.direct_active = true;
+  a.direct_cmd = cmd;
+  a.mds = r.control;
+  a.mds_gen = c.generation;
+  a.mds_stop = kNoControl;
+  c.set(flag::IP, true);
+  if (a.servo) {
+    c.set(flag::DN, true);
+  } else {  // enable the drive first: STATE 0 request, 1 waiting [seed 002]
+    a.enable_req = true;
+    a.mds_waiting = true;
+    a.mso_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+    c.state = 0;
+  }
+  return Err::None;
+}
+
+void Planner::end_direct(AxisRt& a, bool keep_direct_status) noexcept {
+  if (!a.direct) return;
+  if (ControlTag* c = owner_tag(a.mds, a.mds_gen)) c->set(flag::IP, false);
+  a.direct_active = false;
+  a.direct_cmd = 0.0;
+  a.mds = kNoControl;
+  a.mds_waiting = false;
+  if (!keep_direct_status) {
+    a.direct = false;
+    if (ControlTag* s = owner_tag(a.mds_stop, a.mds_stop_gen)) s->set(flag::IP, false);
+    a.mds_stop = kNoControl;
+  }
+}
+
+bool Planner::set_direct_command(AxisId id, double value) noexcept {
+  if (id >= kMaxAxes || !axes_[id].direct_active || !std::isfinite(value)) return false;
+  axes_[id].direct_cmd = value;
+  return true;
 }
 
 void Planner::compute_order() noexcept {

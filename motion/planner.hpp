@@ -196,6 +196,7 @@ struct McdParams;
 struct MrpParams;
 struct MagParams;
 struct MdacParams;
+struct MdsParams;
 
 // ------------------------------------------------------------------ planner
 /// The planner. All state is inside (fixed arrays); update() is noexcept,
@@ -220,6 +221,11 @@ class Planner {
   /// calls this for every input request; exposed for tests. Returns the ERR
   /// (Err::None on success), also written to the control tag. Realtime-safe.
   Err execute(const Request& r) noexcept;
+
+  /// MDS live command: write the direct velocity (units/s) or torque command
+  /// of an axis in direct control, as a program writing the command tag.
+  /// Returns false if the axis is not under an active MDS. Realtime-safe.
+  bool set_direct_command(AxisId id, double value) noexcept;
 
   /// Axis tag (status) of an axis. Realtime-safe.
   const AxisTag& axis(AxisId id) const noexcept { return axes_[id].tag; }
@@ -258,6 +264,15 @@ class Planner {
     std::uint32_t mah_gen = 0;
     /// MDAC links per motion type (0 move, 1 jog, 2 time cam, 3 master offset move) and the queued masters
     std::array<MdacLink, 4> mdac{}, mdac_pending{};
+    // MDS direct control
+    bool direct = false;          ///< AxisStatus.DirectControlStatus (cleared only by MSO, shutdown, servo off)
+    bool direct_active = false;   ///< DirectVelocity/TorqueControlStatus: the direct command is applied
+    double direct_cmd = 0.0;      ///< velocity (units/s) or torque command
+    ControlId mds = kNoControl;
+    std::uint32_t mds_gen = 0;
+    bool mds_waiting = false;     ///< MDS waits for the drive enable (STATE 1)
+    ControlId mds_stop = kNoControl;  ///< MAS stopping direct motion (PC at standstill)
+    std::uint32_t mds_stop_gen = 0;
     int gear_dir = 0;           ///< last gearing direction (+1 same, -1 opposite, 0 never geared)
     bool homing = false;        ///< drive homing (mode 6) in progress
     bool homing_started = false;
@@ -284,6 +299,8 @@ class Planner {
   Err start_mrp(const Request&, const MrpParams&, AxisRt&) noexcept;
   Err start_mag(const Request&, const MagParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mdac(const Request&, const MdacParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_mds(const Request&, const MdsParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  void end_direct(AxisRt& a, bool keep_direct_status) noexcept;
   void break_links(AxisRt& slave) noexcept;
   void break_links_of_master(AxisId master) noexcept;
   void promote_pending(AxisRt& a, int type_index) noexcept;

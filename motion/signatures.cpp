@@ -183,7 +183,7 @@ constexpr std::array<InstrSig, kInstrCount> kTable{{
     {Instr::MAPC, "MAPC", kMapc, false},
     {Instr::MATC, "MATC", kMatc, false},
     {Instr::MDAC, "MDAC", kMdac, true},
-    {Instr::MDS, "MDS", kMds, false},
+    {Instr::MDS, "MDS", kMds, true},
     {Instr::MGS, "MGS", kMgs, true},
     {Instr::MGSD, "MGSD", kGroupCtl, true},
     {Instr::MGSR, "MGSR", kGroupCtl, true},
