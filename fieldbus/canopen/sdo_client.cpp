@@ -223,4 +223,18 @@ bool SdoClient::poll(SdoResult& out) noexcept {
   return true;
 }
 
+bool SdoClient::poll_tag(std::uint32_t tag, SdoResult& out) noexcept {
+  for (std::size_t i = 0; i < result_count_; ++i) {
+    const std::size_t at = (result_head_ + i) % kResultCapacity;
+    if (results_[at].tag != tag) continue;
+    out = results_[at];
+    // Close the gap: move the later results one place towards the head.
+    for (std::size_t j = i; j + 1 < result_count_; ++j)
+      results_[(result_head_ + j) % kResultCapacity] = results_[(result_head_ + j + 1) % kResultCapacity];
+    --result_count_;
+    return true;
+  }
+  return false;
+}
+
 }  // namespace canmotion::canopen

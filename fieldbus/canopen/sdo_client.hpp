@@ -90,6 +90,9 @@ class SdoClient {
   void step(std::int64_t now_ns, FrameSink& out) noexcept;
   /// Take the oldest finished transfer; false if none.
   bool poll(SdoResult& out) noexcept;
+  /// Take the oldest finished transfer with `tag`, leaving the others in
+  /// order; false if none. Lets several users share one client.
+  bool poll_tag(std::uint32_t tag, SdoResult& out) noexcept;
 
   /// Drop all queued transfers; a running one is aborted (abort code
   /// kGeneral sent to the server) at the next step().

@@ -11,7 +11,6 @@
 namespace canmotion::cia402 {
 
 namespace {
-constexpr std::uint32_t kModeWriteTag = 0xFFFF0001u;  // tag of a run-time 0x6060 write
 
 void put_u32(SdoWrite& w, std::uint16_t index, std::uint8_t sub, std::uint8_t size, std::uint32_t value) {
   w = SdoWrite{index, sub, size, value};
@@ -499,10 +498,11 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   // Missed TPDO accounting: a SYNC went out last cycle and TPDO1 did not come.
   if (expect_tpdo_ && !got_tpdo_) ++fb_.tpdo_missed;
   got_tpdo_ = false;
-  // Results of run-time SDO writes (mode switches without RPDO2).
+  // Results of run-time SDO writes (mode switches without RPDO2). Other
+  // results stay for whoever queued them (the application's own transfers).
   canopen::SdoResult r;
-  while (master_.sdo(cfg_.node).poll(r)) {
-    if (r.tag == kModeWriteTag && r.ok() && mdisp_slot_.pdo < 0) fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);
+  while (master_.sdo(cfg_.node).poll_tag(kModeWriteTag, r)) {
+    if (r.ok() && mdisp_slot_.pdo < 0) fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);
   }
   if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
   step_state_machine(now_ns);

@@ -138,6 +138,12 @@ class DriveProxy {
   /// Tell the proxy the cycle's SYNC went out (arms missed-TPDO counting).
   void on_sync_sent() noexcept;
 
+  /// Tag the proxy uses for its own run-time SDO writes (0x6060); the
+  /// application's transfers on master().sdo(node) should use other tags and
+  /// collect their results with poll_tag() once the drive is operational
+  /// (during the boot configuration the proxy owns the client).
+  static constexpr std::uint32_t kModeWriteTag = 0xFFFF0001u;
+
   // ---- commands ---------------------------------------------------------
   /// Go to Operation enabled (2, 3, 4; a fault must be reset first). Clears a
   /// previous transition failure.

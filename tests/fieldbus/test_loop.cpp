@@ -84,6 +84,12 @@ TEST(FieldbusLoop, InjectedFaultEmcyResetReenable) {
   ASSERT_TRUE(sdo.download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
   auto& d = rig.drive(3);
   ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 100));
+  // The application's transfer result is still there for it (the proxy only
+  // takes its own).
+  canopen::SdoResult r;
+  ASSERT_TRUE(sdo.poll_tag(77, r));
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.index, 0x2000);
   EXPECT_EQ(d.failure().kind, cia402::FailureKind::kDriveFault);
   EXPECT_TRUE(d.has_emcy());
   EXPECT_EQ(d.last_emcy_code(), 0x2310);

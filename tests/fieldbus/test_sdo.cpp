@@ -336,3 +336,20 @@ TEST(FieldbusSdo, EmulatorAbortPaths) {
     EXPECT_EQ(s.abort_code, c.abort) << c.name << ": got " << canopen::sdo_abort_text(s.abort_code);
   }
 }
+
+TEST(FieldbusSdo, PollTagLeavesOtherResultsInOrder) {
+  canopen::SdoClient c(2, 100 * kMs);
+  VecSink out;
+  for (std::uint32_t tag : {1u, 2u, 3u, 2u}) {
+    ASSERT_TRUE(c.upload(0x1000, 0, tag));
+    c.step(0, out);
+    c.on_frame(frame("582#4300100092010200"), 0);
+  }
+  canopen::SdoResult r;
+  ASSERT_TRUE(c.poll_tag(2, r));
+  EXPECT_EQ(r.tag, 2u);
+  EXPECT_FALSE(c.poll_tag(9, r));
+  std::vector<std::uint32_t> rest;
+  while (c.poll(r)) rest.push_back(r.tag);
+  EXPECT_EQ(rest, (std::vector<std::uint32_t>{1, 3, 2}));
+}
