@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# vcan.demo, COMMAND part (runs inside the VM, vcan0 and vcan1 up, candump -L
+# writing $CANMOTION_TRACE): the demo on real SocketCAN as separate processes.
+#   vcan-demo-run.sh CANMOTIOND CIA402_EMU EXAMPLES_DIR PERIOD_MS
+# 1. config: demo.yaml with can0 -> vcan0, can1 -> vcan1, period PERIOD_MS
+#    (make-vcan-config.sh);
+# 2. cia402-emu on vcan0 (nodes 2, 3) and on vcan1 (node 4), started first as
+#    demo.yaml says; their boot-up is in the trace before canmotiond starts;
+# 3. canmotiond --config ... --script demo.script --stats in real time (no
+#    --sim); it must exit 0 and print one line per PRINT of the script, with
+#    the script's tags in order;
+# 4. wait until candump has written the final NMT pre-operational frames, stop
+#    the emulators.
+# Artefacts: demo-vcan.yaml, canmotiond.log, canmotiond-trace.log, emu-vcan*.log.
+set -euo pipefail
+daemon="$1" emu="$2" examples="$3" period="$4"
+art="$CANMOTION_ARTIFACTS" trace="$CANMOTION_TRACE"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)"
+fail() { echo "vcan-demo-run: $*" >&2; exit 1; }
+
+cfg="$art/demo-vcan.yaml"
+"$here/make-vcan-config.sh" "$examples/demo.yaml" "$period" > "$cfg"
+script="$examples/demo.script"
+
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; }
+trap cleanup EXIT
+"$emu" --interface vcan0 --node 2 --node 3 --verbose > "$art/emu-vcan0.log" 2>&1 &
+pids+=($!)
+"$emu" --interface vcan1 --node 4 --verbose > "$art/emu-vcan1.log" 2>&1 &
+pids+=($!)
+for ((i = 0; i < 600; i++)); do   # up to 30 s: process start is slow in the VM
+  grep -q ' vcan0 702#00$' "$trace" && grep -q ' vcan0 703#00$' "$trace" && grep -q ' vcan1 704#00$' "$trace" && break
+  sleep 0.05
+done
+for n in vcan0:2 vcan0:3 vcan1:4; do
+  grep -q " ${n%:*} 70${n#*:}#00\$" "$trace" || { cat "$art"/emu-vcan*.log >&2; fail "no boot-up of node ${n#*:} on ${n%:*}"; }
+done
+echo "vcan-demo-run: the three emulated drives booted; starting canmotiond (period $period ms, real time)"
+
+status=0
+start=$(date +%s%N)
+timeout -s INT -k 30 240 "$daemon" --config "$cfg" --script "$script" --stats --trace "$art/canmotiond-trace.log" \
+  > "$art/canmotiond.log" 2>&1 || status=$?
+echo "vcan-demo-run: canmotiond exit $status after $(( ($(date +%s%N) - start) / 1000000 )) ms"
+cat "$art/canmotiond.log"
+[[ $status == 0 ]] || { cat "$art"/emu-vcan*.log >&2; fail "canmotiond exited with status $status"; }
+
+# The script's PRINT statements, in order: each must have produced one line
+# "t=<seconds> tag=value ..." with exactly these tags in this order.
+expected="$(awk '/^[[:space:]]*PRINT[[:space:]]/ { sub(/^[[:space:]]*PRINT[[:space:]]+/, ""); sub(/;.*/, ""); gsub(/[[:space:]]/, ""); gsub(/,/, " "); print }' "$script")"
+got="$(awk '/^t=[0-9.]+ [A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+)*=/ { s = ""; for (i = 2; i <= NF; i++) { split($i, a, "="); s = s (i > 2 ? " " : "") a[1] } print s }' "$art/canmotiond.log")"
+[[ -n "$expected" ]] || fail "no PRINT statement found in $script"
+if [[ "$expected" != "$got" ]]; then
+  echo "expected PRINT lines with tags:" >&2; printf '%s\n' "$expected" >&2
+  echo "got:" >&2; printf '%s\n' "$got" >&2
+  fail "canmotiond's output does not have one line per PRINT of the script"
+fi
+echo "vcan-demo-run: $(wc -l <<<"$expected") PRINT lines present, tags in order"
+
+# candump lags behind under emulation and drops what is still queued when it
+# is stopped: wait (bounded) for the final NMT pre-operational on both buses
+# and for the trace to stop growing.
+for ((i = 0; i < 300; i++)); do
+  grep -q ' vcan0 000#80' "$trace" && grep -q ' vcan1 000#80' "$trace" && break
+  sleep 0.1
+done
+last=-1
+for ((i = 0; i < 100; i++)); do
+  n=$(wc -l < "$trace")
+  [[ $n == "$last" ]] && break
+  last=$n
+  sleep 0.2
+done
+cleanup
+for p in "${pids[@]}"; do wait "$p" || true; done
+trap - EXIT
+echo "vcan-demo-run: emulators stopped; trace has $(wc -l < "$trace") frames"
