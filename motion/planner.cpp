@@ -1602,6 +1602,8 @@ void Planner::compute_order() noexcept {
 
 Result Planner::update(const Input& in, Output& out) noexcept {
   if (started_ && in.cycle <= cycle_) return Result::ErrorCycleNotIncreasing;
+  // the first cycle index may be anything: time starts one period before it
+  if (!started_) cycle_ = in.cycle > 0 ? in.cycle - 1 : 0;
   // 1. feedback and exceptions (against last cycle's command)
   for (std::size_t i = 0; i < axis_count_; ++i) {
     AxisRt& a = axes_[i];

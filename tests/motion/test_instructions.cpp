@@ -686,3 +686,16 @@ TEST(Determinism, SameSequenceTwiceIsBitIdentical) {
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
 }
+
+TEST(Model, FirstCycleIndexCanBeAnything) {
+  Rig r;
+  r.add_axis("X", virt());
+  r.cycle = 123456;  // the runtime starts counting wherever it likes
+  r.submit("MSO(X, on);");
+  r.submit(mam("X", "m", 0, 10, 50, 1000, 1000));
+  r.step();
+  // one period of a 1000 u/s^2 ramp: v = 1 u/s, not a jump into the profile
+  EXPECT_NEAR(r.axis("X").command_velocity, 1.0, 1e-9);
+  Output none{};
+  EXPECT_EQ(r.p->update(Input{r.cycle, {}, {}}, none), Result::ErrorCycleNotIncreasing);
+}
