@@ -651,8 +651,10 @@ TEST(Group, FastDisableAndShutdownReset) {
 // ------------------------------------------------------------------- model rules
 TEST(Model, InstructionsNotYetExecutableGiveErr75) {
   Rig r = servo_rig();
+  r.add_axis("M", virt());
   r.sym.cam_profiles["prof"] = 0;
-  EXPECT_EQ(r.exec("MATC(X, t, same, prof[0], 1, 1, once, immediate, 0, none, timedrivenmode);"), Err::InstructionNotSupported);
+  EXPECT_EQ(r.exec("MAPC(X, M, t, same, prof[0], 1, 1, once, immediate, 0, 0, command, bidirectional);"), Err::InstructionNotSupported);
+  EXPECT_EQ(r.tag("t").err, 75);
 }
 
 TEST(Model, EachExecutionIsARisingEdge) {
