@@ -60,6 +60,7 @@ struct GenRef {
 GenRef gen_ref(Generator& g) noexcept {
   if (auto* p = std::get_if<ProfileGen>(&g)) return {&p->k, p->owner, p->owner_gen};
   if (auto* q = std::get_if<GearGen>(&g)) return {&q->k, q->owner, q->owner_gen};
+  if (auto* c = std::get_if<CamGen>(&g)) return {&c->k, c->owner, c->owner_gen};
   return {};
 }
 
@@ -226,6 +227,10 @@ bool Planner::any_stopping(const AxisRt& a) const noexcept {
 
 void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
   auto& slot = a.gen[static_cast<std::size_t>(s)];
+  if (auto* cg = std::get_if<CamGen>(&slot); cg && cg->profile) {
+    cg->profile->release();  // CAM_PROFILE[0].Status: one user less
+    cg->profile = nullptr;
+  }
   if (auto* p = std::get_if<ProfileGen>(&slot); p && p->master_driven) {
     if (ControlTag* m = owner_tag(p->mdac, p->mdac_gen)) m->set(flag::AC, false);
   }
@@ -251,6 +256,7 @@ void Planner::abort_all(AxisRt& a) noexcept {
 
 void Planner::servo_off(AxisRt& a) noexcept {
   abort_all(a);
+  drop_pending_cam(a);
   end_direct(a, false);
   a.servo = false;
   a.enable_req = false;
@@ -492,6 +498,7 @@ Err Planner::execute(const Request& r) noexcept {
           else if constexpr (std::is_same_v<P, MagParams>) return start_mag(r, p, axes_[p.slave], exerr);
           else if constexpr (std::is_same_v<P, MdacParams>) return start_mdac(r, p, axes_[p.slave], exerr);
           else if constexpr (std::is_same_v<P, MdsParams>) return start_mds(r, p, axes_[p.axis], exerr);
+          else if constexpr (std::is_same_v<P, MatcParams>) return start_matc(r, p, axes_[p.axis], exerr);
           else if constexpr (std::is_same_v<P, MgsParams>) return start_group(r, p.group, p.mode, exerr);
           else if constexpr (std::is_same_v<P, MgsdParams> || std::is_same_v<P, MgsrParams>)
             return start_group(r, p.group, GroupStopMode::Programmed, exerr);
@@ -658,6 +665,7 @@ Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int
   }
   const bool ramping = a.servo && mask != 0 && stop_slots(a, mask, d, jd, r.control, 0);
   if (type == StopType::All) break_links(a);  // MAS All on the slave breaks its MDAC links
+  if (type == StopType::All || type == StopType::TimeCam) drop_pending_cam(a);
   if ((type == StopType::All || type == StopType::DirectControl) && a.direct_active) {
     // direct command to zero; the drive ramps down; PC at standstill
     end_direct(a, true);
@@ -1228,6 +1236,15 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
 void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
   double sum_p = 0, sum_v = 0, sum_a = 0;
   for (std::size_t s = 0; s < kSlots; ++s) {
+    if (auto* cg = std::get_if<CamGen>(&a.gen[s])) {
+      step_cam(a, *cg);
+      if (auto* still = std::get_if<CamGen>(&a.gen[s])) {
+        sum_p += still->k.p;
+        sum_v += still->k.v;
+        sum_a += still->k.a;
+      }
+      continue;
+    }
     if (auto* gg = std::get_if<GearGen>(&a.gen[s])) {
       step_gear(*gg);
       sum_p += gg->k.p;
@@ -1346,6 +1363,8 @@ void Planner::update_status(AxisRt& a) noexcept {
   setb(AxisHomedStatus, a.homed);
   setb(AccelStatus, a.cmd.v * a.cmd.a > 0 || (a.cmd.v == 0 && a.cmd.a != 0));
   setb(DecelStatus, a.cmd.v * a.cmd.a < 0);
+  setb(TimeCamStatus, std::holds_alternative<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]));
+  setb(TimeCamPendingStatus, a.pending_cam.valid());
   const bool torque_mode = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
   setb(DirectVelocityControlStatus, a.direct_active && !torque_mode);
   setb(DirectTorqueControlStatus, a.direct_active && torque_mode);
@@ -1555,6 +1574,114 @@ bool Planner::set_direct_command(AxisId id, double value) noexcept {
   return true;
 }
 
+// --- MATC (time driven)
+bool Planner::attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noexcept {
+  if (id >= kMaxCamProfiles) return false;
+  cam_profiles_[id] = profile;
+  return true;
+}
+
+void Planner::drop_pending_cam(AxisRt& a) noexcept {
+  if (!a.pending_cam.valid()) return;
+  if (ControlTag* c = owner_tag(a.pending_cam.owner, a.pending_cam.owner_gen)) c->set(flag::IP, false);
+  a.pending_cam = PendingCam{};
+}
+
+Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
+  if (Err e = common_checks(a, true); e != Err::None) return e;
+  if (a.homing) return Err::HomeInProcess;
+  if (p.master_driven) return Err::FeatureNotSupported;  // master-driven MATC: not yet
+  if (p.lock_direction != LockDirection::None) return Err::MdscLockDirConflict;  // time driven needs none
+  cam::CamProfile* prof = p.cam_profile < kMaxCamProfiles ? cam_profiles_[p.cam_profile] : nullptr;
+  if (!prof || !prof->calculated()) return Err::CamProfileNotCalculated;
+  bool bad_slave = false, bad_master = false;
+  const cam::CamScaling sc{p.distance_scaling, p.time_scaling};
+  if (cam::check_scaling(sc, bad_slave, bad_master) != cam::CamError::None) {
+    exerr = static_cast<std::int8_t>(operand_index(Instr::MATC, bad_slave ? "DistanceScaling" : "TimeScaling"));
+    return Err::ParameterOutOfRange;
+  }
+  const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.cam_dir);
+  cam::CamMotionConfig cfg;
+  cfg.mode = p.execution_mode == 1 ? cam::ExecutionMode::Continuous : cam::ExecutionMode::Once;
+  cfg.scaling = sc;
+  cfg.direction = dir;
+  ControlTag& c = controls_[r.control];
+  const bool active = std::holds_alternative<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]);
+  if (p.execution_schedule == 1) {  // pending: takes over at the end of the current pass [seed 004]
+    drop_pending_cam(a);             // a second pending MATC overlays the first
+    a.pending_cam = PendingCam{prof, cfg, r.control, c.generation};
+    a.cam_dir = dir;
+    c.set(flag::DN, true);
+    c.set(flag::IP, true);
+    return Err::None;
+  }
+  if (active) return Err::IllegalDynamicChange;  // immediate on an axis already time camming [seed 004]
+  CamGen g;
+  int bad = 0;
+  if (prof->acquire() != cam::CamError::None) return Err::CamProfileNotCalculated;
+  if (g.cm.start(*prof, cfg, &bad) != cam::CamError::None) {
+    prof->release();
+    exerr = static_cast<std::int8_t>(operand_index(Instr::MATC, "Direction"));
+    return Err::ParameterOutOfRange;
+  }
+  fold(a, Slot::TimeCam, true);
+  g.profile = prof;
+  g.t0_cycle = cycle_;
+  g.owner = r.control;
+  g.owner_gen = c.generation;
+  a.gen[static_cast<std::size_t>(Slot::TimeCam)] = g;
+  a.cam_dir = dir;
+  c.set(flag::DN, true);
+  c.set(flag::IP, true);
+  return Err::None;
+}
+
+void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
+  const double x = static_cast<double>(cycle_ - g.t0_cycle) * T_ - g.x_offset;
+  cam::CamMotionOutput o = g.cm.step(x);
+  // a pending cam takes over exactly at the end of the current pass [seed 004]
+  const bool once = g.cm.config().mode == cam::ExecutionMode::Once;
+  const std::int64_t pass_before = g.last_pass;
+  g.last_pass = o.pass;
+  if (a.pending_cam.valid()) {
+    const double end = once ? g.cm.pass_end(0) : g.cm.pass_end(pass_before);
+    if (once ? x >= end : o.pass != pass_before) {
+      const cam::CamMotionOutput at_end = g.cm.step(end);
+      ControlTag* old = owner_tag(g.owner, g.owner_gen);
+      if (old) {
+        old->set(flag::IP, false);
+        if (once) old->set(flag::PC, true);  // Once: PC; Continuous: IP cleared
+      }
+      const std::uint64_t t0 = g.t0_cycle;
+      const double xo = g.x_offset + end;
+      g.k = Kin{at_end.position, 0, 0};
+      fold(a, Slot::TimeCam, false);  // base += position at the pass end: no jump
+      PendingCam pc = a.pending_cam;
+      a.pending_cam = PendingCam{};
+      CamGen n;
+      if (pc.profile->acquire() == cam::CamError::None && n.cm.start(*pc.profile, pc.cfg) == cam::CamError::None) {
+        n.profile = pc.profile;
+        n.t0_cycle = t0;
+        n.x_offset = xo;
+        n.owner = pc.owner;
+        n.owner_gen = pc.owner_gen;
+        a.gen[static_cast<std::size_t>(Slot::TimeCam)] = n;
+        auto& ng = std::get<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]);
+        step_cam(a, ng);
+      } else if (ControlTag* pt = owner_tag(pc.owner, pc.owner_gen)) {
+        pt->reject(Err::CamProfileNotCalculated);
+      }
+      return;
+    }
+  }
+  g.k = Kin{o.position, o.velocity, o.acceleration};
+  if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) c->segment = static_cast<std::int32_t>(o.segment);
+  if (o.complete) {  // Once: PC, the axis holds the end position, TimeCamStatus cleared
+    if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) c->set(flag::PC, true);
+    fold(a, Slot::TimeCam, true);
+  }
+}
+
 void Planner::compute_order() noexcept {
   // depth-first: every axis after the masters it follows (gear, master-driven
   // motion). MAG refuses gear cycles (ERR 10); a cycle through master-driven
@@ -1602,6 +1729,8 @@ void Planner::compute_order() noexcept {
 
 Result Planner::update(const Input& in, Output& out) noexcept {
   if (started_ && in.cycle <= cycle_) return Result::ErrorCycleNotIncreasing;
+  // the first cycle index may be anything: time starts one period before it
+  if (!started_) cycle_ = in.cycle > 0 ? in.cycle - 1 : 0;
   // 1. feedback and exceptions (against last cycle's command)
   for (std::size_t i = 0; i < axis_count_; ++i) {
     AxisRt& a = axes_[i];

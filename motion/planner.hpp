@@ -18,6 +18,7 @@
 #include <variant>
 
 #include "motion/axis.hpp"
+#include "motion/cam/cam_motion.hpp"
 #include "motion/control_tag.hpp"
 #include "motion/profile.hpp"
 #include "motion/signatures.hpp"
@@ -178,6 +179,32 @@ struct GearGen {
   std::uint32_t owner_gen = 0;
 };
 
+/// State of a time-driven MATC: the cam engineer's CamMotion evaluated at cam
+/// time. O(1) amortised step.
+struct CamGen {
+  cam::CamMotion cm{};
+  cam::CamProfile* profile = nullptr;  ///< in use (acquired) while the cam runs
+  std::uint64_t t0_cycle = 0;
+  double x_offset = 0.0;       ///< cam time = (cycle - t0_cycle) * T - x_offset (pending takeovers)
+  std::int64_t last_pass = 0;  ///< pass of the last step (a pending cam waits for its end)
+  Kin k{};
+  bool scurve = false;
+  ControlId owner = kNoControl;
+  std::uint32_t owner_gen = 0;
+};
+
+/// A pending MATC waiting for the end of the current pass (or for an immediate cam).
+struct PendingCam {
+  cam::CamProfile* profile = nullptr;
+  cam::CamMotionConfig cfg{};
+  ControlId owner = kNoControl;
+  std::uint32_t owner_gen = 0;
+  constexpr bool valid() const noexcept { return profile != nullptr; }
+};
+
+/// Capacity of the CAM_PROFILE registry (config: one entry per CAM_PROFILE array tag).
+inline constexpr std::size_t kMaxCamProfiles = 64;
+
 /// Per-axis generator slots. Generators superpose: the command position is
 /// base + the sum of the slot offsets. Bound: one slot per kind of motion
 /// Logix can run at the same time on one axis (move, jog, gear, time cam,
@@ -186,7 +213,7 @@ enum class Slot : std::uint8_t { Move = 0, Jog, Gear, TimeCam, PositionCam, Mast
 inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
 
 /// The closed set of generator states. Issue 5 adds cam and direct states here.
-using Generator = std::variant<std::monostate, ProfileGen, GearGen>;
+using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen>;
 
 // typed instruction parameters (motion/instructions.hpp)
 struct MasParams;
@@ -197,6 +224,7 @@ struct MrpParams;
 struct MagParams;
 struct MdacParams;
 struct MdsParams;
+struct MatcParams;
 
 // ------------------------------------------------------------------ planner
 /// The planner. All state is inside (fixed arrays); update() is noexcept,
@@ -226,6 +254,10 @@ class Planner {
   /// of an axis in direct control, as a program writing the command tag.
   /// Returns false if the axis is not under an active MDS. Realtime-safe.
   bool set_direct_command(AxisId id, double value) noexcept;
+
+  /// Register the CAM_PROFILE array tag `id` (the binder's cam_profiles id).
+  /// The profile must outlive the planner. Not realtime (configuration).
+  bool attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noexcept;
 
   /// Axis tag (status) of an axis. Realtime-safe.
   const AxisTag& axis(AxisId id) const noexcept { return axes_[id].tag; }
@@ -273,6 +305,8 @@ class Planner {
     bool mds_waiting = false;     ///< MDS waits for the drive enable (STATE 1)
     ControlId mds_stop = kNoControl;  ///< MAS stopping direct motion (PC at standstill)
     std::uint32_t mds_stop_gen = 0;
+    PendingCam pending_cam{};     ///< TimeCamPendingStatus
+    int cam_dir = 0;              ///< last time-cam direction (+1/-1, 0 never cammed)
     int gear_dir = 0;           ///< last gearing direction (+1 same, -1 opposite, 0 never geared)
     bool homing = false;        ///< drive homing (mode 6) in progress
     bool homing_started = false;
@@ -300,6 +334,9 @@ class Planner {
   Err start_mag(const Request&, const MagParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mdac(const Request&, const MdacParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mds(const Request&, const MdsParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  Err start_matc(const Request&, const MatcParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  void step_cam(AxisRt& a, CamGen& g) noexcept;
+  void drop_pending_cam(AxisRt& a) noexcept;
   void end_direct(AxisRt& a, bool keep_direct_status) noexcept;
   void break_links(AxisRt& slave) noexcept;
   void break_links_of_master(AxisId master) noexcept;
@@ -335,6 +372,7 @@ class Planner {
   std::array<AxisRt, kMaxAxes> axes_{};
   std::array<ControlTag, kMaxControlTags> controls_{};
   std::array<GroupOp, kMaxGroups> groups_{};
+  std::array<cam::CamProfile*, kMaxCamProfiles> cam_profiles_{};
   std::array<AxisId, kMaxAxes> order_{};  ///< step order: masters before slaves
   std::size_t order_n_ = 0;
 };

@@ -181,7 +181,7 @@ constexpr std::array<InstrSig, kInstrCount> kTable{{
     {Instr::MRP, "MRP", kMrp, true},
     {Instr::MCCP, "MCCP", kMccp, false},
     {Instr::MAPC, "MAPC", kMapc, false},
-    {Instr::MATC, "MATC", kMatc, false},
+    {Instr::MATC, "MATC", kMatc, true},
     {Instr::MDAC, "MDAC", kMdac, true},
     {Instr::MDS, "MDS", kMds, true},
     {Instr::MGS, "MGS", kMgs, true},

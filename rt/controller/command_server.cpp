@@ -669,7 +669,7 @@ struct CommandServer::Impl {
 
   void do_stats(Client& c) {
     const Status& s = status();
-    send_line(c, fmt::format("cycles={}", s.cycle));
+    send_line(c, fmt::format("cycle={}", s.cycle));  // the controller's; the executive's `cycles` follow
     send_line(c, fmt::format("time_s={}", script::format_value(static_cast<double>(s.cycle) * ctl.period_s())));
     send_line(c, fmt::format("period_ms={}", script::format_value(ctl.period_s() * 1e3)));
     send_line(c, fmt::format("axes={}", ctl.axis_count()));

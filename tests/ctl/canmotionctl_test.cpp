@@ -147,7 +147,8 @@ TEST(Canmotionctl, InstructionGetSetStatusStats) {
 
   const Result stats = ctl(&r, d, {"-s", r.sock, "stats"});
   EXPECT_EQ(stats.status, 0) << stats.err;
-  EXPECT_TRUE(contains(stats.out, "cycles ")) << stats.out;
+  EXPECT_EQ(stats.out.rfind("cycle ", 0), 0u) << stats.out;
+  EXPECT_TRUE(contains(stats.out, "\ntime_s ")) << stats.out;
   EXPECT_TRUE(contains(stats.out, "clients                               1")) << stats.out;
 
   const Result raw = ctl(&r, d, {"-s", r.sock, "send", "GET", "mam1.DN"});

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End to end: canmotiond --sim --socket with the demo configuration, driven by
 # canmotionctl: status, an instruction, get/set, a script, a watch, stats; then
-# SIGTERM and a clean exit 0. --sim runs faster than real time, so the daemon
+# SIGTERM and a clean exit 0. Then the same configuration in real time (its
+# buses are `interface: sim`) for the executive's statistics. --sim runs faster than real time, so the daemon
 # gets a long --duration and is stopped by the signal when the checks are done.
 # Usage: daemon-e2e.sh CANMOTIOND CANMOTIONCTL CONFIG
 set -u
@@ -59,7 +60,7 @@ out=$("$ctl" watch Controller.Time --interval 0.5 --count 3) || fail "watch: $ou
 [ "$(wc -l <<<"$out")" = 3 ] || fail "watch printed: $out"
 
 out=$("$ctl" stats) || fail "stats: $out"
-grep -q '^cycles ' <<<"$out" || fail "stats: $out"
+grep -q '^cycle ' <<<"$out" || fail "stats: $out"
 
 if out=$("$ctl" 'MSO(Nope, x)' 2>&1); then fail "an unknown axis was accepted: $out"; fi
 grep -q "Nope" <<<"$out" || fail "error does not name the axis: $out"
@@ -71,4 +72,27 @@ pid=
 [ "$rc" = 0 ] || fail "canmotiond exited $rc after SIGTERM"
 [ ! -e "$sock" ] || fail "the socket file was left behind"
 grep -q 'socket: client .* connected: pid' "$dir/daemon.err" || fail "connections are not logged"
+
+# Real time: `interface: sim` without --sim runs the cycle on the monotonic
+# clock; STATS then includes the executive's latency statistics, also as tags.
+"$daemon" --config "$config" --socket "$sock" --quiet >"$dir/daemon.out" 2>"$dir/daemon.err" &
+pid=$!
+for _ in $(seq 1 200); do
+  [ -S "$sock" ] && break
+  kill -0 "$pid" 2>/dev/null || fail "canmotiond (real time) exited before creating $sock"
+  sleep 0.05
+done
+[ -S "$sock" ] || fail "no socket $sock after 10 s (real time)"
+sleep 0.3
+out=$("$ctl" stats) || fail "stats (real time): $out"
+echo "$out"
+grep -q '^latency_p99 .* us$' <<<"$out" || fail "real-time stats have no latency_p99: $out"
+lat=$("$ctl" get Controller.latency_max_ns) || fail "get Controller.latency_max_ns: $lat"
+[ "$lat" -gt 0 ] 2>/dev/null || fail "Controller.latency_max_ns is '$lat'"
+out=$("$ctl" 'MSO(Gear, rt_mso)') || fail "MSO (real time): $out"
+kill -TERM "$pid"
+wait "$pid"
+rc=$?
+pid=
+[ "$rc" = 0 ] || fail "canmotiond (real time) exited $rc after SIGTERM"
 echo "PASS"

@@ -1,19 +1,22 @@
 #!/usr/bin/env bash
 # vcan.demo, COMMAND part (runs inside the VM, vcan0 and vcan1 up, candump -L
 # writing $CANMOTION_TRACE): the demo on real SocketCAN as separate processes.
-#   vcan-demo-run.sh CANMOTIOND CIA402_EMU EXAMPLES_DIR PERIOD_MS
+#   vcan-demo-run.sh CANMOTIOND CIA402_EMU EXAMPLES_DIR PERIOD_MS [EMU_LAG]
 # 1. config: demo.yaml with can0 -> vcan0, can1 -> vcan1, period PERIOD_MS
 #    (make-vcan-config.sh);
 # 2. cia402-emu on vcan0 (nodes 2, 3) and on vcan1 (node 4), started first as
-#    demo.yaml says; their boot-up is in the trace before canmotiond starts;
+#    demo.yaml says, with --lag EMU_LAG (default 2, the emulator's default);
+#    their boot-up is in the trace before canmotiond starts;
 # 3. canmotiond --config ... --script demo.script --stats in real time (no
 #    --sim); it must exit 0 and print one line per PRINT of the script, with
 #    the script's tags in order;
 # 4. wait until candump has written the final NMT pre-operational frames, stop
-#    the emulators.
+#    the emulators and wait until the trace stops growing (also on failure:
+#    candump lags behind under emulation and drops what is queued when it is
+#    stopped).
 # Artefacts: demo-vcan.yaml, canmotiond.log, canmotiond-trace.log, emu-vcan*.log.
 set -euo pipefail
-daemon="$1" emu="$2" examples="$3" period="$4"
+daemon="$1" emu="$2" examples="$3" period="$4" lag="${5:-2}"
 art="$CANMOTION_ARTIFACTS" trace="$CANMOTION_TRACE"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)"
 fail() { echo "vcan-demo-run: $*" >&2; exit 1; }
@@ -23,11 +26,25 @@ cfg="$art/demo-vcan.yaml"
 script="$examples/demo.script"
 
 pids=()
-cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; }
+settle() {  # wait (bounded, 60 s) until the trace has not grown for 1.5 s
+  local last=-1 n i same=0
+  for ((i = 0; i < 120 && same < 3; i++)); do
+    n=$(wc -l < "$trace")
+    if [[ $n == "$last" ]]; then same=$((same + 1)); else same=0; fi
+    last=$n
+    sleep 0.5
+  done
+}
+cleanup() {
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  pids=()
+  settle
+}
 trap cleanup EXIT
-"$emu" --interface vcan0 --node 2 --node 3 --verbose > "$art/emu-vcan0.log" 2>&1 &
+"$emu" --interface vcan0 --node 2 --node 3 --lag "$lag" --verbose > "$art/emu-vcan0.log" 2>&1 &
 pids+=($!)
-"$emu" --interface vcan1 --node 4 --verbose > "$art/emu-vcan1.log" 2>&1 &
+"$emu" --interface vcan1 --node 4 --lag "$lag" --verbose > "$art/emu-vcan1.log" 2>&1 &
 pids+=($!)
 for ((i = 0; i < 600; i++)); do   # up to 30 s: process start is slow in the VM
   grep -q ' vcan0 702#00$' "$trace" && grep -q ' vcan0 703#00$' "$trace" && grep -q ' vcan1 704#00$' "$trace" && break
@@ -36,7 +53,7 @@ done
 for n in vcan0:2 vcan0:3 vcan1:4; do
   grep -q " ${n%:*} 70${n#*:}#00\$" "$trace" || { cat "$art"/emu-vcan*.log >&2; fail "no boot-up of node ${n#*:} on ${n%:*}"; }
 done
-echo "vcan-demo-run: the three emulated drives booted; starting canmotiond (period $period ms, real time)"
+echo "vcan-demo-run: the three emulated drives (--lag $lag) booted; starting canmotiond (period $period ms, real time)"
 
 status=0
 start=$(date +%s%N)
@@ -65,14 +82,6 @@ for ((i = 0; i < 300; i++)); do
   grep -q ' vcan0 000#80' "$trace" && grep -q ' vcan1 000#80' "$trace" && break
   sleep 0.1
 done
-last=-1
-for ((i = 0; i < 100; i++)); do
-  n=$(wc -l < "$trace")
-  [[ $n == "$last" ]] && break
-  last=$n
-  sleep 0.2
-done
 cleanup
-for p in "${pids[@]}"; do wait "$p" || true; done
 trap - EXIT
 echo "vcan-demo-run: emulators stopped; trace has $(wc -l < "$trace") frames"

@@ -651,8 +651,10 @@ TEST(Group, FastDisableAndShutdownReset) {
 // ------------------------------------------------------------------- model rules
 TEST(Model, InstructionsNotYetExecutableGiveErr75) {
   Rig r = servo_rig();
+  r.add_axis("M", virt());
   r.sym.cam_profiles["prof"] = 0;
-  EXPECT_EQ(r.exec("MATC(X, t, same, prof[0], 1, 1, once, immediate, 0, none, timedrivenmode);"), Err::InstructionNotSupported);
+  EXPECT_EQ(r.exec("MAPC(X, M, t, same, prof[0], 1, 1, once, immediate, 0, 0, command, bidirectional);"), Err::InstructionNotSupported);
+  EXPECT_EQ(r.tag("t").err, 75);
 }
 
 TEST(Model, EachExecutionIsARisingEdge) {
@@ -685,4 +687,17 @@ TEST(Determinism, SameSequenceTwiceIsBitIdentical) {
   const auto b = run();
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
+}
+
+TEST(Model, FirstCycleIndexCanBeAnything) {
+  Rig r;
+  r.add_axis("X", virt());
+  r.cycle = 123456;  // the runtime starts counting wherever it likes
+  r.submit("MSO(X, on);");
+  r.submit(mam("X", "m", 0, 10, 50, 1000, 1000));
+  r.step();
+  // one period of a 1000 u/s^2 ramp: v = 1 u/s, not a jump into the profile
+  EXPECT_NEAR(r.axis("X").command_velocity, 1.0, 1e-9);
+  Output none{};
+  EXPECT_EQ(r.p->update(Input{r.cycle, {}, {}}, none), Result::ErrorCycleNotIncreasing);
 }

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "motion/cam/cam_profile.hpp"
 #include "rig.hpp"
 
 namespace {
@@ -39,6 +40,13 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
   d.position_error_tolerance = 1e9;
   r.add_axis("D", d);
   r.fb[1].drive = DriveState::Enabled;
+  AxisConfig e = c;
+  r.add_axis("C", e);
+  cam::CamProfile prof(8);  // allocated at configuration time
+  const std::array<cam::CamPoint, 3> pts{{{0.0, 0.0, 1}, {0.5, 2.0, 1}, {1.0, 3.0, 1}}};
+  ASSERT_TRUE(cam::mccp(cam::MccpRequest{pts, 0, 3, 0.0, 0.0}, prof).ok());
+  r.p->attach_cam_profile(0, &prof);
+  r.sym.cam_profiles["prof"] = 0;
   // parse everything first (the non-RT side)
   const std::vector<Request> script = {
       r.req("MSO(X, a);"), r.req("MSO(D, b);"),
@@ -52,6 +60,9 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
       r.req("MDAC(X, D, link, move, command);"),
       r.req("MAM(X,mdm,incremental,5,0.5,unitspermasterunit,1,unitspermasterunit2,1,unitspermasterunit2,scurve,10,10,"
             "unitspermasterunit3,disabled,programmed,0,immediateforwardonly,0,0);"),
+      r.req("MSO(C, on3);"),
+      r.req("MATC(C, tc, same, prof[0], 1, 1, continuous, immediate, 0, none, timedrivenmode);"),
+      r.req("MATC(C, tc2, same, prof[0], 2, 1, once, pending, 0, none, timedrivenmode);"),
       r.req("MGS(g, gs, faststop);"),
   };
   r.queue.reserve(16);
