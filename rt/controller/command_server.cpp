@@ -136,6 +136,7 @@ struct CommandServer::Impl {
     std::optional<std::string> write(std::string_view tag, double value) override {
       return s_.host.write(tag, value);
     }
+    void declare(std::string_view tag) override { s_.host.declare(tag); }
 
    private:
     Impl& s_;

@@ -69,6 +69,11 @@ std::optional<double> ControllerHost::read(std::string_view tag, std::string* er
   return tags_.read(refresh(), tag, error);
 }
 
+void ControllerHost::declare(std::string_view tag) {
+  std::string e;
+  if (!tags_.resolve(tag, &e)) (void)tags_.write(tag, 0.0, true);
+}
+
 std::optional<std::string> ControllerHost::write(std::string_view tag, double value) {
   return tags_.write(tag, value, true);
 }

@@ -28,6 +28,7 @@ class ControllerHost final : public script::ScriptHost {
   bool settled() override;
   std::optional<double> read(std::string_view tag, std::string* error) override;
   std::optional<std::string> write(std::string_view tag, double value) override;
+  void declare(std::string_view tag) override;
 
   /// Sequence number of the last command queued (0 = none).
   [[nodiscard]] std::uint64_t last_seq() const noexcept { return last_seq_; }

@@ -298,7 +298,10 @@ Script load(std::string_view text, const std::string& file, ScriptHost& host) {
         for (const auto& t : s.tags)
           if ((err = host.check_tag(t, false))) break;
         break;
-      case Statement::Kind::kAssign: err = host.check_tag(s.tags[0], true); break;
+      case Statement::Kind::kAssign:
+        err = host.check_tag(s.tags[0], true);
+        if (!err) host.declare(s.tags[0]);
+        break;
       case Statement::Kind::kWait: break;
     }
     if (err) throw ScriptError(file, s.line, s.column, *err);

@@ -87,6 +87,10 @@ class ScriptHost {
   virtual std::optional<double> read(std::string_view tag, std::string* error) = 0;
   /// Write a writable tag.
   virtual std::optional<std::string> write(std::string_view tag, double value) = 0;
+  /// Make sure a numeric tag assigned by the script exists (value 0 if new),
+  /// so that later statements may read it or pass it as an operand. Called
+  /// by load() for every `tag := value;` before checking later statements.
+  virtual void declare(std::string_view tag) = 0;
 };
 
 /// Parse script text. Throws ScriptError naming the file, line and column.

@@ -24,8 +24,11 @@ class FakeHost : public ScriptHost {
     return "unknown instruction in '" + std::string(call) + "'";
   }
   std::optional<std::string> check_tag(std::string_view tag, bool for_write) override {
+    if (for_write) {
+      if (tags.count(std::string(tag)) && tag != "Speed" && tag != "Target") return "tag '" + std::string(tag) + "' is read-only";
+      return std::nullopt;
+    }
     if (!tags.count(std::string(tag))) return "no tag named '" + std::string(tag) + "'";
-    if (for_write && tag != "Speed") return "tag '" + std::string(tag) + "' is read-only";
     return std::nullopt;
   }
   std::optional<std::string> execute(std::string_view call, std::string* ctl) override {
@@ -43,6 +46,7 @@ class FakeHost : public ScriptHost {
     }
     return it->second;
   }
+  void declare(std::string_view tag) override { tags.emplace(std::string(tag), 0.0); }
   std::optional<std::string> write(std::string_view tag, double v) override {
     tags[std::string(tag)] = v;
     unsettled = lag;
@@ -170,6 +174,13 @@ TEST(ScriptRunner, WaitsUntilTheHostHasSettled) {
   r.host.lag = 5;
   r.until_end(100);
   EXPECT_EQ(r.lines, (std::vector<std::string>{"t=0.006 Speed=7"}));
+}
+
+TEST(ScriptLoad, AssignedTagsMayBeReadLater) {
+  ScriptRun r("Target := 5; PRINT Target; WAIT UNTIL Target >= 5 TIMEOUT 1;");
+  r.until_end(10);
+  EXPECT_EQ(r.runner->status(), Runner::Status::kDone) << r.runner->error();
+  EXPECT_EQ(r.lines, (std::vector<std::string>{"t=0.001 Target=5"}));
 }
 
 TEST(ScriptFormat, Values) {
