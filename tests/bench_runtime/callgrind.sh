@@ -29,17 +29,23 @@ cycles=$(awk -v s="$secs" 'BEGIN { print int(s * 1000 + 0.5) }')
 echo "# $(date -u +%FT%TZ) valgrind $(valgrind --version | sed 's/valgrind-//'), $daemon"
 echo "# total Ir: ${secs} s of 8 axes: $full; 0.2 s (start-up, boot, enable, stop): $base"
 awk -v f="$full" -v b="$base" -v c="$cycles" 'BEGIN { printf "# steady state: %.0f Ir per 1 ms cycle of 8 axes (%.0f per axis)\n", (f - b) / c, (f - b) / c / 8 }'
-echo "# top $top by self cost in the steady state (full run minus the 0.2 s run, per function):"
-callgrind_annotate --threshold=100 "$out/full.out" > "$out/self.txt" 2>/dev/null
-callgrind_annotate --threshold=100 "$out/base.out" > "$out/self-base.txt" 2>/dev/null
-awk -v n="$top" -v total="$(awk -v f="$full" -v b="$base" 'BEGIN { print f - b }')" '
-  FNR == 1 { on = 0; file++ }
-  /^ *Ir +file:function/ { on = 1; next }
-  on && $1 ~ /^[0-9,]+$/ { v = $1; gsub(/,/, "", v); sub(/^ *[0-9,]+ +\([^)]*\) +/, ""); ir[$0] += (file == 1 ? v : -v) }
-  END { for (f in ir) print ir[f] "\t" f }' "$out/self.txt" "$out/self-base.txt" | sort -t$'\t' -k1,1nr |
-  awk -F'\t' -v n="$top" -v total="$(awk -v f="$full" -v b="$base" 'BEGIN { print f - b }')" 'NR <= n { printf "%12d (%5.1f%%)  %s\n", $1, 100 * $1 / total, $2 }'
+callgrind_annotate --auto=no --threshold=100 "$out/full.out" > "$out/self.txt" 2>/dev/null
+callgrind_annotate --auto=no --threshold=100 "$out/base.out" > "$out/self-base.txt" 2>/dev/null
+steady=$(awk -v f="$full" -v b="$base" 'BEGIN { print f - b }')
+top_steady() {  # top_steady BYFN N: self cost of the full run minus the base run
+  awk -v byfn="$1" '
+    FNR == 1 { on = 0; file++ }
+    /^ *Ir +file:function/ { on = 1; next }
+    on && $1 ~ /^[0-9,]+$/ { v = $1; gsub(/,/, "", v); sub(/^ *[0-9,]+ +\([^)]*\) +/, ""); if (byfn) { sub(/ \[[^]]*\]$/, ""); sub(/^[^:]*:/, "") } ir[$0] += (file == 1 ? v : -v) }
+    END { for (f in ir) print ir[f] "\t" f }' "$out/self.txt" "$out/self-base.txt" | sort -t$'\t' -k1,1nr |
+    awk -F'\t' -v n="$2" -v total="$steady" 'NR <= n { printf "%12d (%5.1f%%)  %s\n", $1, 100 * $1 / total, $2 }'
+}
+echo "# top $top functions by self cost in the steady state (full run minus the 0.2 s run; inlined code counted in its caller):"
+top_steady 1 "$top"
+echo "# top $((top * 2)) source file:function pairs by self cost in the steady state (shows inlined headers, e.g. pdo.hpp packing):"
+top_steady 0 "$((top * 2))"
 echo "# top $((top * 2)) by inclusive cost:"
-callgrind_annotate --inclusive=yes --threshold=100 "$out/full.out" > "$out/incl.txt" 2>/dev/null
+callgrind_annotate --auto=no --inclusive=yes --threshold=100 "$out/full.out" > "$out/incl.txt" 2>/dev/null
 awk -v n="$((top * 2))" '
   /^ *Ir +file:function/ { on = 1; next } on && NF > 0 && k < n && $1 ~ /^[0-9,]+$/ { k++; print }' "$out/incl.txt"
 echo "# callgrind outputs in $out (callgrind_annotate $out/full.out)"
