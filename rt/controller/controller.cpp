@@ -251,8 +251,16 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
       planner_.reset_control(c.control);
     } else if (c.kind == Command::Kind::kEnableDrives) {
       for (auto& b : buses_) b.network->enable_all();
-    } else if (c.kind == Command::Kind::kPreOperational) {
-      preop_pending_ = true;  // sent after this cycle's SYNC, so its TPDOs still come back
+    } else if (c.kind == Command::Kind::kPreOperational && halt_ == Halt::kRunning) {
+      // The drives stop watching the master's heartbeat first, or they fault
+      // (EMCY 0x8130) once the master is gone.
+      for (auto& ax : axes_) {
+        if (ax.proxy == nullptr) continue;
+        auto& sdo = buses_[static_cast<std::size_t>(ax.bus)].network->master().sdo(ax.proxy->node());
+        (void)sdo.download_value<std::uint32_t>(0x1016, 1, 0, kDisarmTag);
+      }
+      halt_ = Halt::kDisarming;
+      halt_since_ns_ = now_ns;
     }
     done_seq_ = c.seq;
   }
@@ -267,14 +275,26 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
   (void)planner_.update(in, out);
   // 6 + 7. Drive state machines and RPDOs, then SYNC, per bus.
   for (std::size_t a = 0; a < axes_.size(); ++a) apply(a, out_[a]);
-  for (std::size_t b = 0; b < buses_.size(); ++b) {
+  for (std::size_t b = 0; b < buses_.size() && halt_ != Halt::kHalted; ++b) {
     auto& sink = static_cast<RecordingSink&>(*buses_[b].sink);
     sink.now_ns = now_ns;
     buses_[b].network->cycle(now_ns, sink);
   }
-  if (preop_pending_) {
-    preop_pending_ = false;
-    for (auto& b : buses_) b.network->master().send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, *b.sink);
+  if (halt_ == Halt::kDisarming) {
+    bool done = true;
+    for (auto& ax : axes_) {
+      if (ax.proxy == nullptr) continue;
+      auto& sdo = buses_[static_cast<std::size_t>(ax.bus)].network->master().sdo(ax.proxy->node());
+      canopen::SdoResult r;
+      while (sdo.poll_tag(kDisarmTag, r)) {
+      }
+      done = done && sdo.idle();
+    }
+    if (done || now_ns - halt_since_ns_ > kDisarmTimeoutNs) {
+      // After this cycle's SYNC, so its TPDOs still come back; then silence.
+      for (auto& b : buses_) b.network->master().send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, *b.sink);
+      halt_ = Halt::kHalted;
+    }
   }
   // 8. Publish.
   publish(now_ns);
@@ -327,6 +347,7 @@ void Controller::publish(std::int64_t now_ns) noexcept {
   s.trace_dropped = trace_dropped_;
   s.telemetry_dropped = telemetry_dropped_;
   s.commands_deferred = deferred_;
+  s.halted = halt_ == Halt::kHalted;
   snapshot_->commit();
 }
 

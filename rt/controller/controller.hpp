@@ -78,7 +78,9 @@ struct Command {
     kInstruction,   ///< execute `request` (one rung transition)
     kResetControl,  ///< clear control tag `control` (prescan)
     kEnableDrives,  ///< ask every drive to enable (outside the planner; tests, bring-up)
-    kPreOperational,  ///< NMT enter pre-operational to every node on every bus (controlled stop)
+    kPreOperational,  ///< controlled stop of the bus: disarm the drives' watch of the master's
+                      ///< heartbeat (0x1016:01 = 0), NMT pre-operational after the last SYNC,
+                      ///< then no more cyclic traffic (Status::halted)
   };
   Kind kind = Kind::kInstruction;
   motion::Request request{};
@@ -156,6 +158,7 @@ struct Status {
   std::uint64_t trace_dropped = 0;
   std::uint64_t telemetry_dropped = 0;
   std::uint64_t commands_deferred = 0;  ///< cycles in which requests had to wait for the next cycle
+  bool halted = false;  ///< after kPreOperational: nodes pre-operational, no PDO or SYNC sent any more
 };
 
 class Controller {
@@ -248,7 +251,13 @@ class Controller {
   std::array<can::TimedFrame, kRxBatch> rx_{};
   std::array<double, motion::kMaxAxes> max_err_{};
   std::optional<Command> held_;  ///< a command popped but deferred to the next cycle
-  bool preop_pending_ = false;
+  /// Controlled stop of the buses (Command::kPreOperational).
+  enum class Halt : std::uint8_t { kRunning, kDisarming, kHalted };
+  Halt halt_ = Halt::kRunning;
+  std::int64_t halt_since_ns_ = 0;
+  static constexpr std::uint32_t kDisarmTag = 0xCA10'1016;  ///< our SDO tag for the 0x1016 writes
+  /// Longest wait for the 0x1016 writes before NMT pre-operational anyway.
+  static constexpr std::int64_t kDisarmTimeoutNs = 500'000'000;
   std::uint64_t done_seq_ = 0;
   std::uint64_t deferred_ = 0;
   std::uint64_t trace_dropped_ = 0;

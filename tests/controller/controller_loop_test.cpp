@@ -174,5 +174,30 @@ TEST(ControllerLoop, InjectedFaultFaultsTheAxis) {
   EXPECT_TRUE(saw_emcy);
 }
 
+
+TEST(ControllerLoop, ControlledStopDisarmsHeartbeatWatchAndHalts) {
+  Rig r;
+  ASSERT_TRUE(r.run_until([](const Status& s) { return s.axes[1].phase == cia402::Phase::kOperational; }, 5000));
+  r.ctl->set_trace(true);
+  Command stop;
+  stop.kind = Command::Kind::kPreOperational;
+  ASSERT_NE(r.ctl->submit(stop), 0u);
+  ASSERT_TRUE(r.run_until([](const Status& s) { return s.halted; }, 500));
+  EXPECT_EQ(r.world.drive(0).nmt_state(), canopen::NmtState::kPreOperational);
+  EXPECT_EQ(r.world.drive(0).read_int(0x1016, 1), 0) << "the drive still watches the master's heartbeat";
+  // The master is silent from now on; a drive that still watched it would
+  // fault with EMCY 0x8130 after 300 ms.
+  TraceRecord tr;
+  while (r.ctl->pop_trace(tr)) {
+  }
+  r.run_until([](const Status&) { return false; }, 1000);
+  std::size_t sent = 0;
+  while (r.ctl->pop_trace(tr)) sent += tr.tx ? 1u : 0u;
+  EXPECT_EQ(sent, 0u) << "frames sent after the halt";
+  EXPECT_NE(r.world.drive(0).state(), cia402::State::kFault);
+  EXPECT_NE(r.world.drive(0).state(), cia402::State::kFaultReactionActive);
+  EXPECT_EQ(r.status().axes[1].last_emcy, 0);
+}
+
 }  // namespace
 }  // namespace canmotion::rt

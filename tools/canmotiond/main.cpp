@@ -182,8 +182,11 @@ class Shutdown {
         // The NMT frame goes out at the end of the cycle that executes the
         // command (after its SYNC); the next cycle receives that SYNC's TPDOs.
         // End after it, before a SYNC that pre-operational drives ignore.
+        // The controller disarms the drives' heartbeat watch (0x1016 over SDO),
+        // sends NMT pre-operational after a SYNC and then halts the cyclic
+        // traffic; one more cycle receives that SYNC's TPDOs.
         if (!preop_sent_) {
-          if (h_.settled()) {
+          if (s.halted || now - since_ > kPreOpTimeout) {
             preop_sent_ = true;
             since_ = now;
           }
@@ -197,6 +200,7 @@ class Shutdown {
   }
   static constexpr double kStopTimeout = 5.0;
   static constexpr double kDisableTimeout = 2.0;
+  static constexpr double kPreOpTimeout = 2.0;
 
  private:
   rt::ControllerHost& h_;
