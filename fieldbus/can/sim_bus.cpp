@@ -21,7 +21,7 @@ std::size_t SimBus::Endpoint::receive(std::span<TimedFrame> out) noexcept {
   std::size_t n = 0;
   while (n < out.size() && rx_count_ > 0) {
     out[n++] = rx_[rx_head_];
-    rx_head_ = (rx_head_ + 1) % rx_.size();
+    if (++rx_head_ == rx_.size()) rx_head_ = 0;
     --rx_count_;
   }
   return n;
@@ -45,7 +45,9 @@ void SimBus::Endpoint::push(const TimedFrame& f) noexcept {
     push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, f.t_ns});
     return;
   }
-  rx_[(rx_head_ + rx_count_) % rx_.size()] = f;
+  std::size_t tail = rx_head_ + rx_count_;  // < 2 * size: one wrap at most
+  if (tail >= rx_.size()) tail -= rx_.size();
+  rx_[tail] = f;
   ++rx_count_;
   ++counters_.rx_frames;
 }

@@ -1,5 +1,6 @@
 #include "fieldbus/cia402/drive_proxy.hpp"
 
+#include <array>
 #include <cinttypes>
 #include <cstdio>
 #include <stdexcept>
@@ -213,7 +214,10 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
     if (f.len < m.size_bytes) return true;  // length error: ignored (the drive reports 0x8210 on its side)
     const auto payload = f.payload();
     auto get = [&](const Slot& s) -> std::uint64_t {
-      const canopen::PdoEntry& e = pdos_.tpdo[static_cast<std::size_t>(s.pdo)].entries[static_cast<std::size_t>(s.entry)];
+      const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(s.entry)];
+      // Byte-aligned entries inside the received payload (all CiA 402 objects): direct load.
+      if (((e.bit_offset | e.bits) % 8) == 0 && e.bit_offset / 8u + e.bits / 8u <= f.len)
+        return canopen::load_le(f.data.data() + e.bit_offset / 8, e.bits / 8u);
       return canopen::unpack_bits(payload, e.bit_offset, e.bits);
     };
     if (sw_slot_.pdo == p) fb_.statusword = static_cast<std::uint16_t>(get(sw_slot_));
@@ -459,22 +463,31 @@ void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
 }
 
 void DriveProxy::send_rpdos(canopen::FrameSink& out) noexcept {
+  struct Item {
+    const Slot* slot;
+    std::uint64_t value;
+  };
+  const std::array<Item, 5> items{{{&cw_slot_, cw_},
+                                   {&tpos_slot_, static_cast<std::uint32_t>(target_position_)},
+                                   {&tvel_slot_, static_cast<std::uint32_t>(target_velocity_)},
+                                   {&ttrq_slot_, static_cast<std::uint16_t>(target_torque_)},
+                                   {&mode_slot_, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_))}}};
   for (std::uint8_t p = 0; p < pdos_.rpdo_count; ++p) {
     const canopen::PdoMap& m = pdos_.rpdo[p];
     can::Frame f;
     f.id = m.cob_id & 0x7FFu;
     f.len = m.size_bytes;
     std::span<std::uint8_t> payload(f.data.data(), f.len);
-    auto put = [&](const Slot& s, std::uint64_t v) {
-      if (s.pdo != p) return;
-      const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(s.entry)];
-      canopen::pack_bits(payload, e.bit_offset, e.bits, v);
-    };
-    put(cw_slot_, cw_);
-    put(tpos_slot_, static_cast<std::uint32_t>(target_position_));
-    put(tvel_slot_, static_cast<std::uint32_t>(target_velocity_));
-    put(ttrq_slot_, static_cast<std::uint16_t>(target_torque_));
-    put(mode_slot_, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_)));
+    for (const Item& it : items) {
+      if (it.slot->pdo != p) continue;
+      const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(it.slot->entry)];
+      // Byte-aligned entries inside the payload (all CiA 402 objects): direct store.
+      if (((e.bit_offset | e.bits) % 8) == 0 && e.bit_offset / 8u + e.bits / 8u <= f.len) {
+        canopen::store_le(f.data.data() + e.bit_offset / 8, e.bits / 8u, it.value);
+      } else {
+        canopen::pack_bits(payload, e.bit_offset, e.bits, it.value);
+      }
+    }
     out.send(f);
   }
 }

@@ -48,6 +48,7 @@ Emulator::Emulator(const EmulatorConfig& cfg)
       sdo_(cfg.node, *this) {
   cfg_.lag_cycles = std::min<std::uint32_t>(cfg_.lag_cycles, kMaxLag);
   build_dictionary();
+  resolve_hot();
   pos_ = cfg_.initial_position;
 }
 
@@ -62,7 +63,11 @@ void Emulator::add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, c
           info ? info->pdo : canopen::PdoMappable::kNo,
           value,
           value,
-          text};
+          text,
+          0,
+          false};
+  e.size = static_cast<std::uint8_t>(canopen::data_type_size(e.type));
+  e.is_signed = canopen::data_type_signed(e.type);
   od_.push_back(e);
 }
 
@@ -173,7 +178,59 @@ void Emulator::build_dictionary() {
       cia402::supported_mode_bit(cia402::Mode::kHoming) | cia402::supported_mode_bit(cia402::Mode::kCsp) |
           cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst));
   std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
+  od_.shrink_to_fit();  // od_ never changes size after this: Entry pointers stay valid
   rebuild_pdos();
+}
+
+void Emulator::resolve_hot() noexcept {
+  // Every object below is added unconditionally by build_dictionary(), so
+  // none of these is nullptr; val()/sval()/put() still accept nullptr.
+  auto must_find = [this](std::uint16_t index, std::uint8_t sub = 0) { return find(index, sub); };
+  Hot& h = hot_;
+  h.error_register = must_find(0x1001);
+  h.sync_cob = must_find(0x1005);
+  h.emcy_cob = must_find(0x1014);
+  for (std::uint8_t s = 1; s <= 4; ++s) h.consumer_hb[s - 1] = must_find(0x1016, s);
+  h.producer_hb = must_find(0x1017);
+  h.error_code = must_find(obj::kErrorCode);
+  h.controlword = must_find(obj::kControlword);
+  h.statusword = must_find(obj::kStatusword);
+  h.quick_stop_option = must_find(obj::kQuickStopOptionCode);
+  h.modes = must_find(obj::kModesOfOperation);
+  h.mode_display = must_find(obj::kModesOfOperationDisplay);
+  h.position_demand = must_find(obj::kPositionDemandValue);
+  h.position_internal = must_find(obj::kPositionActualInternalValue);
+  h.position_actual = must_find(obj::kPositionActualValue);
+  h.fe_window = must_find(obj::kFollowingErrorWindow);
+  h.fe_timeout = must_find(obj::kFollowingErrorTimeOut);
+  h.velocity_actual = must_find(obj::kVelocityActualValue);
+  h.target_torque = must_find(obj::kTargetTorque);
+  h.max_torque = must_find(obj::kMaxTorque);
+  h.torque_actual = must_find(obj::kTorqueActualValue);
+  h.target_position = must_find(obj::kTargetPosition);
+  h.home_offset = must_find(obj::kHomeOffset);
+  h.max_profile_velocity = must_find(obj::kMaxProfileVelocity);
+  h.quick_stop_decel = must_find(obj::kQuickStopDeceleration);
+  h.homing_method = must_find(obj::kHomingMethod);
+  h.homing_speed_switch = must_find(obj::kHomingSpeeds, 1);
+  h.position_offset = must_find(obj::kPositionOffset);
+  h.velocity_offset = must_find(obj::kVelocityOffset);
+  h.torque_offset = must_find(obj::kTorqueOffset);
+  h.ip_value = must_find(obj::kInterpolationTimePeriod, 1);
+  h.ip_index = must_find(obj::kInterpolationTimePeriod, 2);
+  h.fe_actual = must_find(obj::kFollowingErrorActualValue);
+  h.target_velocity = must_find(obj::kTargetVelocity);
+}
+
+std::int64_t Emulator::sval(const Entry* e) noexcept {
+  if (!e) return 0;
+  return e->is_signed ? canopen::sign_extend(e->value, static_cast<unsigned>(e->size) * 8u) : static_cast<std::int64_t>(e->value);
+}
+
+void Emulator::put(Entry* e, std::uint64_t v) noexcept {
+  if (!e) return;
+  const std::size_t n = e->size;
+  e->value = n >= 8 || n == 0 ? v : (v & ((std::uint64_t{1} << (8 * n)) - 1));
 }
 
 Emulator::Entry* Emulator::find(std::uint16_t index, std::uint8_t sub) noexcept {
@@ -193,18 +250,8 @@ std::uint64_t Emulator::get(std::uint16_t index, std::uint8_t sub) const noexcep
   const Entry* e = find(index, sub);
   return e ? e->value : 0;
 }
-std::int64_t Emulator::get_signed(std::uint16_t index, std::uint8_t sub) const noexcept {
-  const Entry* e = find(index, sub);
-  if (!e) return 0;
-  const auto bits = static_cast<unsigned>(canopen::data_type_size(e->type) * 8);
-  return canopen::data_type_signed(e->type) ? canopen::sign_extend(e->value, bits) : static_cast<std::int64_t>(e->value);
-}
-void Emulator::set(std::uint16_t index, std::uint8_t sub, std::uint64_t v) noexcept {
-  if (Entry* e = find(index, sub)) {
-    const std::size_t n = canopen::data_type_size(e->type);
-    e->value = n >= 8 || n == 0 ? v : (v & ((std::uint64_t{1} << (8 * n)) - 1));
-  }
-}
+std::int64_t Emulator::get_signed(std::uint16_t index, std::uint8_t sub) const noexcept { return sval(find(index, sub)); }
+void Emulator::set(std::uint16_t index, std::uint8_t sub, std::uint64_t v) noexcept { put(find(index, sub), v); }
 std::int64_t Emulator::read_int(std::uint16_t index, std::uint8_t sub) const noexcept {
   if (index == obj::kStatusword && sub == 0) return statusword();
   return get_signed(index, sub);
@@ -239,6 +286,18 @@ void Emulator::rebuild_pdos() noexcept {
       }
       const bool ok = m.finalize();
       const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0;
+      auto& cache = rx ? rpdo_entries_[p] : tpdo_entries_[p];
+      cache = {};
+      for (std::uint8_t i = 0; i < m.count; ++i) {
+        const canopen::PdoEntry& pe = m.entries[i];
+        MappedEntry& me = cache[i];
+        me.entry = find(pe.index, pe.sub);
+        me.aligned = (pe.bit_offset % 8) == 0 && (pe.bits % 8) == 0 && pe.bit_offset / 8 + pe.bits / 8 <= can::kMaxPayload;
+        me.byte_offset = static_cast<std::uint8_t>(pe.bit_offset / 8);
+        me.bytes = static_cast<std::uint8_t>(pe.bits / 8);
+        me.is_statusword = pe.index == obj::kStatusword && pe.sub == 0;
+        me.is_controlword = pe.index == obj::kControlword;
+      }
       if (rx) {
         rpdo_[p] = m;
         rpdo_valid_[p] = valid;
@@ -357,12 +416,12 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
 // ============================================================================
 void Emulator::send_emcy(std::uint16_t code, canopen::FrameSink& out) noexcept {
   if (nmt_ == canopen::NmtState::kStopped) return;
-  const auto cob = static_cast<std::uint32_t>(get(0x1014, 0));
+  const auto cob = static_cast<std::uint32_t>(val(hot_.emcy_cob));
   if ((cob & canopen::kPdoInvalid) != 0) return;
   canopen::Emcy e;
   e.node = cfg_.node;
   e.code = code;
-  e.error_register = static_cast<std::uint8_t>(get(0x1001, 0));
+  e.error_register = static_cast<std::uint8_t>(val(hot_.error_register));
   can::Frame f = canopen::make_emcy_frame(e);
   f.id = cob & 0x7FFu;
   out.send(f);
@@ -413,20 +472,29 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
   const can::Frame& f = tf.frame;
   if (!powered_ || f.extended() || f.error()) return;
   out_ = &out;
-  const canopen::CobInfo c = canopen::classify(f.id);
   if (f.id == canopen::cob::kNmt) {
     handle_nmt(f, now_ns_, out);
-  } else if (f.id == (get(0x1005, 0) & 0x7FFu)) {
+    out_ = nullptr;
+    return;
+  }
+  if (f.id == (val(hot_.sync_cob) & 0x7FFu)) {
     if (nmt_ == canopen::NmtState::kOperational || nmt_ == canopen::NmtState::kPreOperational) handle_sync(now_ns_, out);
-  } else if (c.kind == canopen::FrameKind::kSdoRx && c.node == cfg_.node) {
+    out_ = nullptr;
+    return;
+  }
+  // What classify() would say, without the full switch: an SDO request to
+  // this node is 0x600 + node; a heartbeat is 0x700 + node (node 1..127).
+  const std::uint32_t fc = f.id & 0x780u;
+  const auto from_node = static_cast<std::uint8_t>(f.id & 0x7Fu);
+  if (f.id == canopen::cob::sdo_rx(cfg_.node) && cfg_.node >= 1 && cfg_.node <= 127) {
     if (nmt_ != canopen::NmtState::kStopped && !f.remote()) {
       ++counters_.sdo_requests;
       sdo_.on_frame(f, now_ns_, out);
     }
-  } else if (c.kind == canopen::FrameKind::kHeartbeat) {
+  } else if (fc == 0x700u && from_node != 0 && f.id <= 0x7FFu) {
     for (std::uint8_t s = 1; s <= 4; ++s) {
-      const auto v = get(0x1016, s);
-      if ((v & 0xFFFF) != 0 && ((v >> 16) & 0xFF) == c.node) {
+      const auto v = val(hot_.consumer_hb[s - 1]);
+      if ((v & 0xFFFF) != 0 && ((v >> 16) & 0xFF) == from_node) {
         Consumer& k = consumers_[s - 1];
         k.armed = true;
         k.lost = false;
@@ -453,7 +521,7 @@ void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   now_ns_ = now_ns;
   if (!powered_) return;
   out_ = &out;
-  const auto hb_ms = static_cast<std::int64_t>(get(0x1017, 0));
+  const auto hb_ms = static_cast<std::int64_t>(val(hot_.producer_hb));
   if (hb_ms > 0 && now_ns >= next_heartbeat_ns_) {
     out.send(canopen::make_heartbeat_frame(cfg_.node, nmt_));
     ++counters_.heartbeats;
@@ -461,12 +529,12 @@ void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   }
   for (std::uint8_t s = 1; s <= 4; ++s) {
     Consumer& k = consumers_[s - 1];
-    const auto v = get(0x1016, s);
+    const auto v = val(hot_.consumer_hb[s - 1]);
     const auto ms = static_cast<std::int64_t>(v & 0xFFFF);
     if (!k.armed || k.lost || ms == 0) continue;
     if (now_ns - k.last_ns > ms * 1'000'000) {
       k.lost = true;
-      set(0x1001, 0, get(0x1001, 0) | canopen::kErrCommunication);
+      put(hot_.error_register, val(hot_.error_register) | canopen::kErrCommunication);
       switch (cfg_.heartbeat_loss_reaction) {
         case HeartbeatLossReaction::kFault: enter_fault(canopen::emcy_code::kHeartbeatError, out); break;
         case HeartbeatLossReaction::kQuickStop:
@@ -484,11 +552,10 @@ void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
 void Emulator::service(can::Transport& bus, std::int64_t now_ns) noexcept {
   canopen::TransportSink sink(bus);
   now_ns_ = now_ns;
-  std::array<can::TimedFrame, 64> buf;
   for (;;) {
-    const std::size_t n = bus.receive(buf);
-    for (std::size_t i = 0; i < n; ++i) on_frame(buf[i], sink);
-    if (n < buf.size()) break;
+    const std::size_t n = bus.receive(rx_buf_);
+    for (std::size_t i = 0; i < n; ++i) on_frame(rx_buf_[i], sink);
+    if (n < rx_buf_.size()) break;
   }
   step(now_ns, sink);
 }
@@ -537,7 +604,7 @@ void Emulator::enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept
 }
 
 void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept {
-  const auto qs = static_cast<std::int16_t>(get_signed(obj::kQuickStopOptionCode));
+  const auto qs = static_cast<std::int16_t>(sval(hot_.quick_stop_option));
   std::uint16_t prev = last_cw_;
   for (int i = 0; i < 2; ++i) {
     const cia402::StepResult r = cia402::apply_controlword(state_, prev, cw, qs);
@@ -553,12 +620,12 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
     }
     if (r.next == State::kOperationEnabled) {
       // Enabling never jumps: the delay line starts at the present target.
-      const Setpoint sp{static_cast<std::int32_t>(get_signed(obj::kTargetPosition)),
-                        static_cast<std::int32_t>(get_signed(obj::kTargetVelocity)),
-                        static_cast<std::int16_t>(get_signed(obj::kTargetTorque))};
+      const Setpoint sp{static_cast<std::int32_t>(sval(hot_.target_position)),
+                        static_cast<std::int32_t>(sval(hot_.target_velocity)),
+                        static_cast<std::int16_t>(sval(hot_.target_torque))};
       delay_.fill(sp);
       prev_demand_ = sp.position;
-      mode_display_ = static_cast<std::int8_t>(get_signed(obj::kModesOfOperation));
+      mode_display_ = static_cast<std::int8_t>(sval(hot_.modes));
     }
     state_ = r.next;
     prev = cw;
@@ -574,16 +641,16 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
 }
 
 void Emulator::advance_motor(double dt) noexcept {
-  const Setpoint now_sp{static_cast<std::int32_t>(get_signed(obj::kTargetPosition) + get_signed(obj::kPositionOffset)),
-                        static_cast<std::int32_t>(get_signed(obj::kTargetVelocity) + get_signed(obj::kVelocityOffset)),
-                        static_cast<std::int16_t>(get_signed(obj::kTargetTorque) + get_signed(obj::kTorqueOffset))};
+  const Setpoint now_sp{static_cast<std::int32_t>(sval(hot_.target_position) + sval(hot_.position_offset)),
+                        static_cast<std::int32_t>(sval(hot_.target_velocity) + sval(hot_.velocity_offset)),
+                        static_cast<std::int16_t>(sval(hot_.target_torque) + sval(hot_.torque_offset))};
   // Delay line: the setpoint used now is the one received lag_cycles SYNCs ago.
   const std::size_t len = cfg_.lag_cycles + 1;
   delay_[delay_head_] = now_sp;
   const Setpoint sp = delay_[(delay_head_ + len - cfg_.lag_cycles) % len];
   delay_head_ = (delay_head_ + 1) % len;
 
-  const double vmax = std::min(cfg_.max_velocity, static_cast<double>(get(obj::kMaxProfileVelocity)));
+  const double vmax = std::min(cfg_.max_velocity, static_cast<double>(val(hot_.max_profile_velocity)));
   double amax = cfg_.max_acceleration;
   double v_des = 0;
   const auto mode = static_cast<cia402::Mode>(mode_display_);
@@ -599,27 +666,27 @@ void Emulator::advance_motor(double dt) noexcept {
         const double v_ff = (demand - prev_demand_) / dt;
         v_des = v_ff + cfg_.position_gain * (prev_demand_ - pos_) / dt;
         prev_demand_ = demand;
-        set(obj::kPositionDemandValue, 0, static_cast<std::uint32_t>(sp.position));
+        put(hot_.position_demand, static_cast<std::uint32_t>(sp.position));
         break;
       }
       case cia402::Mode::kCsv: v_des = sp.velocity; break;
       case cia402::Mode::kCst: {
-        const double tmax = static_cast<double>(get(obj::kMaxTorque));
+        const double tmax = static_cast<double>(val(hot_.max_torque));
         torque = std::clamp(static_cast<double>(sp.torque), -tmax, tmax);
         v_des = vel_ + torque / 1000.0 * amax * dt;
         break;
       }
       case cia402::Mode::kHoming:
         if (homing_active_ && !homing_done_) {
-          const auto method = static_cast<std::int8_t>(get_signed(obj::kHomingMethod));
+          const auto method = static_cast<std::int8_t>(sval(hot_.homing_method));
           if (method == 35 || method == 37 || std::abs(pos_) < 1.0) {
-            pos_ = static_cast<double>(get_signed(obj::kHomeOffset));
+            pos_ = static_cast<double>(sval(hot_.home_offset));
             homing_done_ = true;
             homing_active_ = false;
             stop_immediately = true;
           } else {
             // Search the home switch at position 0 with the switch-search speed.
-            const double speed = static_cast<double>(get(obj::kHomingSpeeds, 1));
+            const double speed = static_cast<double>(val(hot_.homing_speed_switch));
             const double step = std::min(speed * dt, std::abs(pos_));
             v_des = (pos_ > 0 ? -step : step) / dt;
             amax = std::max(amax, std::abs(v_des - vel_) / dt);
@@ -629,7 +696,7 @@ void Emulator::advance_motor(double dt) noexcept {
       default: break;
     }
   } else if (state_ == State::kQuickStopActive) {
-    amax = static_cast<double>(get(obj::kQuickStopDeceleration));
+    amax = static_cast<double>(val(hot_.quick_stop_decel));
     v_des = 0;
   } else {
     stop_immediately = true;  // power stage off: the model stops (brake)
@@ -645,20 +712,20 @@ void Emulator::advance_motor(double dt) noexcept {
     pos_ += vel_ * dt;
   }
   const double trq = mode == cia402::Mode::kCst && state_ == State::kOperationEnabled ? torque : acc_ / cfg_.max_acceleration * 1000.0;
-  set(obj::kTorqueActualValue, 0, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(std::round(trq), -32768.0, 32767.0))));
-  if (state_ == State::kQuickStopActive && vel_ == 0.0 && !cia402::quick_stop_stays(static_cast<std::int16_t>(get_signed(obj::kQuickStopOptionCode)))) {
+  put(hot_.torque_actual, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(std::round(trq), -32768.0, 32767.0))));
+  if (state_ == State::kQuickStopActive && vel_ == 0.0 && !cia402::quick_stop_stays(static_cast<std::int16_t>(sval(hot_.quick_stop_option)))) {
     state_ = State::kSwitchOnDisabled;  // transition 12 (quick stop completed)
   }
 }
 
 void Emulator::update_outputs() noexcept {
   const std::int32_t p = position();
-  set(obj::kPositionActualValue, 0, static_cast<std::uint32_t>(p));
-  set(obj::kPositionActualInternalValue, 0, static_cast<std::uint32_t>(p));
-  set(obj::kVelocityActualValue, 0, static_cast<std::uint32_t>(static_cast<std::int32_t>(std::round(vel_))));
-  set(obj::kFollowingErrorActualValue, 0, static_cast<std::uint32_t>(static_cast<std::int32_t>(get_signed(obj::kTargetPosition) - p)));
-  set(obj::kModesOfOperationDisplay, 0, static_cast<std::uint8_t>(mode_display_));
-  set(obj::kStatusword, 0, statusword());
+  put(hot_.position_actual, static_cast<std::uint32_t>(p));
+  put(hot_.position_internal, static_cast<std::uint32_t>(p));
+  put(hot_.velocity_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(std::round(vel_))));
+  put(hot_.fe_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(sval(hot_.target_position) - p)));
+  put(hot_.mode_display, static_cast<std::uint8_t>(mode_display_));
+  put(hot_.statusword, statusword());
 }
 
 void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
@@ -673,10 +740,16 @@ void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
     f.id = m.cob_id;
     f.len = m.size_bytes;
     std::span<std::uint8_t> payload(f.data.data(), f.len);
+    const auto& cache = tpdo_entries_[p];
     for (std::uint8_t i = 0; i < m.count; ++i) {
-      const canopen::PdoEntry& e = m.entries[i];
-      const std::uint64_t v = (e.index == obj::kStatusword && e.sub == 0) ? statusword() : get(e.index, e.sub);
-      canopen::pack_bits(payload, e.bit_offset, e.bits, v);
+      const MappedEntry& me = cache[i];
+      const std::uint64_t v = me.is_statusword ? statusword() : val(me.entry);
+      if (me.aligned) {
+        canopen::store_le(f.data.data() + me.byte_offset, me.bytes, v);
+      } else {
+        const canopen::PdoEntry& e = m.entries[i];
+        canopen::pack_bits(payload, e.bit_offset, e.bits, v);
+      }
     }
     out.send(f);
     ++counters_.tpdos;
@@ -693,21 +766,27 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
       if (!rpdo_pending_[p]) continue;
       rpdo_pending_[p] = false;
       const canopen::PdoMap& m = rpdo_[p];
-      const auto payload = rpdo_latch_[p].payload();
+      const can::Frame& latch = rpdo_latch_[p];
+      const auto payload = latch.payload();
+      const auto& cache = rpdo_entries_[p];
       for (std::uint8_t i = 0; i < m.count; ++i) {
-        const canopen::PdoEntry& e = m.entries[i];
-        set(e.index, e.sub, canopen::unpack_bits(payload, e.bit_offset, e.bits));
-        if (e.index == obj::kControlword) cw_written = true;
+        const MappedEntry& me = cache[i];
+        // The latched frame is at least m.size_bytes long (checked in on_frame).
+        const std::uint64_t v = me.aligned ? canopen::load_le(latch.data.data() + me.byte_offset, me.bytes)
+                                           : canopen::unpack_bits(payload, m.entries[i].bit_offset, m.entries[i].bits);
+        put(me.entry, v);
+        if (me.is_controlword) cw_written = true;
       }
     }
-    if (cw_written) apply_controlword(static_cast<std::uint16_t>(get(obj::kControlword)), out);
-    if (state_ != State::kOperationEnabled) mode_display_ = static_cast<std::int8_t>(get_signed(obj::kModesOfOperation));
-    else if (static_cast<std::int8_t>(get_signed(obj::kModesOfOperation)) != mode_display_) {
+    if (cw_written) apply_controlword(static_cast<std::uint16_t>(val(hot_.controlword)), out);
+    const auto modes = static_cast<std::int8_t>(sval(hot_.modes));
+    if (state_ != State::kOperationEnabled) mode_display_ = modes;
+    else if (modes != mode_display_) {
       // Mode switch while enabled: the new mode starts from the present state.
-      mode_display_ = static_cast<std::int8_t>(get_signed(obj::kModesOfOperation));
+      mode_display_ = modes;
       prev_demand_ = pos_;
-      delay_.fill(Setpoint{position(), static_cast<std::int32_t>(get_signed(obj::kTargetVelocity)),
-                           static_cast<std::int16_t>(get_signed(obj::kTargetTorque))});
+      delay_.fill(Setpoint{position(), static_cast<std::int32_t>(sval(hot_.target_velocity)),
+                           static_cast<std::int16_t>(sval(hot_.target_torque))});
     }
   }
   if (cfg_.fail_after_syncs != 0 && counters_.syncs == cfg_.fail_after_syncs) pending_fault_ = cfg_.fail_emcy_code;
@@ -718,20 +797,20 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
     enter_fault(code, out);
   }
   // Motor: advances by the interpolation period 0x60C2, only here.
-  const cia402::InterpolationPeriod ip{static_cast<std::uint8_t>(get(obj::kInterpolationTimePeriod, 1)),
-                                        static_cast<std::int8_t>(get_signed(obj::kInterpolationTimePeriod, 2))};
+  const cia402::InterpolationPeriod ip{static_cast<std::uint8_t>(val(hot_.ip_value)),
+                                        static_cast<std::int8_t>(sval(hot_.ip_index))};
   std::int64_t period_ns = cia402::interpolation_period_ns(ip);
   if (period_ns <= 0) period_ns = 1'000'000;
   advance_motor(static_cast<double>(period_ns) / 1e9);
   // Following error monitoring (CSP, Operation enabled).
-  const auto window = static_cast<std::uint32_t>(get(obj::kFollowingErrorWindow));
+  const auto window = static_cast<std::uint32_t>(val(hot_.fe_window));
   if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kCsp) &&
       window != 0xFFFFFFFFu) {
-    const double fe = std::abs(static_cast<double>(get_signed(obj::kTargetPosition)) - pos_);
+    const double fe = std::abs(static_cast<double>(sval(hot_.target_position)) - pos_);
     if (fe > window) {
       following_error_ = true;
       ++following_error_cycles_;
-      const auto timeout_ms = static_cast<double>(get(obj::kFollowingErrorTimeOut));
+      const auto timeout_ms = static_cast<double>(val(hot_.fe_timeout));
       if (static_cast<double>(following_error_cycles_) * static_cast<double>(period_ns) / 1e6 >= timeout_ms) {
         enter_fault(canopen::emcy_code::kFollowingError, out);
       }

@@ -20,6 +20,7 @@
 /// Not used on the master's RT path; its member functions do not allocate
 /// after construction.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -77,6 +78,10 @@ struct EmulatorCounters {
 class Emulator final : public canopen::SdoServerBackend {
  public:
   explicit Emulator(const EmulatorConfig& cfg);
+  /// Not copyable or movable: the SDO server and the cached dictionary
+  /// pointers refer to this object.
+  Emulator(const Emulator&) = delete;
+  Emulator& operator=(const Emulator&) = delete;
 
   /// Power on (or reset node): dictionary to defaults, boot-up message,
   /// NMT pre-operational.
@@ -124,6 +129,56 @@ class Emulator final : public canopen::SdoServerBackend {
     std::uint64_t value;      // raw little-endian bits
     std::uint64_t default_value;
     const std::string* text;  // strings (0x1008...)
+    std::uint8_t size;        // data_type_size(type), cached
+    bool is_signed;           // data_type_signed(type), cached
+  };
+  /// Entries the SYNC / frame path touches, resolved once after the
+  /// dictionary is built (od_ never grows or reallocates afterwards, so the
+  /// pointers stay valid for the emulator's lifetime).
+  struct Hot {
+    Entry* error_register;      // 0x1001
+    Entry* sync_cob;            // 0x1005
+    Entry* emcy_cob;            // 0x1014
+    std::array<Entry*, 4> consumer_hb;  // 0x1016:1..4
+    Entry* producer_hb;         // 0x1017
+    Entry* error_code;          // 0x603F
+    Entry* controlword;         // 0x6040
+    Entry* statusword;          // 0x6041
+    Entry* quick_stop_option;   // 0x605A
+    Entry* modes;               // 0x6060
+    Entry* mode_display;        // 0x6061
+    Entry* position_demand;     // 0x6062
+    Entry* position_internal;   // 0x6063
+    Entry* position_actual;     // 0x6064
+    Entry* fe_window;           // 0x6065
+    Entry* fe_timeout;          // 0x6066
+    Entry* velocity_actual;     // 0x606C
+    Entry* target_torque;       // 0x6071
+    Entry* max_torque;          // 0x6072
+    Entry* torque_actual;       // 0x6077
+    Entry* target_position;     // 0x607A
+    Entry* home_offset;         // 0x607C
+    Entry* max_profile_velocity;  // 0x607F
+    Entry* quick_stop_decel;    // 0x6085
+    Entry* homing_method;       // 0x6098
+    Entry* homing_speed_switch; // 0x6099:1
+    Entry* position_offset;     // 0x60B0
+    Entry* velocity_offset;     // 0x60B1
+    Entry* torque_offset;       // 0x60B2
+    Entry* ip_value;            // 0x60C2:1
+    Entry* ip_index;            // 0x60C2:2
+    Entry* fe_actual;           // 0x60F4
+    Entry* target_velocity;     // 0x60FF
+  };
+  /// Per mapped PDO entry: the dictionary entry (nullptr if absent) and
+  /// whether it is byte-aligned (all CiA 402 objects are).
+  struct MappedEntry {
+    Entry* entry = nullptr;
+    std::uint8_t byte_offset = 0;
+    std::uint8_t bytes = 0;
+    bool aligned = false;
+    bool is_statusword = false;
+    bool is_controlword = false;
   };
   static constexpr std::uint32_t key(std::uint16_t index, std::uint8_t sub) noexcept {
     return (static_cast<std::uint32_t>(index) << 8) | sub;
@@ -131,6 +186,10 @@ class Emulator final : public canopen::SdoServerBackend {
   void build_dictionary();
   void add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, const std::string* text = nullptr);
   Entry* find(std::uint16_t index, std::uint8_t sub) noexcept;
+  void resolve_hot() noexcept;  // after build_dictionary(): fills hot_
+  static std::uint64_t val(const Entry* e) noexcept { return e ? e->value : 0; }
+  static std::int64_t sval(const Entry* e) noexcept;
+  static void put(Entry* e, std::uint64_t v) noexcept;
   const Entry* find(std::uint16_t index, std::uint8_t sub) const noexcept;
   bool index_exists(std::uint16_t index) const noexcept;
   std::uint64_t get(std::uint16_t index, std::uint8_t sub = 0) const noexcept;
@@ -173,6 +232,12 @@ class Emulator final : public canopen::SdoServerBackend {
   std::array<can::Frame, 4> rpdo_latch_{};
   std::array<bool, 4> rpdo_pending_{};
   std::array<std::uint32_t, 4> tpdo_sync_count_{};
+  std::array<std::array<MappedEntry, canopen::kMaxPdoEntries>, 4> rpdo_entries_{};
+  std::array<std::array<MappedEntry, canopen::kMaxPdoEntries>, 4> tpdo_entries_{};
+  Hot hot_{};
+  // service()'s receive buffer (a member so that it is not re-initialised
+  // on every call; 64 frames per receive() call, more are drained in a loop).
+  std::array<can::TimedFrame, 64> rx_buf_{};
 
   // CiA 402.
   cia402::State state_ = cia402::State::kNotReadyToSwitchOn;
