@@ -7,65 +7,16 @@
 #include "rt/controller/controller.hpp"
 #include "rt/controller/sim_world.hpp"
 #include "tests/support/allocation_counter.hpp"
+#include "tests/support/sim_controller.hpp"
 
 namespace canmotion::rt {
 namespace {
 
 using motion::Instr;
 
-constexpr std::int64_t kPeriod = 1'000'000;
+constexpr std::int64_t kPeriod = test::SimController::kPeriod;
 
-struct Rig {
-  SimWorld world;
-  std::unique_ptr<Controller> ctl;
-  std::int64_t now = 0;
-
-  Rig() {
-    ControllerSpec spec;
-    spec.period_ns = kPeriod;
-    BusSpec bus;
-    bus.name = "sim0";
-    bus.transport = &world.add_bus("sim0");
-    spec.buses.push_back(bus);
-    AxisSpec master;
-    master.name = "Master";
-    master.config.type = motion::AxisType::Virtual;
-    spec.axes.push_back(master);
-    AxisSpec x;
-    x.name = "X";
-    x.config.type = motion::AxisType::CipDrive;
-    x.config.conversion_constant = 1000;  // counts per mm
-    x.config.max_speed = 200;
-    x.config.max_accel = 2000;
-    x.config.max_decel = 2000;
-    x.config.position_error_tolerance = 5;
-    x.bus = 0;
-    x.drive.node = 2;
-    spec.axes.push_back(x);
-    emulator::EmulatorConfig ec;
-    ec.node = 2;
-    world.add_drive(0, ec);
-    ctl = std::make_unique<Controller>(spec);
-    world.power_on(0);
-  }
-  void step() {
-    world.begin_cycle(now);
-    ctl->cycle(now);
-    world.end_cycle(now);
-    now += kPeriod;
-  }
-  Status status() {
-    Status s;
-    ctl->read_status(s);
-    return s;
-  }
-  bool run_until(const std::function<bool(const Status&)>& done, int max_cycles) {
-    for (int i = 0; i < max_cycles; ++i) {
-      step();
-      if (done(status())) return true;
-    }
-    return false;
-  }
+struct Rig : test::SimController {
   motion::ControlId submit(Instr instr, const std::string& control, std::vector<motion::Operand> ops) {
     Command c;
     c.request.instr = instr;

@@ -3,47 +3,13 @@
 #include <gtest/gtest.h>
 
 #include "rt/controller/host.hpp"
-#include "rt/controller/sim_world.hpp"
+#include "tests/support/sim_controller.hpp"
 
 namespace canmotion::rt {
 namespace {
 
-struct HostRig {
-  SimWorld world;
-  std::unique_ptr<Controller> ctl;
-  std::unique_ptr<ControllerHost> host;
-  std::int64_t now = 0;
-  HostRig() {
-    ControllerSpec spec;
-    BusSpec bus;
-    bus.name = "can0";
-    bus.transport = &world.add_bus("can0");
-    spec.buses.push_back(bus);
-    AxisSpec v;
-    v.name = "Master";
-    spec.axes.push_back(v);
-    AxisSpec x;
-    x.name = "X";
-    x.config.type = motion::AxisType::CipDrive;
-    x.config.conversion_constant = 1000;
-    x.bus = 0;
-    x.drive.node = 5;
-    spec.axes.push_back(x);
-    emulator::EmulatorConfig ec;
-    ec.node = 5;
-    world.add_drive(0, ec);
-    ctl = std::make_unique<Controller>(spec);
-    host = std::make_unique<ControllerHost>(*ctl);
-    world.power_on(0);
-  }
-  void cycles(int n) {
-    for (int i = 0; i < n; ++i) {
-      world.begin_cycle(now);
-      ctl->cycle(now);
-      world.end_cycle(now);
-      now += 1'000'000;
-    }
-  }
+struct HostRig : test::SimController {
+  std::unique_ptr<ControllerHost> host = std::make_unique<ControllerHost>(*ctl);
   double read(const std::string& tag) {
     std::string e;
     auto v = host->read(tag, &e);

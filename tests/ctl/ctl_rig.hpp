@@ -24,10 +24,11 @@
 #include "rt/controller/command_server.hpp"
 #include "rt/controller/controller.hpp"
 #include "rt/controller/sim_world.hpp"
+#include "tests/support/sim_controller.hpp"
 
 namespace canmotion::rt::ctltest {
 
-constexpr std::int64_t kPeriod = 1'000'000;
+constexpr std::int64_t kPeriod = test::SimController::kPeriod;
 
 /// A temporary directory, removed with everything in it.
 struct TempDir {
@@ -108,67 +109,22 @@ inline bool is_final(const std::string& l) {
   return l == "OK" || l.rfind("OK ", 0) == 0 || l == "ERR" || l.rfind("ERR ", 0) == 0;
 }
 
-struct Rig {
+/// The standard test controller plus a CommandServer on a temporary socket,
+/// polled after every cycle at the new controller time.
+struct Rig : test::SimController {
   TempDir dir;
   std::string sock = dir.path + "/canmotiond.sock";
-  SimWorld world;
-  std::unique_ptr<Controller> ctl;
   std::unique_ptr<CommandServer> server;
-  std::int64_t now = 0;
   std::vector<std::string> log;
 
   explicit Rig(std::function<void(CommandServerOptions&)> tweak = {}) {
-    ControllerSpec spec;
-    spec.period_ns = kPeriod;
-    BusSpec bus;
-    bus.name = "sim0";
-    bus.transport = &world.add_bus("sim0");
-    spec.buses.push_back(bus);
-    AxisSpec master;
-    master.name = "Master";
-    master.config.type = motion::AxisType::Virtual;
-    master.config.max_speed = 500;
-    master.config.max_accel = 5000;
-    master.config.max_decel = 5000;
-    spec.axes.push_back(master);
-    AxisSpec x;
-    x.name = "X";
-    x.config.type = motion::AxisType::CipDrive;
-    x.config.conversion_constant = 1000;
-    x.config.max_speed = 200;
-    x.config.max_accel = 2000;
-    x.config.max_decel = 2000;
-    x.config.position_error_tolerance = 5;
-    x.bus = 0;
-    x.drive.node = 2;
-    spec.axes.push_back(x);
-    emulator::EmulatorConfig ec;
-    ec.node = 2;
-    world.add_drive(0, ec);
-    ctl = std::make_unique<Controller>(spec);
-    world.power_on(0);
     CommandServerOptions o;
     o.path = sock;
     o.log = [this](const std::string& l) { log.push_back(l); };
     if (tweak) tweak(o);
     server = std::make_unique<CommandServer>(*ctl, o);
   }
-
-  [[nodiscard]] double now_s() const { return static_cast<double>(now) * 1e-9; }
-
-  /// One cycle, then the server's housekeeping at the new controller time.
-  void step() {
-    world.begin_cycle(now);
-    ctl->cycle(now);
-    world.end_cycle(now);
-    now += kPeriod;
-    server->poll(now_s());
-  }
-  Status status() {
-    Status s;
-    ctl->read_status(s);
-    return s;
-  }
+  void after_cycle() override { server->poll(now_s()); }
   bool run_until(const std::function<bool()>& done, int max_cycles) {
     for (int i = 0; i < max_cycles; ++i) {
       if (done()) return true;
