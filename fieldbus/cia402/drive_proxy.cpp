@@ -13,6 +13,17 @@ namespace canmotion::cia402 {
 
 namespace {
 
+/// Write `v` into entry `entry` of `m` in `f` (payload length m.size_bytes). Realtime-safe.
+inline void put_entry(can::Frame& f, const canopen::PdoMap& m, std::int8_t entry, std::uint64_t v) noexcept {
+  const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(entry)];
+  // Byte-aligned entries inside the payload (all CiA 402 objects): direct store.
+  if (((e.bit_offset | e.bits) % 8) == 0 && e.bit_offset / 8u + e.bits / 8u <= f.len) {
+    canopen::store_le(f.data.data() + e.bit_offset / 8, e.bits / 8u, v);
+  } else {
+    canopen::pack_bits(std::span<std::uint8_t>(f.data.data(), f.len), e.bit_offset, e.bits, v);
+  }
+}
+
 void put_u32(SdoWrite& w, std::uint16_t index, std::uint8_t sub, std::uint8_t size, std::uint32_t value) {
   w = SdoWrite{index, sub, size, value};
 }
@@ -463,31 +474,17 @@ void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
 }
 
 void DriveProxy::send_rpdos(canopen::FrameSink& out) noexcept {
-  struct Item {
-    const Slot* slot;
-    std::uint64_t value;
-  };
-  const std::array<Item, 5> items{{{&cw_slot_, cw_},
-                                   {&tpos_slot_, static_cast<std::uint32_t>(target_position_)},
-                                   {&tvel_slot_, static_cast<std::uint32_t>(target_velocity_)},
-                                   {&ttrq_slot_, static_cast<std::uint16_t>(target_torque_)},
-                                   {&mode_slot_, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_))}}};
   for (std::uint8_t p = 0; p < pdos_.rpdo_count; ++p) {
     const canopen::PdoMap& m = pdos_.rpdo[p];
     can::Frame f;
     f.id = m.cob_id & 0x7FFu;
     f.len = m.size_bytes;
-    std::span<std::uint8_t> payload(f.data.data(), f.len);
-    for (const Item& it : items) {
-      if (it.slot->pdo != p) continue;
-      const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(it.slot->entry)];
-      // Byte-aligned entries inside the payload (all CiA 402 objects): direct store.
-      if (((e.bit_offset | e.bits) % 8) == 0 && e.bit_offset / 8u + e.bits / 8u <= f.len) {
-        canopen::store_le(f.data.data() + e.bit_offset / 8, e.bits / 8u, it.value);
-      } else {
-        canopen::pack_bits(payload, e.bit_offset, e.bits, it.value);
-      }
-    }
+    const auto pi = static_cast<std::int8_t>(p);
+    if (cw_slot_.pdo == pi) put_entry(f, m, cw_slot_.entry, cw_);
+    if (tpos_slot_.pdo == pi) put_entry(f, m, tpos_slot_.entry, static_cast<std::uint32_t>(target_position_));
+    if (tvel_slot_.pdo == pi) put_entry(f, m, tvel_slot_.entry, static_cast<std::uint32_t>(target_velocity_));
+    if (ttrq_slot_.pdo == pi) put_entry(f, m, ttrq_slot_.entry, static_cast<std::uint16_t>(target_torque_));
+    if (mode_slot_.pdo == pi) put_entry(f, m, mode_slot_.entry, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_)));
     out.send(f);
   }
 }

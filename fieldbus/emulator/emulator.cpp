@@ -308,6 +308,9 @@ void Emulator::rebuild_pdos() noexcept {
       }
     }
   }
+  rpdo_active_count_ = 0;
+  for (std::uint8_t p = 0; p < 4; ++p)
+    if (rpdo_valid_[p]) rpdo_active_[rpdo_active_count_++] = p;
 }
 
 SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::uint64_t v) const noexcept {
@@ -502,8 +505,9 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
       }
     }
   } else if (nmt_ == canopen::NmtState::kOperational && !f.remote()) {
-    for (std::size_t p = 0; p < 4; ++p) {
-      if (!rpdo_valid_[p] || f.id != rpdo_[p].cob_id) continue;
+    for (std::uint8_t k = 0; k < rpdo_active_count_; ++k) {
+      const std::size_t p = rpdo_active_[k];
+      if (f.id != rpdo_[p].cob_id) continue;
       if (f.len < rpdo_[p].size_bytes) {
         ++counters_.rpdo_length_errors;
         send_emcy(canopen::emcy_code::kPdoLength, out);

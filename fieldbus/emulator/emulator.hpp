@@ -227,6 +227,8 @@ class Emulator final : public canopen::SdoServerBackend {
   // PDOs as currently mapped (rebuilt when the mapping becomes valid).
   std::array<canopen::PdoMap, 4> rpdo_{};
   std::array<bool, 4> rpdo_valid_{};
+  std::array<std::uint8_t, 4> rpdo_active_{};  // numbers - 1 of the valid RPDOs, ascending
+  std::uint8_t rpdo_active_count_ = 0;
   std::array<canopen::PdoMap, 4> tpdo_{};
   std::array<bool, 4> tpdo_valid_{};
   std::array<can::Frame, 4> rpdo_latch_{};
