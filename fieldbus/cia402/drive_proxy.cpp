@@ -510,9 +510,13 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   got_tpdo_ = false;
   // Results of run-time SDO writes (mode switches without RPDO2). Other
   // results stay for whoever queued them (the application's own transfers).
-  canopen::SdoResult r;
-  while (master_.sdo(cfg_.node).poll_tag(kModeWriteTag, r)) {
-    if (r.ok() && mdisp_slot_.pdo < 0) fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);
+  // Only set_mode() queues kModeWriteTag writes, and only when 0x6060 is not
+  // in an RPDO: otherwise skip the poll (and the ~300-byte SdoResult).
+  if (mode_slot_.pdo < 0) {
+    canopen::SdoResult r;
+    while (master_.sdo(cfg_.node).poll_tag(kModeWriteTag, r)) {
+      if (r.ok() && mdisp_slot_.pdo < 0) fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);
+    }
   }
   if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
   step_state_machine(now_ns);
