@@ -20,6 +20,19 @@ bool is_rpdo_map(std::uint16_t i) { return i >= 0x1600 && i <= 0x1603; }
 bool is_tpdo_comm(std::uint16_t i) { return i >= 0x1800 && i <= 0x1803; }
 bool is_tpdo_map(std::uint16_t i) { return i >= 0x1A00 && i <= 0x1A03; }
 
+// std::round (half away from zero) without the libm call; every caller
+// converts the result to an integer, so the sign of a zero result does not
+// matter. x - trunc(x) is exact, so halves are detected exactly.
+inline double round_half_away(double x) noexcept {
+  constexpr double kAllIntegral = 4503599627370496.0;  // 2^52: from here on every double is an integer
+  if (!(std::abs(x) < kAllIntegral)) return x;           // also NaN and infinities, as std::round
+  const double t = static_cast<double>(static_cast<std::int64_t>(x));  // trunc
+  const double d = x - t;
+  if (d >= 0.5) return t + 1.0;
+  if (d <= -0.5) return t - 1.0;
+  return t;
+}
+
 std::uint8_t error_register_for(std::uint16_t code) {
   std::uint8_t r = canopen::kErrGeneric;
   switch (code >> 12) {
@@ -592,7 +605,7 @@ std::uint16_t Emulator::statusword() const noexcept {
 }
 
 std::int32_t Emulator::position() const noexcept {
-  const double p = std::round(pos_);
+  const double p = round_half_away(pos_);
   return static_cast<std::int32_t>(std::clamp(p, -2147483648.0, 2147483647.0));
 }
 
@@ -716,7 +729,7 @@ void Emulator::advance_motor(double dt) noexcept {
     pos_ += vel_ * dt;
   }
   const double trq = mode == cia402::Mode::kCst && state_ == State::kOperationEnabled ? torque : acc_ / cfg_.max_acceleration * 1000.0;
-  put(hot_.torque_actual, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(std::round(trq), -32768.0, 32767.0))));
+  put(hot_.torque_actual, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(round_half_away(trq), -32768.0, 32767.0))));
   if (state_ == State::kQuickStopActive && vel_ == 0.0 && !cia402::quick_stop_stays(static_cast<std::int16_t>(sval(hot_.quick_stop_option)))) {
     state_ = State::kSwitchOnDisabled;  // transition 12 (quick stop completed)
   }
@@ -726,7 +739,7 @@ void Emulator::update_outputs() noexcept {
   const std::int32_t p = position();
   put(hot_.position_actual, static_cast<std::uint32_t>(p));
   put(hot_.position_internal, static_cast<std::uint32_t>(p));
-  put(hot_.velocity_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(std::round(vel_))));
+  put(hot_.velocity_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(round_half_away(vel_))));
   put(hot_.fe_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(sval(hot_.target_position) - p)));
   put(hot_.mode_display, static_cast<std::uint8_t>(mode_display_));
   put(hot_.statusword, statusword());
