@@ -94,7 +94,21 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
     }
     spec.axes.push_back(as);
   }
-  rt.controller = std::make_unique<rt::Controller>(std::move(spec));
+  for (const CamSettings& c : cfg.cams) {
+    rt::CamSpec cs;
+    cs.name = c.name;
+    cs.start_slope = c.start_slope;
+    cs.end_slope = c.end_slope;
+    for (const CamPoint& p : c.points)
+      cs.points.push_back({p.master, p.slave, p.cubic ? motion::cam::kSegmentCubic : motion::cam::kSegmentLinear});
+    spec.cams.push_back(std::move(cs));
+  }
+  try {
+    rt.controller = std::make_unique<rt::Controller>(std::move(spec));
+  } catch (const std::invalid_argument& e) {
+    // e.g. a cam whose MCCP fails: name the file (the message names the cam).
+    throw std::runtime_error(fmt::format("{}: {}", cfg.path, e.what()));
+  }
   return rt;
 }
 

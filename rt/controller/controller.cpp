@@ -58,6 +58,25 @@ Controller::Controller(ControllerSpec spec)
     buses_[b].network = std::make_unique<cia402::DriveNetwork>(spec_.buses[b].network);
     buses_[b].sink = std::make_unique<RecordingSink>(*this, static_cast<std::uint8_t>(b));
   }
+  if (spec_.cams.size() > motion::kMaxCamProfiles)
+    throw std::invalid_argument("at most " + std::to_string(motion::kMaxCamProfiles) + " cam profiles, got " +
+                                std::to_string(spec_.cams.size()));
+  for (std::size_t c = 0; c < spec_.cams.size(); ++c) {
+    const CamSpec& cs = spec_.cams[c];
+    if (cs.points.empty()) throw std::invalid_argument("cam '" + cs.name + "' has no points");
+    auto prof = std::make_unique<motion::cam::CamProfile>(cs.points.size());
+    motion::cam::MccpRequest req;
+    req.cam = cs.points;
+    req.length = static_cast<std::int64_t>(cs.points.size());
+    req.start_slope = cs.start_slope;
+    req.end_slope = cs.end_slope;
+    const motion::cam::MccpResult res = motion::cam::mccp(req, *prof);
+    if (res.err != motion::cam::CamError::None)
+      throw std::invalid_argument("cam '" + cs.name + "': " + motion::cam::describe(res));
+    if (!planner_.attach_cam_profile(static_cast<std::uint16_t>(c), prof.get()))
+      throw std::invalid_argument("cam '" + cs.name + "': the planner refused the profile");
+    cams_.push_back(std::move(prof));
+  }
   axes_.resize(spec_.axes.size());
   for (std::size_t a = 0; a < spec_.axes.size(); ++a) {
     AxisSpec& s = spec_.axes[a];
@@ -97,6 +116,13 @@ std::optional<motion::ControlId> Controller::control_id(std::string_view name_in
   control_names_.emplace(name, id);
   controls_in_use_.store(control_names_.size(), std::memory_order_release);
   return id;
+}
+
+std::optional<std::uint16_t> Controller::cam_id(std::string_view name) const {
+  const std::string want = lower_name(name);
+  for (std::size_t c = 0; c < spec_.cams.size(); ++c)
+    if (lower_name(spec_.cams[c].name) == want) return static_cast<std::uint16_t>(c);
+  return std::nullopt;
 }
 
 std::optional<motion::ControlId> Controller::find_control(std::string_view name_in) const {
@@ -348,6 +374,7 @@ void Controller::publish(std::int64_t now_ns) noexcept {
   s.telemetry_dropped = telemetry_dropped_;
   s.commands_deferred = deferred_;
   s.halted = halt_ == Halt::kHalted;
+  for (std::size_t c = 0; c < cams_.size(); ++c) s.cam_status[c] = cams_[c]->status();
   snapshot_->commit();
 }
 

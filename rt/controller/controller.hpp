@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "fieldbus/can/transport.hpp"
+#include "motion/cam/cam_profile.hpp"
 #include "fieldbus/cia402/drive_proxy.hpp"
 #include "motion/planner.hpp"
 #include "rt/snapshot.hpp"
@@ -65,11 +66,21 @@ struct AxisSpec {
   cia402::DriveConfig drive{};
 };
 
-/// Everything a Controller is built from (config::build_spec makes it from a file).
+/// A cam profile declared in the configuration: computed (MCCP) when the
+/// Controller is built, and named in instructions as `name` or `name[0]`.
+struct CamSpec {
+  std::string name;
+  std::vector<motion::cam::CamPoint> points;
+  double start_slope = 0.0;
+  double end_slope = 0.0;
+};
+
+/// Everything a Controller is built from (config::build_runtime makes it from a file).
 struct ControllerSpec {
   std::int64_t period_ns = 1'000'000;
   std::vector<BusSpec> buses;
   std::vector<AxisSpec> axes;
+  std::vector<CamSpec> cams;
 };
 
 /// A command to the RT thread. Trivially copyable (lives in an SPSC ring).
@@ -159,6 +170,9 @@ struct Status {
   std::uint64_t telemetry_dropped = 0;
   std::uint64_t commands_deferred = 0;  ///< cycles in which requests had to wait for the next cycle
   bool halted = false;  ///< after kPreOperational: nodes pre-operational, no PDO or SYNC sent any more
+  /// CAM_PROFILE[0].Status of each cam profile (0 not calculated, 1 calculating,
+  /// 2 calculated, n = in use by n - 2 cams).
+  std::array<std::int32_t, motion::kMaxCamProfiles> cam_status{};
 };
 
 class Controller {
@@ -208,6 +222,9 @@ class Controller {
   std::optional<motion::ControlId> control_id(std::string_view name);
   [[nodiscard]] std::optional<motion::ControlId> find_control(std::string_view name) const;
   [[nodiscard]] std::vector<std::pair<std::string, motion::ControlId>> controls() const;
+  /// Cam profile id of `name` (case-insensitive), or nullopt.
+  [[nodiscard]] std::optional<std::uint16_t> cam_id(std::string_view name) const;
+  [[nodiscard]] std::size_t cam_count() const noexcept { return cams_.size(); }
   [[nodiscard]] double period_s() const noexcept { return static_cast<double>(spec_.period_ns) * 1e-9; }
   [[nodiscard]] std::uint64_t cycles() const noexcept { return cycle_.load(std::memory_order_acquire); }
 
@@ -245,6 +262,7 @@ class Controller {
   motion::Planner planner_;
   std::vector<BusRt> buses_;
   std::vector<AxisRt> axes_;
+  std::vector<std::unique_ptr<motion::cam::CamProfile>> cams_;  ///< attached to the planner, same ids
   std::array<motion::AxisFeedback, motion::kMaxAxes> fb_{};
   std::array<motion::AxisOutput, motion::kMaxAxes> out_{};
   std::array<motion::Request, kMaxRequestsPerCycle> requests_{};

@@ -21,6 +21,8 @@ std::optional<std::string> ControllerHost::bind(std::string_view call, motion::R
     if (control_tag) *control_tag = pc.operands[i].text;
   }
   for (const auto& [name, value] : tags_.user_tags()) sym.numeric_tags.emplace(name, value);
+  for (const auto& cam : c_.spec().cams)
+    sym.cam_profiles.emplace(cam.name, *c_.cam_id(cam.name));
   return motion::bind_call(pc, sym, out);
 }
 

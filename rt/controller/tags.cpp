@@ -144,6 +144,15 @@ std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* erro
     if (error) *error = fmt::format("Controller has no member '{}'; members: {}", member, fmt::join(names, ", "));
     return std::nullopt;
   }
+  if (const std::size_t br = base.find('['); br != std::string_view::npos) {
+    const auto cam = c_.cam_id(base.substr(0, br));
+    if (cam && base.substr(br) == "[0]" && iequals(member, "Status"))
+      return TagRef{TagRef::Kind::kCamStatus, *cam, 0, false};
+    if (error)
+      *error = cam ? fmt::format("a CAM_PROFILE tag has one member, {}[0].Status", base.substr(0, br))
+                   : fmt::format("no cam profile named '{}'", base.substr(0, br));
+    return std::nullopt;
+  }
   for (std::size_t a = 0; a < c_.axis_count(); ++a) {
     if (!iequals(c_.axis_name(static_cast<motion::AxisId>(a)), base)) continue;
     const auto id = static_cast<std::uint16_t>(a);
@@ -181,6 +190,7 @@ std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* erro
 double TagTable::read(const Status& s, const TagRef& t) const {
   switch (t.kind) {
     case TagRef::Kind::kUser: return 0.0;  // read through the name (see read(s, name))
+    case TagRef::Kind::kCamStatus: return s.cam_status[t.index];
     case TagRef::Kind::kController: return stats_.at(t.index).second();
     case TagRef::Kind::kControlFlag: return s.controls[t.index].get(t.member) ? 1.0 : 0.0;
     case TagRef::Kind::kControl: {

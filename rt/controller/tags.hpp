@@ -10,6 +10,7 @@
 ///                                          e.g. X.GearingLockStatus)
 ///   X.DriveState  X.Statusword  X.Controlword  X.LastEmcy  X.TpdoMissed  (CIP drive axes)
 ///   mag1.EN .DN .ER .PC .IP .AC .ACCEL .DECEL .ERR .EXERR .STATE .SEGMENT .STATUS
+///   cam1[0].Status    (CAM_PROFILE status: 0 not calculated, 2 calculated, n in use by n-2 cams)
 ///   Controller.Cycle  Controller.Time  and the statistics the owner registers
 ///   user numeric tags (created by `tag := value;`)
 ///
@@ -30,7 +31,7 @@ namespace canmotion::rt {
 
 /// A resolved tag.
 struct TagRef {
-  enum class Kind : std::uint8_t { kAxis, kMotionBit, kAxisStatusBit, kAxisFaultBit, kControl, kControlFlag, kController, kUser };
+  enum class Kind : std::uint8_t { kAxis, kMotionBit, kAxisStatusBit, kAxisFaultBit, kControl, kControlFlag, kController, kUser, kCamStatus };
   Kind kind = Kind::kAxis;
   std::uint16_t index = 0;  ///< axis id, control id, or statistic/user slot
   std::uint8_t member = 0;  ///< attribute number, bit number or member number
