@@ -2,7 +2,8 @@
 /// \file
 /// The standard in-process test controller: a virtual axis "Master" and a CIP
 /// drive axis "X" (node 2, 1000 counts per unit) with an emulated CiA 402 drive
-/// on one SimBus "sim0", stepped cycle by cycle on virtual time. Shared by the
+/// on one SimBus "sim0", and a cam profile "cam1" (a 1 s, 10-unit cubic
+/// rise and return), stepped cycle by cycle on virtual time. Shared by the
 /// controller, host and command-server tests. Header-only; link canmotion::rt.
 
 #include <cstdint>
@@ -47,6 +48,10 @@ struct SimController {
     x.bus = 0;
     x.drive.node = kNode;
     spec.axes.push_back(x);
+    rt::CamSpec cam;
+    cam.name = "cam1";
+    cam.points = {{0.0, 0.0, 1}, {0.5, 10.0, 1}, {1.0, 0.0, 0}};
+    spec.cams.push_back(cam);
     emulator::EmulatorConfig ec;
     ec.node = kNode;
     world.add_drive(0, ec);
