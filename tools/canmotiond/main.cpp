@@ -271,6 +271,15 @@ int run(const Options& o) {
   }
   rt::Controller& ctl = *rt.controller;
   rt::ControllerHost host(ctl);
+  // The cycle statistics as tags (Controller.latency_max_ns, ...), registered
+  // before the script is checked; they read the executive once it exists.
+  rt::CyclicExecutive* exec_for_tags = nullptr;
+  for (std::string_view name : rt::stat_tag_names())
+    host.tags().add_statistic(std::string(name), [&exec_for_tags, name] {
+      return exec_for_tags == nullptr
+                 ? 0.0
+                 : static_cast<double>(rt::stat_tag_value(exec_for_tags->statistics().snapshot(), name).value_or(0));
+    });
   const bool sim = o.sim;  // virtual time only with --sim; `interface: sim` alone runs in real time
 
   // 3. Script, checked against the controller before anything runs.
@@ -313,6 +322,7 @@ int run(const Options& o) {
   rt::MonotonicClock mclock;
   rt::Clock& clock = sim ? static_cast<rt::Clock&>(vclock) : static_cast<rt::Clock&>(mclock);
   rt::CyclicExecutive exec(ec, clock);
+  exec_for_tags = &exec;
 
   // canmotionctl's socket (rt/controller/command_server.hpp), served from housekeeping.
   std::unique_ptr<rt::CommandServer> server;

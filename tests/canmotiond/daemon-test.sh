@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# canmotiond as a user runs it (--sim): statistics tags in scripts, and the
+# exit status contract: 0 ok, 1 script failure, 2 bad configuration or script.
+# Usage: daemon-test.sh CANMOTIOND EXAMPLES_DIR WORKDIR
+set -uo pipefail
+bin="$1" ex="$2" work="$3"
+mkdir -p "$work"
+fail() { echo "daemon-test: FAIL: $*" >&2; exit 1; }
+
+# 1. Statistics and controller tags in a script; exit 0.
+printf 'WAIT 0.5;\nPRINT Controller.cycles, Controller.overruns, Controller.Time;\n' > "$work/stats.script"
+out=$("$bin" --config "$ex/demo.yaml" --sim --script "$work/stats.script" -q 2>&1); rc=$?
+[[ $rc == 0 ]] || fail "stats script exit $rc: $out"
+# The script starts after the first cycle (t=0.001); the executive counts completed cycles.
+grep -q '^t=0.501 Controller.cycles=500 Controller.overruns=0 Controller.Time=0.501$' <<<"$out" || fail "stats line: $out"
+
+# 2. A WAIT UNTIL that times out fails the script: exit 1, with the reason.
+printf 'WAIT UNTIL Master.CommandPosition > 1 TIMEOUT 0.2;\n' > "$work/timeout.script"
+out=$("$bin" --config "$ex/demo.yaml" --sim --script "$work/timeout.script" -q 2>&1); rc=$?
+[[ $rc == 1 ]] || fail "timeout script exit $rc, want 1: $out"
+grep -q 'timeout.script:1: WAIT UNTIL Master.CommandPosition > 1 timed out after 0.2 s (Master.CommandPosition = 0)' <<<"$out" ||
+  fail "timeout message: $out"
+
+# 3. A bad configuration: exit 2, file:line:column and key named, nothing run.
+sed 's/max_speed: 500/max_sped: 500/' "$ex/demo.yaml" > "$work/bad.yaml"
+out=$("$bin" --config "$work/bad.yaml" --sim --duration 1 --trace "$work/bad-trace.log" 2>&1); rc=$?
+[[ $rc == 2 ]] || fail "bad config exit $rc, want 2: $out"
+grep -qE "bad.yaml:[0-9]+:[0-9]+: error: axes\[0\]\.max_sped: unknown key 'max_sped'; did you mean 'max_speed'\?" <<<"$out" ||
+  fail "bad config message: $out"
+grep -q "nothing was sent on any bus" <<<"$out" || fail "bad config: no 'nothing was sent' line: $out"
+[[ ! -e "$work/bad-trace.log" ]] || fail "a trace was written for a bad configuration"
+
+# 4. A bad script: exit 2 before anything runs.
+printf 'MSO(Nobody, mso1);\n' > "$work/bad.script"
+out=$("$bin" --config "$ex/demo.yaml" --sim --script "$work/bad.script" -q 2>&1); rc=$?
+[[ $rc == 2 ]] || fail "bad script exit $rc, want 2: $out"
+grep -q 'bad.script:1:1:' <<<"$out" || fail "bad script message: $out"
+
+# 5. --help works and names the options.
+"$bin" --help | grep -q -- '--script' || fail "--help"
+echo "daemon-test: statistics tags, exit statuses 0/1/2 and messages as documented"
