@@ -581,16 +581,10 @@ Err Planner::start_masd(const Request& r, AxisRt& a) noexcept {
 }
 
 Err Planner::start_masr(const Request& r, AxisRt& a) noexcept {
-  if (!a.cfg.configured) return Err::AxisNotConfigured;
-  if (a.cfg.inhibited) return Err::AxisIsInhibited;
-  a.shutdown = false;
-  a.faulted = false;
-  a.tag.exception_faults = 0;
-  a.tag.motion_fault_status = 0;
-  a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
-  a.reset_grace = a.fault_reset_pulse ? reset_grace_cycles() : 0;
-  controls_[r.control].set(flag::DN, true);
-  return Err::None;
+  // MASR = MAFR (clear the faults, pulse a drive fault reset) + leave Shutdown.
+  const Err e = start_mafr(r, a);
+  if (e == Err::None) a.shutdown = false;
+  return e;
 }
 
 Err Planner::start_mafr(const Request& r, AxisRt& a) noexcept {

@@ -168,16 +168,20 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
     put(out, " = ");
     put_value(out, d.sdo_index, d.sdo_sub, d.value, d.sdo_total);
   };
+  // An initiate frame that carries data: the value (expedited) or the size.
+  auto initiate = [&](const char* verb) {
+    put(out, verb);
+    put_obj(out, d.sdo_index, d.sdo_sub);
+    if (s.expedited) {
+      val();
+    } else {
+      put(out, ": segmented");
+      if (s.size_indicated) fmt::format_to(fmt::appender(out), ", {} bytes", s.size);
+    }
+  };
   switch (s.kind) {
     case sdo::SdoFrameKind::kInitiateDownloadRequest:
-      put(out, "write ");
-      put_obj(out, d.sdo_index, d.sdo_sub);
-      if (s.expedited) {
-        val();
-      } else {
-        put(out, ": segmented");
-        if (s.size_indicated) fmt::format_to(fmt::appender(out), ", {} bytes", s.size);
-      }
+      initiate("write ");
       break;
     case sdo::SdoFrameKind::kInitiateDownloadResponse:
       put(out, "write ");
@@ -206,14 +210,7 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
       put_obj(out, d.sdo_index, d.sdo_sub);
       break;
     case sdo::SdoFrameKind::kInitiateUploadResponse:
-      put(out, "read ");
-      put_obj(out, d.sdo_index, d.sdo_sub);
-      if (s.expedited) {
-        val();
-      } else {
-        put(out, ": segmented");
-        if (s.size_indicated) fmt::format_to(fmt::appender(out), ", {} bytes", s.size);
-      }
+      initiate("read ");
       break;
     case sdo::SdoFrameKind::kUploadSegmentRequest:
       fmt::format_to(fmt::appender(out), "read segment request (toggle {})", s.toggle ? 1 : 0);
