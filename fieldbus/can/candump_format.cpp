@@ -328,17 +328,25 @@ std::size_t format_candump_line(std::span<char> out, const Frame& frame, std::in
   return w.n;
 }
 
+namespace {
+/// The start both formats share: the optional timestamp, then the interface.
+bool parse_time_and_iface(std::string_view& rest, CandumpLine& out) noexcept {
+  if (!parse_leading_time(rest, out)) return false;
+  const std::string_view iface = next_token(rest);
+  if (!valid_iface(iface)) {
+    out.reason = iface.empty() ? "missing interface name" : "bad interface name";
+    return false;
+  }
+  out.iface = iface;
+  return true;
+}
+}  // namespace
+
 CandumpParse parse_candump_log_line(std::string_view line, CandumpLine& out) noexcept {
   out.reason = "";
   out.format = CandumpFormat::kLog;
   std::string_view rest = trim_right(line);
-  if (!parse_leading_time(rest, out)) return CandumpParse::kMalformed;
-  const std::string_view iface = next_token(rest);
-  if (!valid_iface(iface)) {
-    out.reason = iface.empty() ? "missing interface name" : "bad interface name";
-    return CandumpParse::kMalformed;
-  }
-  out.iface = iface;
+  if (!parse_time_and_iface(rest, out)) return CandumpParse::kMalformed;
   const std::string_view tok = next_token(rest);
   if (tok.empty()) {
     out.reason = "missing ID#DATA";
@@ -363,13 +371,7 @@ CandumpParse parse_candump_screen_line(std::string_view line, CandumpLine& out) 
   out.reason = "";
   out.format = CandumpFormat::kScreen;
   std::string_view rest = trim_right(line);
-  if (!parse_leading_time(rest, out)) return CandumpParse::kMalformed;
-  const std::string_view iface = next_token(rest);
-  if (!valid_iface(iface)) {
-    out.reason = iface.empty() ? "missing interface name" : "bad interface name";
-    return CandumpParse::kMalformed;
-  }
-  out.iface = iface;
+  if (!parse_time_and_iface(rest, out)) return CandumpParse::kMalformed;
   std::string_view id_tok = next_token(rest);
   if (id_tok == "RX" || id_tok == "TX") {  // candump -x: "RX - -" / "TX B E"
     next_token(rest);
