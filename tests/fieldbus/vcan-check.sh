@@ -30,9 +30,11 @@ awk -v p="$cycle_us" '$2 == "602#4000100000000000" { exit } $2 == "080#" { if (l
         if (m < 0.8 * p || m > 5 * p) { print "mean SYNC interval out of range"; exit 1 } }' "$frames" ||
   fail "SYNC period check failed"
 # One RPDO and one TPDO per node per cycle while operational: count them between
-# the first and the last TPDO of each node and compare with the SYNCs there
-# (+-5 for the window edges: under emulation candump may log a TPDO a few
-# microseconds before the SYNC it answers).
+# the first and the last TPDO of each node and compare with the SYNCs there.
+# Tolerance: 1 % of the SYNCs, at least 5. Under emulation candump may log a
+# TPDO before the SYNC it answers, and the window edges move with it (one CI
+# run counted 1257 TPDOs for 1251 SYNCs); a real defect, such as no TPDO or two
+# per SYNC, is off by hundreds.
 for n in 2 3; do
   # (only the master program's part: up to the raw cansend requests)
   awk -v r="20$n" -v tp="18$n" '
@@ -43,7 +45,8 @@ for n in 2 3; do
     END {
       for (i = first; i <= last; i++) { if (ids[i] == "080") s++; if (ids[i] == r) rp++; if (ids[i] == tp) t++ }
       printf "vcan-check: node %s: %d SYNC, %d RPDO, %d TPDO while operational\n", substr(tp, 3), s, rp, t
-      if (s < 100 || rp < s - 5 || rp > s + 5 || t < s - 5 || t > s + 5) { print "not one RPDO and one TPDO per cycle"; exit 1 }
+      tol = s / 100; if (tol < 5) tol = 5
+      if (s < 100 || rp < s - tol || rp > s + tol || t < s - tol || t > s + tol) { print "not one RPDO and one TPDO per cycle"; exit 1 }
     }' "$frames" || fail "node $n: PDO count check failed"
 done
 # The raw cansend upload of 0x1000 and the emulator's expedited reply.
