@@ -31,10 +31,10 @@ awk -v p="$cycle_us" '$2 == "602#4000100000000000" { exit } $2 == "080#" { if (l
   fail "SYNC period check failed"
 # One RPDO and one TPDO per node per cycle while operational: count them between
 # the first and the last TPDO of each node and compare with the SYNCs there.
-# Tolerance: 1 % of the SYNCs, at least 5. Under emulation candump may log a
-# TPDO before the SYNC it answers, and the window edges move with it (one CI
-# run counted 1257 TPDOs for 1251 SYNCs); a real defect, such as no TPDO or two
-# per SYNC, is off by hundreds.
+# Tolerance: 2 % of the SYNCs, at least 5. Under emulation candump falls
+# behind and drops whole bursts of the master (RPDOs + SYNC) while the drives'
+# TPDOs are still logged (CI runs counted 1257 TPDOs for 1251 SYNCs and 1246
+# for 1233); a real defect, such as no TPDO or two per SYNC, is off by hundreds.
 for n in 2 3; do
   # (only the master program's part: up to the raw cansend requests)
   awk -v r="20$n" -v tp="18$n" '
@@ -45,7 +45,7 @@ for n in 2 3; do
     END {
       for (i = first; i <= last; i++) { if (ids[i] == "080") s++; if (ids[i] == r) rp++; if (ids[i] == tp) t++ }
       printf "vcan-check: node %s: %d SYNC, %d RPDO, %d TPDO while operational\n", substr(tp, 3), s, rp, t
-      tol = s / 100; if (tol < 5) tol = 5
+      tol = s / 50; if (tol < 5) tol = 5
       if (s < 100 || rp < s - tol || rp > s + tol || t < s - tol || t > s + tol) { print "not one RPDO and one TPDO per cycle"; exit 1 }
     }' "$frames" || fail "node $n: PDO count check failed"
 done
