@@ -175,11 +175,14 @@ struct CommandServer::Impl {
     std::vector<std::string> watch;
   };
 
-  Impl(Controller& c, CommandServerOptions o) : ctl(c), host(c), opt(std::move(o)) {}
+  Impl(Controller& c, CommandServerOptions o)
+      : ctl(c), own_host(c), host(o.shared_host ? *o.shared_host : own_host), opt(std::move(o)) {}
 
   Controller& ctl;
-  ControllerHost host;
+  ControllerHost own_host;  ///< used unless options.shared_host is set
+  ControllerHost& host;
   CommandServerOptions opt;
+  std::string refusal;  ///< non-empty: motion is refused (controlled stop)
   int listen_fd = -1;
   gid_t sock_gid = 0;
   std::string group_name;
@@ -542,6 +545,7 @@ struct CommandServer::Impl {
   void do_call(Client& c, std::string_view line) {
     std::string call(line);
     if (!call.empty() && call.back() == ';') call.pop_back();
+    if (!refusal.empty()) return send_line(c, "ERR " + refusal);
     c.control.clear();
     if (auto e = host.execute(call, &c.control)) {
       send_line(c, "ERR " + *e);
@@ -688,6 +692,10 @@ struct CommandServer::Impl {
 
   void start_script(Client& c) {
     c.mode = Mode::kIdle;
+    if (!refusal.empty()) {
+      c.script_text.clear();
+      return send_line(c, "ERR " + refusal);
+    }
     auto run = std::make_unique<ScriptRun>();
     run->host = std::make_unique<ClientHost>(*this);
     try {
@@ -840,6 +848,17 @@ CommandServer::~CommandServer() {
 }
 
 void CommandServer::poll(double now_s) { impl_->poll_once(now_s); }
+
+void CommandServer::refuse_motion(std::string reason) {
+  if (reason.empty()) reason = "motion is refused";
+  impl_->refusal = std::move(reason);
+  for (auto& c : impl_->clients) {
+    if (c->fd < 0 || c->mode != Impl::Mode::kScript) continue;
+    c->mode = Impl::Mode::kIdle;
+    c->run.reset();
+    impl_->send_line(*c, "ERR script stopped: " + impl_->refusal);
+  }
+}
 
 std::size_t CommandServer::client_count() const noexcept { return impl_->clients.size(); }
 const std::string& CommandServer::path() const noexcept { return impl_->opt.path; }

@@ -70,6 +70,11 @@ struct CommandServerOptions {
   /// tags `Controller.<field>` (e.g. Controller.latency_max_ns). Empty: STATS
   /// shows the controller's counters only.
   std::function<CycleStats()> cycle_stats;
+  /// Execute through this host instead of an own one, so that clients and the
+  /// owner (e.g. the daemon's `--script`) share user tags (`SET t 1` is seen
+  /// by `WAIT UNTIL t`). Must outlive the server and be used on the server's
+  /// thread only. Null: the server has its own host.
+  ControllerHost* shared_host = nullptr;
 };
 
 /// The socket server. Construction creates the socket; destruction closes
@@ -91,6 +96,12 @@ class CommandServer {
   /// for anything a client does (a client whose request raises is
   /// disconnected with an ERR line). Not realtime.
   void poll(double now_s);
+
+  /// From now on refuse motion: instruction calls and RUN get `ERR <reason>`,
+  /// and running client scripts are stopped with that line (motion they
+  /// already started is the owner's to stop). GET, SET, STATUS, WATCH and
+  /// STATS still work. Used by canmotiond's controlled stop. Not realtime.
+  void refuse_motion(std::string reason);
 
   /// Clients currently connected.
   [[nodiscard]] std::size_t client_count() const noexcept;

@@ -559,4 +559,63 @@ TEST(CommandServer, EndOfInputInsideRunIsAnError) {
 }
 
 }  // namespace
+TEST(CommandServer, RefuseMotionStopsScriptsAndRefusesCallsButKeepsReads) {
+  Rig r;
+  r.boot();
+  Client c(r.sock), s(r.sock);
+  servo_on(r, c);
+  // A script that would move later: it is waiting when the stop begins.
+  s.send("RUN late.script\nWAIT 10;\nMAJ(X, maj_late, 0, 10, unitspersec, 100, unitspersec2, 100, unitspersec2, "
+         "trapezoidal, 100, 100, %oftime, disabled, programmed, 0, none);\nEND\n");
+  for (int i = 0; i < 20; ++i) r.step();
+  r.server->refuse_motion("canmotiond is stopping");
+  const auto stopped = r.response(s);
+  ASSERT_EQ(stopped.size(), 1u);
+  EXPECT_EQ(stopped[0], "ERR script stopped: canmotiond is stopping");
+  EXPECT_EQ(r.request(c, mam("X", "mam9", "5", 50)), "ERR canmotiond is stopping");
+  EXPECT_FALSE(r.ctl->find_control("mam9").has_value()) << "a refused call creates no control tag";
+  c.send("RUN\nPRINT X.CommandPosition;\nEND\n");
+  const auto run = r.response(c);
+  ASSERT_EQ(run.size(), 1u);
+  EXPECT_EQ(run[0], "ERR canmotiond is stopping");
+  // Reads and tag writes still work.
+  EXPECT_EQ(r.request(c, "SET Distance 3"), "OK Distance=3");
+  EXPECT_EQ(r.request(c, "GET Distance"), "OK Distance=3");
+  EXPECT_EQ(r.request(c, "GET X.CommandVelocity"), "OK X.CommandVelocity=0");
+  for (int i = 0; i < 12000; ++i) r.step();
+  const auto late = r.ctl->find_control("maj_late");  // created when the script was loaded
+  ASSERT_TRUE(late.has_value());
+  EXPECT_FALSE(r.status().controls[*late].en()) << "the stopped script never ran its MAJ";
+  EXPECT_EQ(r.status().axes[1].tag.command_velocity, 0.0);
+}
+
+TEST(CommandServer, SharedHostSharesUserTagsWithTheOwner) {
+  std::unique_ptr<ControllerHost> owner;
+  Rig r([&owner](CommandServerOptions&) {});
+  owner = std::make_unique<ControllerHost>(*r.ctl);
+  // A second server on the same controller, sharing the owner's host.
+  CommandServerOptions o;
+  o.path = r.dir.path + "/shared.sock";
+  o.log = [](const std::string&) {};
+  o.shared_host = owner.get();
+  CommandServer shared(*r.ctl, o);
+  EXPECT_EQ(&shared.host(), owner.get());
+  EXPECT_NE(&r.server->host(), owner.get()) << "without shared_host a server has its own host";
+  Client c(shared.path());
+  std::optional<std::string> reply;
+  c.send("SET Speed 42\n");
+  for (int i = 0; i < 100 && !reply; ++i) {
+    r.step();
+    shared.poll(r.now_s());
+    reply = c.line();
+  }
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_EQ(*reply, "OK Speed=42");
+  std::string err;
+  const auto v = owner->read("Speed", &err);
+  ASSERT_TRUE(v.has_value()) << err;
+  EXPECT_EQ(*v, 42.0) << "the owner's script sees the client's SET";
+  EXPECT_FALSE(r.server->host().read("Speed", &err).has_value()) << "the other server's own host does not";
+}
+
 }  // namespace canmotion::rt::ctltest

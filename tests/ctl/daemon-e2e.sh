@@ -22,7 +22,16 @@ fail() {
   exit 1
 }
 
-"$daemon" --config "$config" --sim --socket "$sock" --duration 1000000 --quiet >"$dir/daemon.out" 2>"$dir/daemon.err" &
+# The daemon's own --script shares user tags with the socket's clients: it
+# waits for a tag that canmotionctl sets.
+cat >"$dir/daemon.script" <<'SCRIPT'
+E2eGo := 0;
+WAIT UNTIL E2eGo = 1 TIMEOUT 600;
+PRINT E2eGo;
+SCRIPT
+start=$(date +%s.%N)
+"$daemon" --config "$config" --sim --socket "$sock" --script "$dir/daemon.script" --duration 1000000 --quiet \
+  >"$dir/daemon.out" 2>"$dir/daemon.err" &
 pid=$!
 for _ in $(seq 1 200); do
   [ -S "$sock" ] && break
@@ -61,6 +70,16 @@ out=$("$ctl" watch Controller.Time --interval 0.5 --count 3) || fail "watch: $ou
 
 out=$("$ctl" stats) || fail "stats: $out"
 grep -q '^cycle ' <<<"$out" || fail "stats: $out"
+
+"$ctl" set E2eGo 1 || fail "set E2eGo"
+for _ in $(seq 1 100); do grep -q 'E2eGo=1' "$dir/daemon.out" && break; sleep 0.05; done
+grep -q 'E2eGo=1' "$dir/daemon.out" || fail "the daemon's script did not see the client's SET E2eGo 1"
+
+# --sim with --socket is paced at real time by default (--sim-rate 1): the
+# controller's clock never runs ahead of the wall clock.
+ctime=$("$ctl" get Controller.Time) || fail "get Controller.Time"
+awk -v c="$ctime" -v s="$start" -v n="$(date +%s.%N)" 'BEGIN { exit !(c <= n - s + 0.5) }' ||
+  fail "--sim --socket ran ahead of real time: controller time $ctime s after $(awk -v s="$start" -v n="$(date +%s.%N)" 'BEGIN{print n-s}') s"
 
 if out=$("$ctl" 'MSO(Nope, x)' 2>&1); then fail "an unknown axis was accepted: $out"; fi
 grep -q "Nope" <<<"$out" || fail "error does not name the axis: $out"

@@ -47,6 +47,7 @@ struct Options {
   std::string socket;
   std::string socket_group;
   bool quiet = false;
+  double sim_rate = -1;  // --sim-rate; < 0 = default (1 with --socket, else 0 = flat out)
 };
 
 /// Writes the trace and CSV files and prints events; drained from the
@@ -333,6 +334,7 @@ int run(const Options& o) {
     so.io_interval_s = sim ? 0.001 : 0.0;  // --sim: housekeeping runs every cycle; poll the socket once per ms
     so.log = [](const std::string& l) { fmt::print(stderr, "canmotiond: socket: {}\n", l); };
     if (!sim) so.cycle_stats = [&exec] { return exec.statistics().snapshot(); };
+    so.shared_host = &host;  // clients and --script share user tags
     try {
       server = std::make_unique<rt::CommandServer>(ctl, std::move(so));
     } catch (const std::exception& e) {
@@ -352,8 +354,14 @@ int run(const Options& o) {
   bool ended = false;
 
   // The non-RT work of one step: outputs, script, progress, end of run.
+  // --sim pacing: at most sim_rate x real time (0 = as fast as possible).
+  const double sim_rate = o.sim_rate >= 0 ? o.sim_rate : (server ? 1.0 : 0.0);
+  bool refusing = false;
   auto housekeeping = [&](std::uint64_t cycle) -> bool {
     const double now = static_cast<double>(cycle) * ctl.period_s();
+    if (sim && sim_rate > 0)
+      std::this_thread::sleep_until(wall0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                std::chrono::duration<double>(now / sim_rate)));
     out->drain(o.quiet);
     if (server) server->poll(now);
     if (runner && shutdown.phase() == Shutdown::Phase::kNone) {
@@ -370,6 +378,10 @@ int run(const Options& o) {
     if (g_signal.load() != 0 && shutdown.phase() == Shutdown::Phase::kNone) {
       fmt::print(stderr, "canmotiond: signal {}: stopping axes, disabling drives\n", g_signal.load());
       shutdown.begin(now);
+    }
+    if (server && !refusing && shutdown.phase() != Shutdown::Phase::kNone) {
+      refusing = true;  // no new motion from clients once the controlled stop has begun
+      server->refuse_motion("canmotiond is stopping (controlled stop): motion instructions and scripts are refused");
     }
     if (!o.quiet && cycle >= next_progress) {
       next_progress += per_second;
@@ -458,6 +470,10 @@ int main(int argc, char** argv) {
   app.add_flag("--stats", o.stats, "print cycle statistics once a second and at the end");
   app.add_option("--socket", o.socket, "serve canmotionctl on this UNIX socket (mode 0660; see tools/canmotionctl/README.md)");
   app.add_option("--socket-group", o.socket_group, "group owning the --socket file and allowed to use it (default: the daemon's group)");
+  app.add_option("--sim-rate", o.sim_rate,
+                 "with --sim: run at most this many times real time (0 = as fast as possible; default 0, or 1 "
+                 "with --socket so that canmotionctl users see motion at its real speed)")
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", o.quiet, "no progress lines or summary");
   app.footer(
       "Examples:\n"
