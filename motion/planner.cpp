@@ -61,6 +61,7 @@ GenRef gen_ref(Generator& g) noexcept {
   if (auto* p = std::get_if<ProfileGen>(&g)) return {&p->k, p->owner, p->owner_gen};
   if (auto* q = std::get_if<GearGen>(&g)) return {&q->k, q->owner, q->owner_gen};
   if (auto* c = std::get_if<CamGen>(&g)) return {&c->k, c->owner, c->owner_gen};
+  if (auto* pc = std::get_if<PosCamGen>(&g)) return {&pc->k, pc->owner, pc->owner_gen};
   return {};
 }
 
@@ -231,11 +232,13 @@ void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
     cg->profile->release();  // CAM_PROFILE[0].Status: one user less
     cg->profile = nullptr;
   }
+  if (auto* pc = std::get_if<PosCamGen>(&slot)) end_position_cam(a, *pc);  // MAPC (planner_mapc.cpp)
   if (auto* p = std::get_if<ProfileGen>(&slot); p && p->master_driven) {
     if (ControlTag* m = owner_tag(p->mdac, p->mdac_gen)) m->set(flag::AC, false);
   }
   if (const GenRef g = gen_ref(slot); g.k) {
-    a.base += g.k->p;
+    if (s == Slot::MasterOffset) add_master_offset(a, g.k->p);  // shifts the cam's master, not the slave
+    else a.base += g.k->p;
     if (clear_owner_ip) {
       if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) {
         c->set(flag::IP, false);
@@ -257,6 +260,7 @@ void Planner::abort_all(AxisRt& a) noexcept {
 void Planner::servo_off(AxisRt& a) noexcept {
   abort_all(a);
   drop_pending_cam(a);
+  drop_pending_pcam(a);
   end_direct(a, false);
   a.servo = false;
   a.enable_req = false;
@@ -394,7 +398,7 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
     Kin tot{};
     bool any = false;
     for (std::size_t s = 0; s < kSlots; ++s) {
-      if (const GenRef g = gen_ref(a.gen[s]); g.k) {
+      if (const GenRef g = gen_ref(a.gen[s]); g.k && s != static_cast<std::size_t>(Slot::MasterOffset)) {
         tot.v += g.k->v;
         tot.a += g.k->a;
         any = true;
@@ -499,6 +503,7 @@ Err Planner::execute(const Request& r) noexcept {
           else if constexpr (std::is_same_v<P, MdacParams>) return start_mdac(r, p, axes_[p.slave], exerr);
           else if constexpr (std::is_same_v<P, MdsParams>) return start_mds(r, p, axes_[p.axis], exerr);
           else if constexpr (std::is_same_v<P, MatcParams>) return start_matc(r, p, axes_[p.axis], exerr);
+          else if constexpr (std::is_same_v<P, MapcParams>) return start_mapc(r, p, axes_[p.slave], exerr);
           else if constexpr (std::is_same_v<P, MgsParams>) return start_group(r, p.group, p.mode, exerr);
           else if constexpr (std::is_same_v<P, MgsdParams> || std::is_same_v<P, MgsrParams>)
             return start_group(r, p.group, GroupStopMode::Programmed, exerr);
@@ -660,6 +665,7 @@ Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int
   const bool ramping = a.servo && mask != 0 && stop_slots(a, mask, d, jd, r.control, 0);
   if (type == StopType::All) break_links(a);  // MAS All on the slave breaks its MDAC links
   if (type == StopType::All || type == StopType::TimeCam) drop_pending_cam(a);
+  if (type == StopType::All || type == StopType::PositionCam) drop_pending_pcam(a);
   if ((type == StopType::All || type == StopType::DirectControl) && a.direct_active) {
     // direct command to zero; the drive ramps down; PC at standstill
     end_direct(a, true);
@@ -777,25 +783,32 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   if (a.homing) return Err::HomeInProcess;
   if (any_stopping(a)) return Err::NotAllowedWhileStopping;
   const Idx& I = idx();
-  Dyn dy;
-  if (Err e = decode_dynamics(p.dyn, a.cfg, a.last_speed, dy, exerr); e != Err::None) return e;
   const auto mt = p.move_type;
+  // master offset moves (5/6) shift the master of the active position cam:
+  // Slot::MasterOffset, master units, MDAC link 3 (planner_mapc.cpp)
+  const bool offset = mt == MoveType::AbsoluteMasterOffset || mt == MoveType::IncrementalMasterOffset;
+  const AxisConfig* ucfg = offset ? position_cam_master(a) : &a.cfg;
+  if (!ucfg) return Err::PositionCamNotEnabled;
+  const Slot slot = offset ? Slot::MasterOffset : Slot::Move;
+  const int link = offset ? 3 : 0;
+  Dyn dy;
+  if (Err e = decode_dynamics(p.dyn, *ucfg, a.last_speed, dy, exerr); e != Err::None) return e;
+  if (offset) dy.merge = false;  // a merge would end the cam it offsets: ignored (README)
   const double pos = p.position;
-  if (mt == MoveType::AbsoluteMasterOffset || mt == MoveType::IncrementalMasterOffset)
-    return Err::FeatureNotSupported;  // runs with gearing/camming (issue 5)
   const bool rot_type = mt == MoveType::RotaryShortest || mt == MoveType::RotaryPositive || mt == MoveType::RotaryNegative;
   if (rot_type) {
     if (!a.cfg.rotary) return Err::AxisModeNotRotary;
     if (pos < 0 || pos >= a.cfg.unwind) { exerr = static_cast<std::int8_t>(I.mam_pos); return Err::ParameterOutOfRange; }
   }
-  auto* old = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Move)]);
+  auto* old = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(slot)]);
   if (old && old->role != GenRole::Move) old = nullptr;
   // The new profile continues the acceleration of S-curve motion; trapezoidal
   // motion steps its acceleration anyway, so it hands over with a = 0.
   Kin start{};
   if (dy.merge) start = Kin{0, a.cmd.v, any_scurve(a) ? a.cmd.a : 0.0};
   else if (old) start = Kin{0, old->k.v, old->scurve ? old->k.a : 0.0};
-  if (dy.seconds && (a.cmd.v != 0 || a.cmd.a != 0)) return Err::AxisNotAtRest;
+  const Kin rest = offset ? (old ? old->k : Kin{}) : a.cmd;
+  if (dy.seconds && (rest.v != 0 || rest.a != 0)) return Err::AxisNotAtRest;
   // distance
   const double cur = user_command(a);
   const double U = a.cfg.unwind;
@@ -820,17 +833,21 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
       L = pos - unwind_position(cur, U);
       if (L > 0) L -= U;
       break;
-    default: break;
+    case MoveType::AbsoluteMasterOffset: L = pos - master_offset(a); break;
+    case MoveType::IncrementalMasterOffset:
+      L = pos;
+      if (old && old->move_type == MoveType::IncrementalMasterOffset) L += old->total - old->k.p;
+      break;
   }
-  if (L > 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitPositive & 1u)) return Err::OvertravelCondition;
-  if (L < 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitNegative & 1u)) return Err::OvertravelCondition;
+  if (!offset && L > 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitPositive & 1u)) return Err::OvertravelCondition;
+  if (!offset && L < 0 && (a.tag.motion_fault_status >> motion_fault::SoftTravelLimitNegative & 1u)) return Err::OvertravelCondition;
   ProfileGen g;
   g.role = GenRole::Move;
   if (dy.master_driven) {  // the profile runs over master travel
     g.lock = dy.lock;
     g.lock_pos = dy.lock_pos;
     bool ok_md = true;
-    if (Err e = master_driven_setup(a, 0, g, start, ok_md); e != Err::None) return e;
+    if (Err e = master_driven_setup(a, link, g, start, ok_md); e != Err::None) return e;
   }
   if (dy.seconds) {
     const double Ld = std::fabs(L);
@@ -877,7 +894,7 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   if (dy.merge) {
     for (std::size_t s = 0; s < kSlots; ++s) fold(a, static_cast<Slot>(s), true);
   } else {
-    fold(a, Slot::Move, true);
+    fold(a, slot, true);
   }
   ControlTag& c = controls_[r.control];
   g.t0_cycle = cycle_;
@@ -889,12 +906,12 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   g.scurve = dy.scurve;
   g.owner = r.control;
   g.owner_gen = c.generation;
-  promote_pending(a, 0);
+  promote_pending(a, link);
   if (g.master_driven) {
     c.set(flag::AC, true);
     if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
   }
-  a.gen[static_cast<std::size_t>(Slot::Move)] = g;
+  a.gen[static_cast<std::size_t>(slot)] = g;
   if (g.speed > 0) a.last_speed = g.speed;
   c.set(flag::DN, true);
   c.set(flag::IP, true);
@@ -1229,7 +1246,21 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
 
 void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
   double sum_p = 0, sum_v = 0, sum_a = 0;
-  for (std::size_t s = 0; s < kSlots; ++s) {
+  // the master offset move shifts the position cam's master: it steps first
+  // and is not part of the slave's sum
+  constexpr std::array<Slot, kSlots> kStepOrder{Slot::Move, Slot::Jog, Slot::Gear, Slot::TimeCam,
+                                                Slot::MasterOffset, Slot::PositionCam, Slot::StopAll};
+  for (const Slot slot_id : kStepOrder) {
+    const auto s = static_cast<std::size_t>(slot_id);
+    if (auto* pc = std::get_if<PosCamGen>(&a.gen[s])) {
+      step_position_cam(a, *pc);
+      if (auto* still = std::get_if<PosCamGen>(&a.gen[s])) {
+        sum_p += still->k.p;
+        sum_v += still->k.v;
+        sum_a += still->k.a;
+      }
+      continue;
+    }
     if (auto* cg = std::get_if<CamGen>(&a.gen[s])) {
       step_cam(a, *cg);
       if (auto* still = std::get_if<CamGen>(&a.gen[s])) {
@@ -1304,6 +1335,7 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
       c->set(flag::ACCEL, g->k.v * g->k.a > 0 || (g->k.v == 0 && g->k.a != 0));
       c->set(flag::DECEL, g->k.v * g->k.a < 0);
     }
+    if (slot_id == Slot::MasterOffset) continue;
     sum_p += g->k.p;
     sum_v += g->k.v;
     sum_a += g->k.a;
@@ -1359,6 +1391,7 @@ void Planner::update_status(AxisRt& a) noexcept {
   setb(DecelStatus, a.cmd.v * a.cmd.a < 0);
   setb(TimeCamStatus, std::holds_alternative<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]));
   setb(TimeCamPendingStatus, a.pending_cam.valid());
+  position_cam_status(a, ms);
   const bool torque_mode = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
   setb(DirectVelocityControlStatus, a.direct_active && !torque_mode);
   setb(DirectTorqueControlStatus, a.direct_active && torque_mode);
@@ -1688,6 +1721,7 @@ void Planner::compute_order() noexcept {
       AxisId m = kNoAxis;
       if (auto* g = std::get_if<GearGen>(&s)) m = g->master;
       if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) m = p->master;
+      if (auto* pc = std::get_if<PosCamGen>(&s)) m = pc->master;
       if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
     }
     for (std::size_t k = n; k < kSlots; ++k) out[k] = kNoAxis;

@@ -202,6 +202,45 @@ struct PendingCam {
   constexpr bool valid() const noexcept { return profile != nullptr; }
 };
 
+/// State of an MAPC (position cam, motion/planner_mapc.cpp): the cam engineer's
+/// CamMotion evaluated at the master coordinate = master travel since the
+/// lock (filtered by MasterDirection) + the master offset (finished master
+/// offset moves + the running one in Slot::MasterOffset). O(1) amortised step.
+struct PosCamGen {
+  cam::CamMotion cm{};
+  cam::CamProfile* profile = nullptr;  ///< in use (acquired) while the cam runs
+  AxisId master = kNoAxis;
+  bool use_actual = false;      ///< MasterReference actual (CIP masters only)
+  std::uint8_t schedule = 0;    ///< ExecutionSchedule: 0 immediate, 2 forward only, 3 reverse only, 4 bidirectional
+  std::uint8_t master_dir = 0;  ///< MasterDirection: 0 bidirectional, 1 forward only, 2 reverse only
+  double master_lock = 0.0;     ///< MasterLockPosition (master user frame)
+  bool locked = false;          ///< the master crossed MasterLockPosition (immediate: at once)
+  bool inside = true;           ///< the cam coordinate is inside the profile (Persistent relocks)
+  bool slipping = false;        ///< the master moved against MasterDirection this cycle
+  double prev_mp = 0.0;         ///< master position (drive frame) last cycle
+  double lock_mp = 0.0;         ///< master position (drive frame) at the lock
+  double travel = 0.0;          ///< master travel since the lock as the cam follows it
+  double offset_base = 0.0;     ///< sum of the finished master offset moves (master units)
+  double x_shift = 0.0;         ///< cam coordinate of the takeover (pending cams)
+  double x = 0.0;               ///< cam coordinate of the last step
+  std::int64_t last_pass = 0;
+  Kin k{};
+  ControlId owner = kNoControl;
+  std::uint32_t owner_gen = 0;
+};
+
+/// A pending MAPC waiting for the end of the current pass (or for a non-pending cam).
+struct PendingPosCam {
+  cam::CamProfile* profile = nullptr;
+  cam::CamMotionConfig cfg{};
+  AxisId master = kNoAxis;
+  bool use_actual = false;
+  std::uint8_t master_dir = 0;
+  ControlId owner = kNoControl;
+  std::uint32_t owner_gen = 0;
+  constexpr bool valid() const noexcept { return profile != nullptr; }
+};
+
 /// Capacity of the CAM_PROFILE registry (config: one entry per CAM_PROFILE array tag).
 inline constexpr std::size_t kMaxCamProfiles = 64;
 
@@ -213,7 +252,7 @@ enum class Slot : std::uint8_t { Move = 0, Jog, Gear, TimeCam, PositionCam, Mast
 inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
 
 /// The closed set of generator states. Issue 5 adds cam and direct states here.
-using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen>;
+using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen, PosCamGen>;
 
 // typed instruction parameters (motion/instructions.hpp)
 struct MasParams;
@@ -225,6 +264,7 @@ struct MagParams;
 struct MdacParams;
 struct MdsParams;
 struct MatcParams;
+struct MapcParams;
 
 // ------------------------------------------------------------------ planner
 /// The planner. All state is inside (fixed arrays); update() is noexcept,
@@ -307,6 +347,8 @@ class Planner {
     std::uint32_t mds_stop_gen = 0;
     PendingCam pending_cam{};     ///< TimeCamPendingStatus
     int cam_dir = 0;              ///< last time-cam direction (+1/-1, 0 never cammed)
+    PendingPosCam pending_pcam{}; ///< PositionCamPendingStatus (MAPC)
+    int pcam_dir = 0;             ///< last position-cam direction (+1/-1, 0 never cammed)
     int gear_dir = 0;           ///< last gearing direction (+1 same, -1 opposite, 0 never geared)
     bool homing = false;        ///< drive homing (mode 6) in progress
     bool homing_started = false;
@@ -336,6 +378,15 @@ class Planner {
   Err start_mds(const Request&, const MdsParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_matc(const Request&, const MatcParams&, AxisRt&, std::int8_t& exerr) noexcept;
   void step_cam(AxisRt& a, CamGen& g) noexcept;
+  // MAPC and master offset moves (motion/planner_mapc.cpp)
+  Err start_mapc(const Request&, const MapcParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  void step_position_cam(AxisRt& a, PosCamGen& g) noexcept;
+  void drop_pending_pcam(AxisRt& a) noexcept;
+  void end_position_cam(AxisRt& a, PosCamGen& g) noexcept;  ///< fold hook: release, AC, end the offset move
+  void add_master_offset(AxisRt& a, double d) noexcept;     ///< fold hook of Slot::MasterOffset
+  double master_offset(const AxisRt& a) const noexcept;     ///< total master offset the cam sees
+  const AxisConfig* position_cam_master(const AxisRt& a) const noexcept;  ///< null: no position cam (ERR 33)
+  void position_cam_status(const AxisRt& a, std::uint32_t& ms) const noexcept;
   void drop_pending_cam(AxisRt& a) noexcept;
   void end_direct(AxisRt& a, bool keep_direct_status) noexcept;
   void break_links(AxisRt& slave) noexcept;

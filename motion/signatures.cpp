@@ -180,7 +180,7 @@ constexpr std::array<InstrSig, kInstrCount> kTable{{
     {Instr::MCD, "MCD", kMcd, true},
     {Instr::MRP, "MRP", kMrp, true},
     {Instr::MCCP, "MCCP", kMccp, false},
-    {Instr::MAPC, "MAPC", kMapc, false},
+    {Instr::MAPC, "MAPC", kMapc, true},
     {Instr::MATC, "MATC", kMatc, true},
     {Instr::MDAC, "MDAC", kMdac, true},
     {Instr::MDS, "MDS", kMds, true},

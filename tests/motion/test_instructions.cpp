@@ -186,7 +186,7 @@ TEST(Mam, ErrorCasesChangeNothing) {
       {mam("X", "e", 0, 5, 10, 100, 100, "scurve", 10, -1, "unitspersec3"), Err::ParameterOutOfRange, 12},
       {mam("X", "e", 0, 5, 10, 100, 100, "scurve", 150, 10, "%oftime"), Err::ParameterOutOfRange, 11},
       {mam("X", "e", 2, 5, 10), Err::AxisModeNotRotary, 0},
-      {mam("X", "e", 5, 5, 10), Err::FeatureNotSupported, 0},
+      {mam("X", "e", 5, 5, 10), Err::PositionCamNotEnabled, 0},  // master offset without a position cam,
       {"MAM(X,e,0,5,1,unitspermasterunit,1,unitspermasterunit2,1,unitspermasterunit2,trapezoidal,0,0,unitspersec3,disabled,programmed,0,immediateforwardonly,0,0);",
        Err::MdscNotActivated, 0},
       {"MAM(X,e,0,5,1,unitspermasterunit,1,unitspersec2,1,unitspermasterunit2,trapezoidal,0,0,unitspersec3,disabled,programmed,0,none,0,0);",
@@ -652,8 +652,8 @@ TEST(Group, FastDisableAndShutdownReset) {
 TEST(Model, InstructionsNotYetExecutableGiveErr75) {
   Rig r = servo_rig();
   r.add_axis("M", virt());
-  r.sym.cam_profiles["prof"] = 0;
-  EXPECT_EQ(r.exec("MAPC(X, M, t, same, prof[0], 1, 1, once, immediate, 0, 0, command, bidirectional);"), Err::InstructionNotSupported);
+  r.sym.coordinate_systems["cs"] = 0;
+  EXPECT_EQ(r.exec("MCSD(cs, t);"), Err::InstructionNotSupported);
   EXPECT_EQ(r.tag("t").err, 75);
 }
 
