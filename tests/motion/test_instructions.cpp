@@ -186,7 +186,7 @@ TEST(Mam, ErrorCasesChangeNothing) {
       {mam("X", "e", 0, 5, 10, 100, 100, "scurve", 10, -1, "unitspersec3"), Err::ParameterOutOfRange, 12},
       {mam("X", "e", 0, 5, 10, 100, 100, "scurve", 150, 10, "%oftime"), Err::ParameterOutOfRange, 11},
       {mam("X", "e", 2, 5, 10), Err::AxisModeNotRotary, 0},
-      {mam("X", "e", 5, 5, 10), Err::PositionCamNotEnabled, 0},  // master offset without a position cam,
+      {mam("X", "e", 5, 5, 10), Err::PositionCamNotEnabled, 0},  // master offset without a position cam
       {"MAM(X,e,0,5,1,unitspermasterunit,1,unitspermasterunit2,1,unitspermasterunit2,trapezoidal,0,0,unitspersec3,disabled,programmed,0,immediateforwardonly,0,0);",
        Err::MdscNotActivated, 0},
       {"MAM(X,e,0,5,1,unitspermasterunit,1,unitspersec2,1,unitspermasterunit2,trapezoidal,0,0,unitspersec3,disabled,programmed,0,none,0,0);",
