@@ -42,6 +42,7 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
   r.fb[1].drive = DriveState::Enabled;
   AxisConfig e = c;
   r.add_axis("C", e);
+  r.add_axis("P", e);  // position cam slave of X (MAPC, master offset moves)
   cam::CamProfile prof(8);  // allocated at configuration time
   const std::array<cam::CamPoint, 3> pts{{{0.0, 0.0, 1}, {0.5, 2.0, 1}, {1.0, 3.0, 1}}};
   ASSERT_TRUE(cam::mccp(cam::MccpRequest{pts, 0, 3, 0.0, 0.0}, prof).ok());
@@ -63,6 +64,17 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
       r.req("MSO(C, on3);"),
       r.req("MATC(C, tc, same, prof[0], 1, 1, continuous, immediate, 0, none, timedrivenmode);"),
       r.req("MATC(C, tc2, same, prof[0], 2, 1, once, pending, 0, none, timedrivenmode);"),
+      r.req("MSO(P, on4);"),
+      r.req(maj("X", "jx", 0, 5)),
+      r.req("MAPC(P, X, pc, same, prof[0], 1, 1, continuous, immediate, 0, 0, command, bidirectional);"),
+      r.req(mam("P", "mo", 6, 0.3, 1, 10, 10, "scurve", 60, 60)),
+      r.req("MDAC(P, X, link2, masteroffsetmove, command);"),
+      r.req("MAM(P,mo2,5,-0.2,0.5,unitspermasterunit,1,unitspermasterunit2,1,unitspermasterunit2,trapezoidal,0,0,"
+            "unitspermasterunit3,disabled,programmed,0,immediateforwardonly,0,0);"),
+      r.req("MAS(P, s2, masteroffsetmove, no, 0, unitspersec2, no, 0, unitspersec3);"),
+      r.req("MAPC(P, X, pc2, opposite, prof[0], 2, 1, once, pending, 0, 0.5, command, forwardonly);"),
+      r.req("MAS(P, s3, positioncam, no, 0, unitspersec2, no, 0, unitspersec3);"),
+      r.req("MAPC(P, X, pc3, same, prof[0], 1, 1, persistent, bidirectional, 5, 0, command, reverseonly);"),
       r.req("MGS(g, gs, faststop);"),
   };
   r.queue.reserve(16);
@@ -74,6 +86,9 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
   }
   g_count = false;
   EXPECT_EQ(g_allocs.load(), 0);
+  // the position cam part of the workload really ran (no request refused)
+  for (const char* t : {"pc", "pc2", "mo", "link2", "mo2", "s2", "s3", "pc3"}) EXPECT_FALSE(r.tag(t).er()) << t << " ERR " << r.tag(t).err;
+  EXPECT_TRUE(r.tag("pc2").pc() || r.tag("pc2").ip());
 }
 
 // The counter itself works (so the test above can fail).
