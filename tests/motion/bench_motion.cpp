@@ -3,8 +3,12 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <cmath>
 #include <memory>
+#include <stdexcept>
+#include <vector>
 
+#include "motion/cam/cam_profile.hpp"
 #include "motion/planner.hpp"
 #include "motion/profile.hpp"
 #include "motion/st_parser.hpp"
@@ -95,6 +99,39 @@ void gear_bench(benchmark::State& st, bool fractional) {
 void BM_StepGearReal(benchmark::State& st) { gear_bench(st, false); }
 void BM_StepGearFractional(benchmark::State& st) { gear_bench(st, true); }
 
+// MAPC: half the axes are virtual masters jogging at 10 units/s (one cam
+// segment per cycle), each other axis position-cams continuously on one with a
+// 1000-point cubic profile (master 0..9.99, segment 0.01)
+void BM_StepPositionCam1000Cubic(benchmark::State& st) {
+  Bench b;
+  cam::CamProfile prof(1000);
+  std::vector<cam::CamPoint> pts(1000);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const double x = 0.01 * static_cast<double>(i);
+    pts[i] = cam::CamPoint{x, x + 0.5 * std::sin(x * 2 * 3.14159265358979 / 9.99), cam::kSegmentCubic};
+  }
+  if (!cam::mccp(cam::MccpRequest{pts, 0, 1000, 1.0, 1.0}, prof).ok()) throw std::runtime_error("mccp");
+  b.p->attach_cam_profile(0, &prof);
+  b.sym.cam_profiles["prof"] = 0;
+  for (int i = 0; i < kAxes; i += 2) {
+    const std::string m = "a" + std::to_string(i), s = "a" + std::to_string(i + 1);
+    b.run("MAJ(" + m + ", mv" + std::to_string(i) +
+          ", 0, 10, unitspersec, 1000, unitspersec2, 1000, unitspersec2, trapezoidal, 0, 0, unitspersec3, disabled, programmed, 0, none);");
+    b.run("MAPC(" + s + ", " + m + ", mv" + std::to_string(i + 1) +
+          ", same, prof[0], 1, 1, continuous, immediate, 0, 0, command, bidirectional);");
+    if (!b.p->control(static_cast<ControlId>(100 + i + 1)).ip()) throw std::runtime_error("MAPC refused");
+  }
+  b.step();
+  for (auto _ : st) {
+    b.step();
+    benchmark::DoNotOptimize(b.out[1].position);
+  }
+  st.counters["ns_per_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes),
+                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["ns_per_cam_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes / 2),
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // plan_move for an S-curve from a moving state (a merge): the planning maths alone
 void BM_PlanSCurveMoveFromMotion(benchmark::State& st) {
   Limits l{100, 1000, 800, 20000, 15000};
@@ -157,6 +194,7 @@ BENCHMARK(BM_StepMoveSCurve);
 BENCHMARK(BM_StepJog);
 BENCHMARK(BM_StepGearReal);
 BENCHMARK(BM_StepGearFractional);
+BENCHMARK(BM_StepPositionCam1000Cubic);
 BENCHMARK(BM_PlanSCurveMoveFromMotion);
 BENCHMARK(BM_PlanSCurveMoveRestToRest);
 BENCHMARK(BM_StartSCurveMam);
