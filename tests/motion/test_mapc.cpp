@@ -531,3 +531,39 @@ TEST(MapcProperty, SlaveEqualsScaledProfileOfTheMaster) {
     EXPECT_LE(worst, 1e-9);
   }
 }
+
+// --------------------------------------------------------------- ST binding
+// Every MAPC enumeration keyword binds to its number, case-insensitively, and
+// the numbers bind to the same request.
+TEST(MapcParse, KeywordsAndNumbersBindAlike) {
+  PcRig c;
+  const struct { const char* kw; const char* num; } forms[] = {
+      {"MAPC(S, M, k, same, lin[0], 1.5, 2, once, immediate, 1, 2, actual, bidirectional);",
+       "MAPC(S, M, k, 0, lin[0], 1.5, 2, 0, 0, 1, 2, 0, 0);"},
+      {"mapc(S, M, k, Opposite, lin[0], -1, 0.5, Continuous, Pending, -3, 4, Command, ForwardOnly);",
+       "MAPC(S, M, k, 1, lin[0], -1, 0.5, 1, 1, -3, 4, 1, 1);"},
+      {"MAPC(S, M, k, REVERSE, lin[0], 1, 1, PERSISTENT, FORWARDONLY, 0, 0, command, REVERSEONLY);",
+       "MAPC(S, M, k, 2, lin[0], 1, 1, 2, 2, 0, 0, 1, 2);"},
+      {"MAPC(S, M, k, unchanged, lin[0], 1, 1, once, reverseonly, 0, 0, command, bidirectional);",
+       "MAPC(S, M, k, 3, lin[0], 1, 1, 0, 3, 0, 0, 1, 0);"},
+      {"MAPC(S, M, k, same, lin[0], 1, 1, once, bidirectional, 0, 0, command, bidirectional);",
+       "MAPC(S, M, k, 0, lin[0], 1, 1, 0, 4, 0, 0, 1, 0);"},
+  };
+  for (const auto& f : forms) {
+    const Request a = c.r.req(f.kw), b = c.r.req(f.num);
+    ASSERT_EQ(a.instr, Instr::MAPC) << f.kw;
+    ASSERT_EQ(a.count, 13) << f.kw;
+    ASSERT_EQ(b.count, 13) << f.num;
+    for (std::size_t i = 0; i < 13; ++i) {
+      EXPECT_EQ(a.op[i].value, b.op[i].value) << f.kw << " operand " << i;
+      EXPECT_EQ(a.op[i].ref, b.op[i].ref) << f.kw << " operand " << i;
+    }
+  }
+  // wrong operand counts and unknown keywords are refused by the parser/binder
+  Request q;
+  EXPECT_TRUE(parse_and_bind("MAPC(S, M, k, same, lin[0], 1, 1, twice, immediate, 0, 0, command, bidirectional);",
+                             c.r.sym, q)
+                  .has_value());
+  EXPECT_TRUE(parse_and_bind("MAPC(S, M, k, same, lin[0], 1, 1, once, immediate, 0, 0, command);", c.r.sym, q)
+                  .has_value());
+}
