@@ -249,7 +249,8 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
     if (continuous && o.pass != g.last_pass) {
       take = true;
       end = o.pass > g.last_pass ? g.cm.pass_end(g.last_pass) : g.cm.pass_end(g.last_pass - 1);
-    } else if (!continuous && o.range != cam::CamRange::Inside) {
+    } else if (!continuous && o.range != cam::CamRange::Inside && g.inside) {
+      // (a Persistent cam already outside its range hands over when the master next leaves it)
       take = true;
       end = o.range == cam::CamRange::PastEnd ? g.cm.pass_end(0) : g.cm.pass_end(0) - g.cm.pass_length();
     }

@@ -298,6 +298,23 @@ TEST(Mapc, PendingWithoutAnActiveCamWaitsForANonPendingOne) {
   EXPECT_NEAR(c.s(), 4.0 + 2 * 3.0, 1e-9);
 }
 
+TEST(Mapc, PendingAfterAPersistentCamOutsideItsRangeWaitsForTheNextExit) {
+  PcRig c;
+  ASSERT_EQ(c.r.exec(PcRig::mapc("a", "lin", 1, 1, "persistent", "immediate", 0, 5)), Err::None);
+  c.move_master(8);  // outside (profile 13)
+  ASSERT_EQ(c.r.exec(PcRig::mapc("b", "step", 1, 1, "once", "pending")), Err::None);
+  c.r.step(10);
+  EXPECT_TRUE(c.r.tag("a").ip());  // no takeover while it stays outside
+  EXPECT_TRUE(c.bit(PositionCamPendingStatus));
+  c.move_master(3);  // back inside (profile 8)
+  EXPECT_NEAR(c.s(), 6.0, 1e-9);
+  c.move_master(6);  // leaves at profile 10 (master 5): the pending cam takes over there
+  EXPECT_FALSE(c.r.tag("a").ip());
+  EXPECT_TRUE(c.r.tag("a").pc());
+  EXPECT_TRUE(c.r.tag("b").ac());
+  EXPECT_NEAR(c.s(), 10.0 + 1.0, 1e-9);
+}
+
 TEST(Mapc, SecondPendingOverlaysTheFirst) {
   PcRig c;
   ASSERT_EQ(c.r.exec(PcRig::mapc("a", "step", 1, 1, "once", "immediate")), Err::None);
