@@ -151,6 +151,14 @@ inline constexpr ObjectInfo kObjects[] = {
   {0x1A00, 0x1BFF, 1, 64, DT::kUnsigned32, AC::kRw, PM::kNo, "TPDO mapping parameter: mapped object"},
   // ---- canmotion emulator (manufacturer-specific area) ----------------------
   {0x2000, 0x2000, 0, 0, DT::kUnsigned16, AC::kRw, PM::kNo, "canmotion emulator: inject fault (EMCY code, 0 = none)"},
+  // ---- canmotion drive extensions for MDS (cia402.hpp obj::kRamp* / kSlat*) ----
+  {0x2010, 0x2010, 0, 0, DT::kUnsigned8, AC::kRo, PM::kNo, "Ramp velocity limits: highest sub-index supported"},
+  {0x2010, 0x2010, 1, 1, DT::kUnsigned32, AC::kRw, PM::kNo, "Ramp velocity - positive"},
+  {0x2010, 0x2010, 2, 2, DT::kUnsigned32, AC::kRw, PM::kNo, "Ramp velocity - negative"},
+  {0x2011, 0x2011, 0, 0, DT::kUnsigned8, AC::kRw, PM::kNo, "Ramp jerk - control (% of ramp time)"},
+  {0x2020, 0x2020, 0, 0, DT::kUnsigned8, AC::kRw, PM::kNo, "SLAT configuration"},
+  {0x2021, 0x2021, 0, 0, DT::kUnsigned32, AC::kRw, PM::kNo, "SLAT set point"},
+  {0x2022, 0x2022, 0, 0, DT::kUnsigned16, AC::kRw, PM::kNo, "SLAT time delay (ms)"},
   // ---- CiA 402 drive profile --------------------------------------------------
   {0x603F, 0x603F, 0, 0, DT::kUnsigned16, AC::kRo, PM::kTpdo, "Error code"},
   {0x6040, 0x6040, 0, 0, DT::kUnsigned16, AC::kRw, PM::kRpdo, "Controlword"},

@@ -62,7 +62,80 @@ inline constexpr std::uint16_t kFollowingErrorActualValue = 0x60F4;
 inline constexpr std::uint16_t kDigitalInputs = 0x60FD;
 inline constexpr std::uint16_t kTargetVelocity = 0x60FF;
 inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
+
+// ---- MDS drive-side ramps and SLAT (Logix seed 002) --------------------------
+// Standard objects carry the ramp accelerations: RampAcceleration ->
+// kProfileAcceleration (0x6083), RampDeceleration -> kProfileDeceleration
+// (0x6084), both counts/s^2, applied by the drive to the CSV target. CiA 402
+// has no direction-dependent velocity limit (0x607F is one symmetric limit for
+// every mode), no "% of ramp time" jerk and no SLAT, so these are
+// manufacturer-specific (0x2000-0x5FFF area):
+/// RECORD: sub1 RampVelocity - Positive, sub2 RampVelocity - Negative
+/// (UNSIGNED32, counts/s, magnitudes): limits of the CSV target in each direction.
+inline constexpr std::uint16_t kRampVelocityLimit = 0x2010;
+inline constexpr std::uint8_t kRampVelocityPositiveSub = 1;
+inline constexpr std::uint8_t kRampVelocityNegativeSub = 2;
+/// UNSIGNED8, 0..100: RampJerk - Control, the share (%) of a full-scale ramp
+/// spent in jerk-limited (S-curve) segments; 0 = trapezoidal.
+inline constexpr std::uint16_t kRampJerkControl = 0x2011;
+/// UNSIGNED8: SLAT Configuration (SlatConfiguration below), used in CST.
+inline constexpr std::uint16_t kSlatConfiguration = 0x2020;
+/// UNSIGNED32, counts/s: SLAT Set Point (velocity-error threshold).
+inline constexpr std::uint16_t kSlatSetPoint = 0x2021;
+/// UNSIGNED16, ms: SLAT Time Delay (how long the error must stay beyond the
+/// set point before the drive switches from torque to speed control).
+inline constexpr std::uint16_t kSlatTimeDelay = 0x2022;
 }  // namespace obj
+
+/// SLAT Configuration (0x2020) enumeration, numbers as in the Logix MDS page.
+enum class SlatConfiguration : std::uint8_t {
+  kDisabled = 0,        ///< SLAT disabled: plain torque control in CST
+  kMinSpeedTorque = 1,  ///< torque -> speed if Velocity Error > set point; back if Speed Error < 0
+  kMaxSpeedTorque = 2,  ///< torque -> speed if Velocity Error < -set point; back if Speed Error > 0
+};
+
+[[nodiscard]] constexpr std::string_view slat_name(SlatConfiguration c) noexcept {
+  switch (c) {
+    case SlatConfiguration::kDisabled: return "SLAT disabled";
+    case SlatConfiguration::kMinSpeedTorque: return "SLAT Min Speed/Torque";
+    case SlatConfiguration::kMaxSpeedTorque: return "SLAT Max Speed/Torque";
+  }
+  return "?";
+}
+
+/// The SLAT switching rule of seed 002, one SYNC at a time. `velocity_error`
+/// = velocity command (0x60FF) - actual velocity (counts/s). Going from torque
+/// to speed control needs the condition to hold for `delay_ns` (SLAT Time
+/// Delay, counted in `held_ns`, which the caller keeps between calls); going
+/// back to torque control is immediate. Returns true for speed control.
+/// Realtime-safe.
+[[nodiscard]] constexpr bool slat_speed_control(SlatConfiguration c, bool speed_control, double velocity_error,
+                                                double set_point, std::int64_t dt_ns, std::int64_t delay_ns,
+                                                std::int64_t& held_ns) noexcept {
+  bool to_speed = false;
+  bool to_torque = false;
+  switch (c) {
+    case SlatConfiguration::kDisabled: held_ns = 0; return false;
+    case SlatConfiguration::kMinSpeedTorque:
+      to_speed = velocity_error > set_point;
+      to_torque = velocity_error < 0;
+      break;
+    case SlatConfiguration::kMaxSpeedTorque:
+      to_speed = velocity_error < -set_point;
+      to_torque = velocity_error > 0;
+      break;
+  }
+  if (speed_control) {
+    held_ns = 0;
+    return !to_torque;
+  }
+  if (!to_speed) {
+    held_ns = 0;
+    return false;
+  }
+  held_ns += dt_ns;
+  return held_ns >= delay_ns;
+}
 
 // ============================================================================
 // Statusword (0x6041) and controlword (0x6040) bits

@@ -88,6 +88,16 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                         "node %u: heartbeat lost (none for %.1f ms; drive was in %.*s, statusword 0x%04X)%s", node,
                         static_cast<double>(timeout_ns) / 1e6, static_cast<int>(sn.size()), sn.data(), statusword, emcy);
       break;
+    case FailureKind::kModeSwitchTimeout: {
+      const auto rq = mode_name(mode_requested);
+      const auto sh = mode_name(mode_shown);
+      n = std::snprintf(out.data(), out.size(),
+                        "node %u: mode switch to %d (%.*s) not shown in 0x6061 within %.1f ms: drive still shows %d "
+                        "(%.*s), statusword 0x%04X%s",
+                        node, mode_requested, static_cast<int>(rq.size()), rq.data(), static_cast<double>(timeout_ns) / 1e6,
+                        mode_shown, static_cast<int>(sh.size()), sh.data(), statusword, emcy);
+      break;
+    }
     case FailureKind::kUnexpectedBootUp:
       n = std::snprintf(out.data(), out.size(), "node %u: unexpected boot-up while %.*s (drive reset itself)%s", node,
                         static_cast<int>(phase_name(phase).size()), phase_name(phase).data(), emcy);
@@ -212,6 +222,7 @@ void DriveProxy::restart() noexcept {
   state_ = State::kUnknown;
   wanted_ = State::kSwitchOnDisabled;
   in_flight_ = false;
+  mode_switch_pending_ = false;
   failure_ = Failure{};
   master_.sdo(cfg_.node).cancel_all();
 }
@@ -372,7 +383,7 @@ void DriveProxy::quick_stop() noexcept { set_wanted(State::kQuickStopActive); }
 void DriveProxy::fault_reset() noexcept {
   set_wanted(State::kSwitchOnDisabled);
   reset_requested_ = true;
-  if (failure_.kind == FailureKind::kDriveFault) failure_ = Failure{};
+  if (failure_.kind == FailureKind::kDriveFault || failure_.kind == FailureKind::kModeSwitchTimeout) failure_ = Failure{};
 }
 
 bool DriveProxy::start_homing() noexcept {
@@ -388,6 +399,10 @@ bool DriveProxy::set_mode(Mode m) noexcept {
     if (!master_.sdo(cfg_.node).download_value<std::int8_t>(obj::kModesOfOperation, 0, static_cast<std::int8_t>(m), kModeWriteTag))
       return false;
     sdo_mode_pending_ = m;
+  }
+  if (m != mode_ || fb_.mode_display != static_cast<std::int8_t>(m)) {
+    mode_switch_pending_ = true;
+    mode_switch_since_ns_ = now_ns_;
   }
   mode_ = m;
   target_position_ = fb_.position;
@@ -519,8 +534,26 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
     }
   }
   if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
+  check_mode_switch(now_ns);
   step_state_machine(now_ns);
   send_rpdos(out);
+}
+
+void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {
+  if (!mode_switch_pending_) return;
+  if (fb_.mode_display == static_cast<std::int8_t>(mode_)) {
+    mode_switch_pending_ = false;
+    return;
+  }
+  const std::int64_t waited = now_ns - mode_switch_since_ns_;
+  if (cfg_.mode_switch_timeout_ns > 0 && waited > cfg_.mode_switch_timeout_ns) {
+    mode_switch_pending_ = false;
+    if (failure_.kind == FailureKind::kNone || failure_.kind == FailureKind::kTransitionTimeout) {
+      fail(FailureKind::kModeSwitchTimeout, now_ns, waited, cfg_.mode_switch_timeout_ns);
+      failure_.mode_requested = static_cast<std::int8_t>(mode_);
+      failure_.mode_shown = fb_.mode_display;
+    }
+  }
 }
 
 void DriveProxy::on_sync_sent() noexcept { expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_; }

@@ -55,6 +55,7 @@ struct DriveConfig {
   std::int64_t sdo_timeout_ns = 200'000'000;        ///< per SDO response
   std::int64_t start_timeout_ns = 1'000'000'000;    ///< NMT start -> first TPDO
   std::int64_t transition_timeout_ns = 500'000'000; ///< per state machine transition
+  std::int64_t mode_switch_timeout_ns = 500'000'000; ///< 0x6061 must show a set_mode() request within this; 0 = unchecked
   bool reset_node_first = false;  ///< send NMT reset node instead of waiting for a boot-up first
 };
 
@@ -82,6 +83,7 @@ enum class FailureKind : std::uint8_t {
   kDriveFault,         ///< the drive went to Fault (reaction) on its own
   kHeartbeatLost,      ///< heartbeat consumer timed out
   kUnexpectedBootUp,   ///< the drive rebooted while operational
+  kModeSwitchTimeout,  ///< 0x6061 did not show the mode requested in 0x6060 in time (mode_requested / mode_shown)
 };
 
 /// A failure with everything needed to explain it.
@@ -101,6 +103,8 @@ struct Failure {
   std::uint8_t sdo_sub = 0;
   std::uint32_t sdo_abort = 0;
   std::int64_t t_ns = 0;                    ///< when it was detected
+  std::int8_t mode_requested = 0;           ///< kModeSwitchTimeout: 0x6060 written
+  std::int8_t mode_shown = 0;               ///< kModeSwitchTimeout: 0x6061 still shown
 
   /// One sentence, e.g. "node 2: transition 4 (Switched on -> Operation
   /// enabled) timed out after 500.0 ms: drive is in Switched on, statusword
@@ -230,6 +234,9 @@ class DriveProxy {
 
   Mode mode_ = Mode::kCsp;
   Mode sdo_mode_pending_ = Mode::kNoMode;
+  bool mode_switch_pending_ = false;      // set_mode() waits for 0x6061 (mode_switch_timeout_ns)
+  std::int64_t mode_switch_since_ns_ = 0;
+  void check_mode_switch(std::int64_t now_ns) noexcept;
   std::uint16_t cw_ = 0;
   std::int32_t target_position_ = 0;
   std::int32_t target_velocity_ = 0;

@@ -170,8 +170,16 @@ void Emulator::build_dictionary() {
   add(obj::kSoftwarePositionLimit, 2, 0x7FFFFFFFu);
   add(obj::kMaxProfileVelocity, 0, static_cast<std::uint32_t>(cfg_.max_velocity));
   add(obj::kProfileVelocity, 0, 100000);
-  add(obj::kProfileAcceleration, 0, 1000000);
-  add(obj::kProfileDeceleration, 0, 1000000);
+  // Ramps of CSV (MDS): by default as fast as the model can go.
+  add(obj::kProfileAcceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
+  add(obj::kProfileDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
+  add(obj::kRampVelocityLimit, 0, 2);
+  add(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub, static_cast<std::uint32_t>(cfg_.max_velocity));
+  add(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub, static_cast<std::uint32_t>(cfg_.max_velocity));
+  add(obj::kRampJerkControl, 0, 0);
+  add(obj::kSlatConfiguration, 0, 0);
+  add(obj::kSlatSetPoint, 0, 0);
+  add(obj::kSlatTimeDelay, 0, 0);
   add(obj::kQuickStopDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
   add(obj::kHomingMethod, 0, 35);
   add(obj::kHomingSpeeds, 0, 2);
@@ -233,6 +241,14 @@ void Emulator::resolve_hot() noexcept {
   h.ip_index = must_find(obj::kInterpolationTimePeriod, 2);
   h.fe_actual = must_find(obj::kFollowingErrorActualValue);
   h.target_velocity = must_find(obj::kTargetVelocity);
+  h.profile_accel = must_find(obj::kProfileAcceleration);
+  h.profile_decel = must_find(obj::kProfileDeceleration);
+  h.ramp_vpos = must_find(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub);
+  h.ramp_vneg = must_find(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub);
+  h.ramp_jerk = must_find(obj::kRampJerkControl);
+  h.slat_config = must_find(obj::kSlatConfiguration);
+  h.slat_set_point = must_find(obj::kSlatSetPoint);
+  h.slat_delay = must_find(obj::kSlatTimeDelay);
 }
 
 std::int64_t Emulator::sval(const Entry* e) noexcept {
@@ -402,6 +418,8 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
     if (m != 0 && m != 6 && m != 8 && m != 9 && m != 10) return SdoAbort::kInvalidValue;
   }
   if (index == obj::kInterpolationTimePeriod && sub == 1 && v == 0) return SdoAbort::kInvalidValue;
+  if (index == obj::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;
+  if (index == obj::kSlatConfiguration && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 2) {
     const auto i = static_cast<std::int8_t>(v);
     if (i < -9) return SdoAbort::kValueTooLow;
@@ -422,7 +440,8 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   if (index == 0x1017) next_heartbeat_ns_ = now_ns_ + static_cast<std::int64_t>(v) * 1'000'000;
   if (index == 0x1016) consumers_[static_cast<std::size_t>(std::min<std::uint8_t>(sub, 4) - 1)] = Consumer{};
   if (index == kFaultInjection && v != 0) inject_fault(static_cast<std::uint16_t>(v));
-  if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled) mode_display_ = static_cast<std::int8_t>(v);
+  if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled && !cfg_.refuse_mode_switch)
+    mode_display_ = static_cast<std::int8_t>(v);
   if (index == obj::kControlword && out_ != nullptr) apply_controlword(static_cast<std::uint16_t>(v), *out_);
   return SdoAbort::kNone;
 }
@@ -642,7 +661,8 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
                         static_cast<std::int16_t>(sval(hot_.target_torque))};
       delay_.fill(sp);
       prev_demand_ = sp.position;
-      mode_display_ = static_cast<std::int8_t>(sval(hot_.modes));
+      if (!cfg_.refuse_mode_switch) mode_display_ = static_cast<std::int8_t>(sval(hot_.modes));
+      reset_direct_model();
     }
     state_ = r.next;
     prev = cw;
@@ -686,11 +706,10 @@ void Emulator::advance_motor(double dt) noexcept {
         put(hot_.position_demand, static_cast<std::uint32_t>(sp.position));
         break;
       }
-      case cia402::Mode::kCsv: v_des = sp.velocity; break;
+      case cia402::Mode::kCsv: v_des = csv_ramp(sp.velocity, dt); break;
       case cia402::Mode::kCst: {
         const double tmax = static_cast<double>(val(hot_.max_torque));
-        torque = std::clamp(static_cast<double>(sp.torque), -tmax, tmax);
-        v_des = vel_ + torque / 1000.0 * amax * dt;
+        v_des = cst_step(std::clamp(static_cast<double>(sp.torque), -tmax, tmax), sp.velocity, dt, torque);
         break;
       }
       case cia402::Mode::kHoming:
@@ -721,6 +740,7 @@ void Emulator::advance_motor(double dt) noexcept {
   if (stop_immediately) {
     acc_ = 0;
     vel_ = 0;
+    reset_direct_model();
   } else {
     v_des = std::clamp(v_des, -vmax, vmax);
     const double dv = std::clamp(v_des - vel_, -amax * dt, amax * dt);
@@ -729,6 +749,7 @@ void Emulator::advance_motor(double dt) noexcept {
     pos_ += vel_ * dt;
   }
   const double trq = mode == cia402::Mode::kCst && state_ == State::kOperationEnabled ? torque : acc_ / cfg_.max_acceleration * 1000.0;
+  torque_ = trq;
   put(hot_.torque_actual, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(round_half_away(trq), -32768.0, 32767.0))));
   if (state_ == State::kQuickStopActive && vel_ == 0.0 && !cia402::quick_stop_stays(static_cast<std::int16_t>(sval(hot_.quick_stop_option)))) {
     state_ = State::kSwitchOnDisabled;  // transition 12 (quick stop completed)
@@ -797,13 +818,16 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
     }
     if (cw_written) apply_controlword(static_cast<std::uint16_t>(val(hot_.controlword)), out);
     const auto modes = static_cast<std::int8_t>(sval(hot_.modes));
-    if (state_ != State::kOperationEnabled) mode_display_ = modes;
+    if (cfg_.refuse_mode_switch) {
+      // fault injection: 0x6061 keeps showing the old mode
+    } else if (state_ != State::kOperationEnabled) mode_display_ = modes;
     else if (modes != mode_display_) {
       // Mode switch while enabled: the new mode starts from the present state.
       mode_display_ = modes;
       prev_demand_ = pos_;
       delay_.fill(Setpoint{position(), static_cast<std::int32_t>(sval(hot_.target_velocity)),
                            static_cast<std::int16_t>(sval(hot_.target_torque))});
+      reset_direct_model();
     }
   }
   if (cfg_.fail_after_syncs != 0 && counters_.syncs == cfg_.fail_after_syncs) pending_fault_ = cfg_.fail_emcy_code;
@@ -818,6 +842,7 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
                                         static_cast<std::int8_t>(sval(hot_.ip_index))};
   std::int64_t period_ns = cia402::interpolation_period_ns(ip);
   if (period_ns <= 0) period_ns = 1'000'000;
+  sync_period_ns_ = period_ns;
   advance_motor(static_cast<double>(period_ns) / 1e9);
   // Following error monitoring (CSP, Operation enabled).
   const auto window = static_cast<std::uint32_t>(val(hot_.fe_window));

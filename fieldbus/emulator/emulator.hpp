@@ -61,6 +61,19 @@ struct EmulatorConfig {
   std::uint64_t fail_after_syncs = 0;      ///< 0 = never
   std::uint16_t fail_emcy_code = 0x2310;   ///< code used by fail_after_syncs
   HeartbeatLossReaction heartbeat_loss_reaction = HeartbeatLossReaction::kFault;
+  /// Fault injection: accept 0x6060 writes but never show a new mode in
+  /// 0x6061 (the drive refuses the mode switch); the master's mode-switch
+  /// timeout (drive.timeouts.mode_switch_ms) must catch it.
+  bool refuse_mode_switch = false;
+  // Load model of CST (see README "Motor and load model"): motor torque T
+  // (per mille of rated torque, 0x6071 clamped to 0x6072) accelerates the
+  // motor by (T - load_torque - viscous_friction * v) / 1000 * rated_torque_acceleration.
+  double rated_torque_acceleration = 0.0;  ///< counts/s^2 at 1000 per mille; 0 = max_acceleration
+  double load_torque = 0.0;                ///< constant load, per mille, against positive rotation
+  double viscous_friction = 0.0;           ///< per mille per count/s
+  /// SLAT speed control: fraction of the velocity error corrected per SYNC
+  /// (0..1], within the torque limit 0x6072.
+  double speed_loop_gain = 0.2;
 };
 
 /// Running totals, for tests and the tool's status line.
@@ -110,6 +123,12 @@ class Emulator final : public canopen::SdoServerBackend {
   [[nodiscard]] double position_exact() const noexcept { return pos_; }
   [[nodiscard]] double velocity() const noexcept { return vel_; }
   [[nodiscard]] std::int8_t mode_display() const noexcept { return mode_display_; }
+  /// CST with SLAT 1/2: true while the drive is in speed control.
+  [[nodiscard]] bool slat_speed_control() const noexcept { return slat_speed_; }
+  /// Motor torque applied at the last SYNC (per mille of rated torque).
+  [[nodiscard]] double torque() const noexcept { return torque_; }
+  /// Fault injection at run time (see EmulatorConfig::refuse_mode_switch).
+  void set_refuse_mode_switch(bool on) noexcept { cfg_.refuse_mode_switch = on; }
   [[nodiscard]] const EmulatorCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const EmulatorConfig& config() const noexcept { return cfg_; }
   /// Read an integer object (testing aid); 0 if absent.
@@ -169,6 +188,15 @@ class Emulator final : public canopen::SdoServerBackend {
     Entry* ip_index;            // 0x60C2:2
     Entry* fe_actual;           // 0x60F4
     Entry* target_velocity;     // 0x60FF
+    // MDS ramps and SLAT (direct_model.cpp)
+    Entry* profile_accel;       // 0x6083 RampAcceleration
+    Entry* profile_decel;       // 0x6084 RampDeceleration
+    Entry* ramp_vpos;           // 0x2010:1
+    Entry* ramp_vneg;           // 0x2010:2
+    Entry* ramp_jerk;           // 0x2011
+    Entry* slat_config;         // 0x2020
+    Entry* slat_set_point;      // 0x2021
+    Entry* slat_delay;          // 0x2022
   };
   /// Per mapped PDO entry: the dictionary entry (nullptr if absent) and
   /// whether it is byte-aligned (all CiA 402 objects are).
@@ -205,6 +233,13 @@ class Emulator final : public canopen::SdoServerBackend {
   void enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept;
   void send_emcy(std::uint16_t code, canopen::FrameSink& out) noexcept;
   void advance_motor(double dt) noexcept;
+  // direct_model.cpp: MDS drive-side behaviour, kept out of the hot path's
+  // common code. csv_ramp: the next velocity towards `target` with the ramp
+  // objects (0x6083/0x6084/0x2010/0x2011). cst_step: SLAT switching and the
+  // load model; returns the next velocity and sets `torque` to the motor torque.
+  double csv_ramp(double target, double dt) noexcept;
+  double cst_step(double torque_cmd, double velocity_cmd, double dt, double& torque) noexcept;
+  void reset_direct_model() noexcept;
   void update_outputs() noexcept;
   void send_tpdos(canopen::FrameSink& out) noexcept;
 
@@ -256,6 +291,11 @@ class Emulator final : public canopen::SdoServerBackend {
   double vel_ = 0;
   double acc_ = 0;
   double prev_demand_ = 0;
+  double ramp_acc_ = 0;             // CSV ramp: acceleration of the S-curve (counts/s^2)
+  bool slat_speed_ = false;         // CST SLAT: in speed control
+  std::int64_t slat_held_ns_ = 0;   // CST SLAT: time the torque->speed condition has held
+  std::int64_t sync_period_ns_ = 1'000'000;  // period of the present SYNC (for SLAT time delay)
+  double torque_ = 0;               // motor torque at the last SYNC (per mille)
   static constexpr std::size_t kMaxLag = 64;  // bound of lag_cycles
   struct Setpoint {
     std::int32_t position;
