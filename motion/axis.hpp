@@ -50,6 +50,9 @@ struct AxisConfig {
   enum class DirectMode : std::uint8_t { Velocity = 0, Torque = 1 };
   DirectMode direct_mode = DirectMode::Velocity;
   double max_torque = 100.0;       ///< MDS torque mode: 100 % of maximum (drive torque units, e.g. per mille of rated)
+  /// MDS torque mode: initial DirectVelocityControl Command (units/s) sent
+  /// with the torque command, the drive's speed reference for SLAT 1/2.
+  double direct_velocity_command = 0.0;
   std::uint8_t group = 0;          ///< motion group index (< kMaxGroups)
   /// Exception action per ExceptionKind. Defaults: position error and drive
   /// fault stop the drive, lost node and bus-off shut down, soft overtravel stops the planner.

@@ -1353,7 +1353,7 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
     if (a.direct) {  // MDS: CSV or CST following the axis configuration
       const bool torque = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
       out->mode = torque ? DriveMode::CyclicTorque : DriveMode::CyclicVelocity;
-      out->velocity = torque ? 0.0 : (a.direct_active ? a.direct_cmd : 0.0);
+      out->velocity = a.direct_active ? (torque ? a.direct_vel_cmd : a.direct_cmd) : 0.0;
       out->torque = torque && a.direct_active ? a.direct_cmd : 0.0;
       out->acceleration = 0.0;
     }
@@ -1566,6 +1566,7 @@ Err Planner::start_mds(const Request& r, const MdsParams& p, AxisRt& a, std::int
   a.direct = true;
   a.direct_active = true;
   a.direct_cmd = cmd;
+  if (a.mds == kNoControl) a.direct_vel_cmd = a.cfg.direct_velocity_command;  // kept by a superseding MDS
   a.mds = r.control;
   a.mds_gen = c.generation;
   a.mds_stop = kNoControl;
@@ -1598,6 +1599,14 @@ void Planner::end_direct(AxisRt& a, bool keep_direct_status) noexcept {
 bool Planner::set_direct_command(AxisId id, double value) noexcept {
   if (id >= kMaxAxes || !axes_[id].direct_active || !std::isfinite(value)) return false;
   axes_[id].direct_cmd = value;
+  return true;
+}
+
+bool Planner::set_direct_velocity_command(AxisId id, double value) noexcept {
+  if (id >= kMaxAxes || !axes_[id].direct_active || !std::isfinite(value) ||
+      axes_[id].cfg.direct_mode != AxisConfig::DirectMode::Torque)
+    return false;
+  axes_[id].direct_vel_cmd = value;
   return true;
 }
 

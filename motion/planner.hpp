@@ -294,6 +294,10 @@ class Planner {
   /// of an axis in direct control, as a program writing the command tag.
   /// Returns false if the axis is not under an active MDS. Realtime-safe.
   bool set_direct_command(AxisId id, double value) noexcept;
+  /// MDS torque mode: write the DirectVelocityControl Command (units/s) sent
+  /// with the torque command (the drive's SLAT speed reference). False if the
+  /// axis is not under an active MDS in torque mode. Realtime-safe.
+  bool set_direct_velocity_command(AxisId id, double value) noexcept;
 
   /// Register the CAM_PROFILE array tag `id` (the binder's cam_profiles id).
   /// The profile must outlive the planner. Not realtime (configuration).
@@ -340,6 +344,7 @@ class Planner {
     bool direct = false;          ///< AxisStatus.DirectControlStatus (cleared only by MSO, shutdown, servo off)
     bool direct_active = false;   ///< DirectVelocity/TorqueControlStatus: the direct command is applied
     double direct_cmd = 0.0;      ///< velocity (units/s) or torque command
+    double direct_vel_cmd = 0.0;  ///< torque mode: velocity command for SLAT (units/s)
     ControlId mds = kNoControl;
     std::uint32_t mds_gen = 0;
     bool mds_waiting = false;     ///< MDS waits for the drive enable (STATE 1)
