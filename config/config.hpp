@@ -97,6 +97,23 @@ struct DriveSettings {
   std::vector<SdoWrite> sdo_writes;
 };
 
+/// An axis's `direct_control:` block (MDS, seed 002): the direct command's
+/// kind and the drive-side ramps and SLAT, in user units; written to the
+/// drive at boot (cia402.hpp obj::kProfileAcceleration .. kSlatTimeDelay).
+/// The planner part (mode, max_torque, velocity_command) is in AxisSettings::axis.
+struct DirectControlSettings {
+  bool present = false;
+  std::optional<double> ramp_acceleration;       ///< units/s^2 -> 0x6083
+  std::optional<double> ramp_deceleration;       ///< units/s^2 -> 0x6084
+  std::optional<double> ramp_velocity_positive;  ///< units/s -> 0x2010:1
+  std::optional<double> ramp_velocity_negative;  ///< units/s -> 0x2010:2
+  std::optional<std::uint8_t> ramp_jerk_control; ///< % 0..100 -> 0x2011
+  std::uint8_t slat_configuration = 0;           ///< 0 disabled, 1 min speed/torque, 2 max speed/torque -> 0x2020
+  double slat_set_point = 0.0;                   ///< units/s -> 0x2021
+  std::uint16_t slat_time_delay_ms = 0;          ///< ms -> 0x2022
+  Location where;
+};
+
 /// One `axes:` entry.
 struct AxisSettings {
   std::string name;
@@ -104,6 +121,7 @@ struct AxisSettings {
   std::string bus;          ///< AXIS_CIP_DRIVE only
   std::uint8_t node = 0;    ///< AXIS_CIP_DRIVE only: CANopen node id 1..127
   DriveSettings drive;      ///< AXIS_CIP_DRIVE only
+  DirectControlSettings direct;  ///< AXIS_CIP_DRIVE only: `direct_control:` (MDS)
   Location where;
 };
 

@@ -338,6 +338,63 @@ class Loader {
     scalar(n, path, "accel", h.accel, 0.0, 1e15, "units/s^2");
   }
 
+  /// `direct_control:` of a CIP axis (MDS): direct command kind, drive ramps, SLAT.
+  void direct_control(const YAML::Node& n, const std::string& path, AxisSettings& a) {
+    DirectControlSettings& d = a.direct;
+    motion::AxisConfig& c = a.axis;
+    d.present = true;
+    d.where = loc(n);
+    if (!check_map(n, path, {"mode", "max_torque", "velocity_command", "ramp", "slat"})) return;
+    using DM = motion::AxisConfig::DirectMode;
+    enumeration(n, path, "mode", c.direct_mode, {{"velocity", DM::Velocity}, {"torque", DM::Torque}});
+    scalar(n, path, "max_torque", c.max_torque, 1.0, 32767.0, "per mille of rated torque");
+    scalar(n, path, "velocity_command", c.direct_velocity_command, -1e12, 1e12, "units/s");
+    const double conv = c.conversion_constant;
+    // A value in user units that the drive gets in counts as UNSIGNED32.
+    auto counts = [&](const YAML::Node& m, const std::string& p, std::string_view key, std::optional<double>& out,
+                      std::string_view unit, std::string_view object) {
+      double v = 0;
+      if (!scalar(m, p, key, v, 1e-12, 1e15, unit)) return;
+      const double cnt = std::round(v * conv);
+      if (cnt < 1 || cnt > 4294967295.0) {
+        error(m[std::string(key)], sub(p, key),
+              fmt::format("{} {} x conversion_constant {} = {} counts does not fit {} (UNSIGNED32, 1 .. 4294967295)", v,
+                          unit, conv, cnt, object));
+        return;
+      }
+      out = v;
+    };
+    if (const YAML::Node r = n["ramp"]) {
+      const std::string p = path + ".ramp";
+      if (check_map(r, p, {"acceleration", "deceleration", "velocity_positive", "velocity_negative", "jerk_control"})) {
+        counts(r, p, "acceleration", d.ramp_acceleration, "units/s^2", "0x6083 profile acceleration");
+        counts(r, p, "deceleration", d.ramp_deceleration, "units/s^2", "0x6084 profile deceleration");
+        counts(r, p, "velocity_positive", d.ramp_velocity_positive, "units/s", "0x2010:1 ramp velocity - positive");
+        counts(r, p, "velocity_negative", d.ramp_velocity_negative, "units/s", "0x2010:2 ramp velocity - negative");
+        std::uint8_t j = 0;
+        if (scalar(r, p, "jerk_control", j, std::uint8_t{0}, std::uint8_t{100}, "% of the ramp time")) d.ramp_jerk_control = j;
+      }
+    }
+    if (const YAML::Node s = n["slat"]) {
+      const std::string p = path + ".slat";
+      if (check_map(s, p, {"configuration", "set_point", "time_delay_ms"})) {
+        enumeration(s, p, "configuration", d.slat_configuration,
+                    {{"SLAT disabled", std::uint8_t{0}}, {"SLAT Min Speed/Torque", std::uint8_t{1}},
+                     {"SLAT Max Speed/Torque", std::uint8_t{2}}});
+        if (scalar(s, p, "set_point", d.slat_set_point, 0.0, 1e12, "units/s") &&
+            std::round(d.slat_set_point * conv) > 4294967295.0)
+          error(s["set_point"], p + ".set_point",
+                fmt::format("{} units/s x conversion_constant {} does not fit 0x2021 (UNSIGNED32 counts/s)",
+                            d.slat_set_point, conv));
+        scalar(s, p, "time_delay_ms", d.slat_time_delay_ms, std::uint16_t{0}, std::uint16_t{65535}, "ms");
+        if (d.slat_configuration != 0 && c.direct_mode != DM::Torque)
+          error(s["configuration"] ? s["configuration"] : s, p + ".configuration",
+                fmt::format("SLAT {} needs the direct command in torque: set {}.mode: torque (SLAT acts in CST)",
+                            d.slat_configuration, path));
+      }
+    }
+  }
+
   void exception_actions(const YAML::Node& n, const std::string& path, motion::AxisConfig& a) {
     using K = motion::ExceptionKind;
     using A = motion::ExceptionAction;
@@ -361,7 +418,8 @@ class Loader {
     a.drive = defaults;
     if (!check_map(n, path, {"name", "type", "bus", "node", "units", "conversion_constant", "rotary", "unwind",
                              "max_speed", "max_accel", "max_decel", "max_accel_jerk", "max_decel_jerk",
-                             "soft_limits", "position_error_tolerance", "homing", "exception_actions", "drive"}))
+                             "soft_limits", "position_error_tolerance", "homing", "exception_actions", "drive",
+                             "direct_control"}))
       return a;
     if (!string(n, path, "name", a.name)) error(n, path + ".name", "missing: every axis needs a name");
     auto& c = a.axis;
@@ -404,8 +462,15 @@ class Loader {
       if (!n["node"]) error(n, path + ".node", "missing: an AXIS_CIP_DRIVE axis needs its drive's node id (1 .. 127)");
       scalar(n, path, "node", a.node, std::uint8_t{1}, std::uint8_t{127});
       if (n["drive"]) drive(n["drive"], path + ".drive", a.drive);
+      if (n["direct_control"]) {
+        direct_control(n["direct_control"], path + ".direct_control", a);
+        if (a.drive.pdo != cia402::PdoProfile::kCspCsvCst)
+          error(n["direct_control"], path + ".direct_control",
+                "MDS sends 0x60FF/0x6071 and switches 0x6060 cyclically: set drive.pdo: csp_csv_cst (here or under "
+                "`drives:`)");
+      }
     } else {
-      for (std::string_view k : {"bus", "node", "drive"})
+      for (std::string_view k : {"bus", "node", "drive", "direct_control"})
         if (n[std::string(k)]) error(n[std::string(k)], sub(path, k), "only an AXIS_CIP_DRIVE axis has a drive; this axis is AXIS_VIRTUAL");
     }
     if (c.rotary && c.homing.home_position >= c.unwind)

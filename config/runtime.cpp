@@ -9,6 +9,26 @@
 
 namespace canmotion::config {
 
+std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
+  std::vector<cia402::SdoWrite> w;
+  const DirectControlSettings& d = a.direct;
+  if (!d.present || a.axis.type != motion::AxisType::CipDrive) return w;
+  namespace obj = cia402::obj;
+  const double conv = a.axis.conversion_constant;
+  auto u32 = [&](std::uint16_t index, std::uint8_t sub, const std::optional<double>& v) {
+    if (v) w.push_back({index, sub, 4, static_cast<std::uint32_t>(std::llround(*v * conv))});
+  };
+  u32(obj::kProfileAcceleration, 0, d.ramp_acceleration);
+  u32(obj::kProfileDeceleration, 0, d.ramp_deceleration);
+  u32(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub, d.ramp_velocity_positive);
+  u32(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub, d.ramp_velocity_negative);
+  if (d.ramp_jerk_control) w.push_back({obj::kRampJerkControl, 0, 1, *d.ramp_jerk_control});
+  w.push_back({obj::kSlatConfiguration, 0, 1, d.slat_configuration});
+  w.push_back({obj::kSlatSetPoint, 0, 4, static_cast<std::uint32_t>(std::llround(d.slat_set_point * conv))});
+  w.push_back({obj::kSlatTimeDelay, 0, 2, d.slat_time_delay_ms});
+  return w;
+}
+
 cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s) {
   cia402::DriveConfig d;
   d.node = a.node;
@@ -22,6 +42,8 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   d.sdo_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.sdo_ms) * 1'000'000;
   d.transition_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.transition_ms) * 1'000'000;
   if (a.drive.following_error_window > 0) d.extra_writes.push_back({0x6065, 0, 4, a.drive.following_error_window});
+  d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
+  for (const cia402::SdoWrite& w : direct_control_writes(a)) d.extra_writes.push_back(w);
   for (const SdoWrite& w : a.drive.sdo_writes)
     d.extra_writes.push_back({w.index, w.sub, w.size, static_cast<std::uint32_t>(static_cast<std::int64_t>(w.value))});
   return d;

@@ -38,6 +38,10 @@ struct Runtime {
 /// SDO writes, heartbeats, PDO profile), for the controller's period.
 [[nodiscard]] cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s);
 
+/// The SDO writes of an axis's `direct_control:` (ramps 0x6083, 0x6084,
+/// 0x2010:1/2, 0x2011; SLAT 0x2020..0x2022) in drive units; empty without one.
+[[nodiscard]] std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a);
+
 /// The emulated drive standing in for a CIP axis in a simulated bus: its
 /// limits are set so that it can follow the axis's configured maxima.
 [[nodiscard]] emulator::EmulatorConfig emulator_config(const AxisSettings& a);

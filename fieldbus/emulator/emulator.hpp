@@ -129,6 +129,13 @@ class Emulator final : public canopen::SdoServerBackend {
   [[nodiscard]] double torque() const noexcept { return torque_; }
   /// Fault injection at run time (see EmulatorConfig::refuse_mode_switch).
   void set_refuse_mode_switch(bool on) noexcept { cfg_.refuse_mode_switch = on; }
+  /// Change the CST load model (see EmulatorConfig) at run time, e.g. for a
+  /// drive built from a configuration file.
+  void set_load_model(double rated_torque_acceleration, double load_torque, double viscous_friction) noexcept {
+    cfg_.rated_torque_acceleration = rated_torque_acceleration;
+    cfg_.load_torque = load_torque;
+    cfg_.viscous_friction = viscous_friction;
+  }
   [[nodiscard]] const EmulatorCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const EmulatorConfig& config() const noexcept { return cfg_; }
   /// Read an integer object (testing aid); 0 if absent.

@@ -196,7 +196,9 @@ void Controller::feedback(std::size_t a) noexcept {
   ax.prev_counts = d.position;
   ax.have_prev = d.tpdo_count > 0;
   f.drive = drive_state_of(p.state(), operational);
-  f.drive_fault = f.drive == motion::DriveState::Fault;
+  // A refused mode switch (0x6061 never showed the mode, drive.timeouts.mode_switch_ms)
+  // reaches the planner as a drive fault, handled per its exception action.
+  f.drive_fault = f.drive == motion::DriveState::Fault || p.failure().kind == cia402::FailureKind::kModeSwitchTimeout;
   f.emcy_code = p.last_emcy_code();
   f.node_lost = p.failure().kind == cia402::FailureKind::kHeartbeatLost;
   f.bus_off = buses_[static_cast<std::size_t>(ax.bus)].bus_off;
