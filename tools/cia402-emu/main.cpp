@@ -43,6 +43,10 @@ constexpr const char* kFooter = R"(Examples:
       (from another shell) SDO upload of 0x1000 from node 2: reply 582#4300100092010200
   cansend vcan0 602#2B00200011860000
       inject a following-error fault (EMCY 0x8611) through object 0x2000
+  cia402-emu -i vcan0 -n 2 --viscous-friction 0.01 --rated-torque-acceleration 1000000
+      CST with a load: torque accelerates against friction (SLAT 0x2020..0x2022)
+  cia402-emu -i vcan0 -n 2 --refuse-mode-switch
+      0x6061 never follows 0x6060: the master's mode-switch timeout fires
 
 The drive waits in NMT pre-operational until a master configures it over SDO
 and starts it (NMT 0x000 01 <node>). It sends its TPDOs on each SYNC (0x080)
@@ -73,6 +77,8 @@ int main(int argc, char** argv) {
   std::string hb_reaction = "fault";
   double duration = 0;
   bool verbose = false;
+  double rated_torque_accel = 0.0, load_torque = 0.0, viscous = 0.0;
+  bool refuse_mode = false;
   app.add_option("-i,--interface", iface, "CAN interface (vcan0, can0)")->required();
   app.add_option("-n,--node", nodes, "node-ID of an emulated drive (1..127); repeat for several drives")
       ->required()
@@ -86,6 +92,14 @@ int main(int argc, char** argv) {
   app.add_option("--heartbeat-reaction", hb_reaction, "reaction to a lost master heartbeat (0x1016)")
       ->check(CLI::IsMember({"fault", "quickstop", "none"}))
       ->default_val("fault");
+  app.add_option("--rated-torque-acceleration", rated_torque_accel,
+                 "CST load model: acceleration at 1000 per mille torque, counts/s^2 (0 = --max-acceleration)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--load-torque", load_torque, "CST load model: constant load torque, per mille (against + rotation)");
+  app.add_option("--viscous-friction", viscous, "CST load model: friction, per mille per count/s")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--refuse-mode-switch", refuse_mode,
+               "fault injection: accept 0x6060 but never show a new mode in 0x6061 (the master's mode-switch timeout)");
   app.add_option("--duration", duration, "exit after this many seconds (0 = run until SIGINT/SIGTERM)");
   app.add_flag("-v,--verbose", verbose, "print NMT and CiA 402 state changes");
   try {
@@ -125,6 +139,10 @@ int main(int argc, char** argv) {
     c.max_acceleration = max_accel;
     c.fail_after_syncs = fail_after;
     c.fail_emcy_code = code;
+    c.rated_torque_acceleration = rated_torque_accel;
+    c.load_torque = load_torque;
+    c.viscous_friction = viscous;
+    c.refuse_mode_switch = refuse_mode;
     c.heartbeat_loss_reaction = hb_reaction == "fault"       ? emulator::HeartbeatLossReaction::kFault
                                 : hb_reaction == "quickstop" ? emulator::HeartbeatLossReaction::kQuickStop
                                                              : emulator::HeartbeatLossReaction::kNone;
