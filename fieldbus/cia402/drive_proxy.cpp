@@ -353,6 +353,7 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
       if (tpdo_seen_) {
         phase_ = Phase::kOperational;
         phase_since_ns_ = now_ns;
+        mode_switch_since_ns_ = now_ns;  // a set_mode() before this waits from here
         state_ = decode_state(fb_.statusword);
         follow_actual();
       } else if (now_ns - phase_since_ns_ > cfg_.start_timeout_ns) {
