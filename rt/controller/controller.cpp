@@ -277,6 +277,18 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
       requests_[nreq++] = c.request;
     } else if (c.kind == Command::Kind::kResetControl) {
       planner_.reset_control(c.control);
+    } else if (c.kind == Command::Kind::kDirectCommand && c.axis < spec_.axes.size()) {
+      // DirectCommandVelocity is the MDS command in velocity mode and the SLAT
+      // speed reference in torque mode; DirectCommandTorque only exists in torque mode.
+      const bool torque_mode = spec_.axes[c.axis].config.direct_mode == motion::AxisConfig::DirectMode::Torque;
+      const auto id = static_cast<motion::AxisId>(c.axis);
+      if (c.direct_torque) {
+        if (torque_mode) (void)planner_.set_direct_command(id, c.value);
+      } else if (torque_mode) {
+        (void)planner_.set_direct_velocity_command(id, c.value);
+      } else {
+        (void)planner_.set_direct_command(id, c.value);
+      }
     } else if (c.kind == Command::Kind::kEnableDrives) {
       for (auto& b : buses_) b.network->enable_all();
     } else if (c.kind == Command::Kind::kPreOperational && halt_ == Halt::kRunning) {

@@ -92,11 +92,16 @@ struct Command {
     kPreOperational,  ///< controlled stop of the bus: disarm the drives' watch of the master's
                       ///< heartbeat (0x1016:01 = 0), NMT pre-operational after the last SYNC,
                       ///< then no more cyclic traffic (Status::halted)
+    kDirectCommand,   ///< MDS live command: write `value` to axis `axis`'s DirectCommandVelocity
+                      ///< (direct_torque false) or DirectCommandTorque (true); no effect without an active MDS
   };
   Kind kind = Kind::kInstruction;
   motion::Request request{};
   motion::ControlId control = motion::kNoControl;
   std::uint64_t seq = 0;  ///< set by submit(); echoed as Status::done_seq
+  std::uint16_t axis = 0;     ///< kDirectCommand
+  bool direct_torque = false; ///< kDirectCommand
+  double value = 0.0;         ///< kDirectCommand: units/s or torque units
 };
 
 /// Something the RT thread reports. Trivially copyable.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -25,7 +26,7 @@ bool iequals(std::string_view a, std::string_view b) {
 enum Attr : std::uint8_t {
   kActualPosition, kCommandPosition, kActualVelocity, kCommandVelocity, kCommandAcceleration, kPositionError,
   kMotionStatus, kAxisStatus, kAxisFault, kAxisState, kDriveState, kStatusword, kControlword, kLastEmcy,
-  kTpdoMissed, kMaxPositionError,
+  kTpdoMissed, kMaxPositionError, kDirectCommandVelocity, kDirectCommandTorque,
 };
 struct Named {
   std::string_view name;
@@ -40,6 +41,8 @@ constexpr std::array kAttrs{
     Named{"DriveState", kDriveState},           Named{"Statusword", kStatusword},
     Named{"Controlword", kControlword},         Named{"LastEmcy", kLastEmcy},
     Named{"TpdoMissed", kTpdoMissed},           Named{"MaxPositionError", kMaxPositionError},
+    // MDS live commands (writable; read back as the last value written here)
+    Named{"DirectCommandVelocity", kDirectCommandVelocity}, Named{"DirectCommandTorque", kDirectCommandTorque},
 };
 namespace ms = motion::motion_status;
 constexpr std::array kMotionBits{
@@ -156,7 +159,9 @@ std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* erro
   for (std::size_t a = 0; a < c_.axis_count(); ++a) {
     if (!iequals(c_.axis_name(static_cast<motion::AxisId>(a)), base)) continue;
     const auto id = static_cast<std::uint16_t>(a);
-    if (const Named* n = find(kAttrs, member)) return TagRef{TagRef::Kind::kAxis, id, n->value, false};
+    if (const Named* n = find(kAttrs, member))
+      return TagRef{TagRef::Kind::kAxis, id, n->value,
+                    n->value == kDirectCommandVelocity || n->value == kDirectCommandTorque};
     if (const Named* n = find(kMotionBits, member)) return TagRef{TagRef::Kind::kMotionBit, id, n->value, false};
     if (const Named* n = find(kStatusBits, member)) return TagRef{TagRef::Kind::kAxisStatusBit, id, n->value, false};
     if (const Named* n = find(kFaultBits, member)) return TagRef{TagRef::Kind::kAxisFaultBit, id, n->value, false};
@@ -224,6 +229,11 @@ double TagTable::read(const Status& s, const TagRef& t) const {
         case kControlword: return a.controlword;
         case kLastEmcy: return a.last_emcy;
         case kTpdoMissed: return static_cast<double>(a.tpdo_missed);
+        case kDirectCommandVelocity:
+        case kDirectCommandTorque: {
+          const auto it = direct_.find((static_cast<std::uint32_t>(t.index) << 8) | t.member);
+          return it == direct_.end() ? 0.0 : it->second;
+        }
         default: return a.max_abs_position_error;
       }
     }
@@ -242,6 +252,17 @@ std::optional<std::string> TagTable::write(std::string_view name, double value, 
   std::string e;
   const auto t = resolve(name, &e);
   if (t && !t->writable) return fmt::format("tag '{}' is read-only", name);
+  if (t && t->kind == TagRef::Kind::kAxis) {  // MDS live command (DirectCommandVelocity / DirectCommandTorque)
+    if (!std::isfinite(value)) return fmt::format("tag '{}' needs a finite number", name);
+    Command c;
+    c.kind = Command::Kind::kDirectCommand;
+    c.axis = t->index;
+    c.direct_torque = t->member == kDirectCommandTorque;
+    c.value = value;
+    if (c_.submit(c) == 0) return std::string("the controller's command queue is full; try again");
+    direct_[(static_cast<std::uint32_t>(t->index) << 8) | t->member] = value;
+    return std::nullopt;
+  }
   if (!t) {
     if (!create || name.find('.') != std::string_view::npos || name.empty() ||
         !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_'))

@@ -9,6 +9,8 @@
 ///                                          AxisFault bit by its Logix name,
 ///                                          e.g. X.GearingLockStatus)
 ///   X.DriveState  X.Statusword  X.Controlword  X.LastEmcy  X.TpdoMissed  (CIP drive axes)
+///   X.DirectCommandVelocity  X.DirectCommandTorque  (writable: the MDS command, live;
+///                                                    read back as the last value written)
 ///   mag1.EN .DN .ER .PC .IP .AC .ACCEL .DECEL .ERR .EXERR .STATE .SEGMENT .STATUS
 ///   cam1[0].Status    (CAM_PROFILE status: 0 not calculated, 2 calculated, n in use by n-2 cams)
 ///   Controller.Cycle  Controller.Time  and the statistics the owner registers
@@ -50,7 +52,9 @@ class TagTable {
   [[nodiscard]] double read(const Status& s, const TagRef& t) const;
   /// Resolve and read in one go.
   std::optional<double> read(const Status& s, std::string_view name, std::string* error);
-  /// Write a writable (user) tag. Creates it when `create` is true.
+  /// Write a writable tag: a user tag (created when `create` is true), or an
+  /// axis's DirectCommandVelocity / DirectCommandTorque (queued for the RT
+  /// thread; acts on an active MDS, see Command::Kind::kDirectCommand).
   std::optional<std::string> write(std::string_view name, double value, bool create);
 
   /// Extra read-only controller statistics (e.g. `Controller.LatencyMaxUs`),
@@ -67,6 +71,7 @@ class TagTable {
   Controller& c_;
   std::map<std::string, double, std::less<>> user_;  // lower-case name -> value
   std::vector<std::pair<std::string, std::function<double()>>> stats_;
+  std::map<std::uint32_t, double> direct_;  // (axis << 8 | attribute) -> last DirectCommand* written
 };
 
 }  // namespace canmotion::rt

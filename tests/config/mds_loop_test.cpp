@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -200,11 +201,16 @@ TEST(MdsLoop, VelocityRampsAndSlat1And2EndToEnd) {
   EXPECT_EQ(reached - moving, 999);  // 1000 SYNCs of +50 counts/s
   EXPECT_NEAR(l.read("V.ActualVelocity"), 50.0, 1e-9);
 
-  // ---- live command change: beyond RampVelocity - Positive, then negative ---
-  ASSERT_TRUE(l.ctl().planner().set_direct_command(0, 80.0));
+  // ---- live command change through the tag (as canmotionctl SET / a script
+  // assignment): beyond RampVelocity - Positive, then negative -------------
+  ASSERT_EQ(l.host.write("V.DirectCommandVelocity", 80.0), std::nullopt);
+  EXPECT_EQ(l.read("V.DirectCommandVelocity"), 80.0);
+  ASSERT_EQ(l.host.write("V.DirectCommandTorque", 500.0), std::nullopt);  // velocity mode: no torque command
+  EXPECT_NE(l.host.write("V.ActualVelocity", 1.0), std::nullopt);           // read-only
   for (int i = 0; i < 400; ++i) l.cycle();
   EXPECT_EQ(ev.velocity(), 60'000.0);  // 0x2010:1
-  ASSERT_TRUE(l.ctl().planner().set_direct_command(0, -70.0));
+  EXPECT_EQ(ev.read_int(0x6071), 0);
+  ASSERT_EQ(l.host.write("V.DirectCommandVelocity", -70.0), std::nullopt);
   int decel_cycles = 0, accel_cycles = 0;
   for (int i = 0; i < 1500; ++i) {
     const double v0 = ev.velocity();
@@ -248,7 +254,8 @@ TEST(MdsLoop, VelocityRampsAndSlat1And2EndToEnd) {
   EXPECT_EQ(et.mode_display(), 10);
   EXPECT_EQ(s1.to_speed, 1);  // from rest: error 8 000 > 2 000 for 5 ms
   EXPECT_NEAR(et.velocity(), 8'000, 1);
-  ASSERT_TRUE(l.ctl().planner().set_direct_velocity_command(1, 3.0));  // live: below the actual speed
+  // live, through the tag: in torque mode DirectCommandVelocity is the SLAT speed reference
+  ASSERT_EQ(l.host.write("T.DirectCommandVelocity", 3.0), std::nullopt);
   for (int i = 0; i < 800; ++i) s1.step(l);
   EXPECT_EQ(s1.to_torque, 1);  // Speed Error < 0: back to torque control (0 per mille: coasting)
   EXPECT_EQ(s1.to_speed, 2);   // below 3 000 - 2 000 for 5 ms: speed control again
@@ -265,6 +272,9 @@ TEST(MdsLoop, VelocityRampsAndSlat1And2EndToEnd) {
   EXPECT_EQ(s2.to_torque, 0);
   EXPECT_NEAR(ew.velocity(), 5'000, 1);
   EXPECT_NEAR(ew.torque(), 50, 1);  // speed control holds against the friction, not the 300 commanded
+  ASSERT_EQ(l.host.write("W.DirectCommandTorque", 120.0), std::nullopt);  // live torque command through the tag
+  for (int i = 0; i < 5; ++i) l.cycle();
+  EXPECT_EQ(ew.read_int(0x6071), 120);
 
   // ---- the trace: boot SDO writes of the ramps and SLAT, mode switches -------
   EXPECT_TRUE(l.traced(" can0 602#2383600050C30000")) << "0x6083 = 50 000";
