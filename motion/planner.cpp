@@ -236,6 +236,9 @@ void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
   if (auto* p = std::get_if<ProfileGen>(&slot); p && p->master_driven) {
     if (ControlTag* m = owner_tag(p->mdac, p->mdac_gen)) m->set(flag::AC, false);
   }
+  if (auto* cg = std::get_if<CamGen>(&slot); cg && cg->master_driven) {
+    if (ControlTag* m = owner_tag(cg->md.mdac, cg->md.mdac_gen)) m->set(flag::AC, false);
+  }
   if (const GenRef g = gen_ref(slot); g.k) {
     if (s == Slot::MasterOffset) add_master_offset(a, g.k->p);  // shifts the cam's master, not the slave
     else a.base += g.k->p;
@@ -244,6 +247,8 @@ void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
         c->set(flag::IP, false);
         c->set(flag::ACCEL, false);
         c->set(flag::DECEL, false);
+        c->set(flag::TrackingMaster, false);
+        c->set(flag::AC, false);
       }
     }
   }
@@ -334,6 +339,7 @@ Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, b
   g.master = l.master;
   g.use_actual = l.use_actual;
   g.locked = immediate;
+  g.following = immediate;  // Move/JogLockStatus set at once for immediate locks
   g.prev_mp = mp;
   g.u = 0;
   g.mdac = l.ctl;
@@ -1280,24 +1286,18 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
     auto* g = std::get_if<ProfileGen>(&a.gen[s]);
     if (!g) continue;
     bool done;
+    bool tracking = false;
     if (g->master_driven) {
       // abscissa = master travel in the lock direction [RM002H p.512]
       const AxisRt& m = axes_[g->master];
       const double mp = g->use_actual ? m.fb_pos : m.cmd.p;
-      double dm = mp - g->prev_mp;
-      const bool fwd = g->lock == LockDirection::ImmediateForwardOnly || g->lock == LockDirection::PositionForwardOnly;
-      if (!g->locked) {
-        const bool crossed = fwd ? (g->prev_mp < g->lock_pos && mp >= g->lock_pos)
-                                 : (g->prev_mp > g->lock_pos && mp <= g->lock_pos);
-        if (crossed) { g->locked = true; dm = mp - g->lock_pos; } else { dm = 0; }
-      }
-      g->prev_mp = mp;
-      const double du = g->locked ? std::max(0.0, fwd ? dm : -dm) : 0.0;
-      g->following = du > 0;
+      const double du = master_follow_step(g->lock, g->lock_pos, mp, g->prev_mp, g->locked, g->following);
       g->u += du;
       const Kin ku = g->prof.sample(g->u, g->hint);
       const double udot = du / T_;
       g->k = Kin{ku.p, ku.v * udot, ku.a * udot * udot};
+      // TrackingMaster: locked, following, and the accel transition to the programmed ratio done
+      tracking = g->locked && g->following && g->speed > 0 && std::fabs(ku.v) >= g->speed * (1 - 1e-9);
       done = g->role != GenRole::Jog && g->prof.finite() && g->u >= g->prof.duration();
     } else {
       const double t = static_cast<double>(cycle_ - g->t0_cycle) * T_;
@@ -1334,6 +1334,7 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
     if (c) {
       c->set(flag::ACCEL, g->k.v * g->k.a > 0 || (g->k.v == 0 && g->k.a != 0));
       c->set(flag::DECEL, g->k.v * g->k.a < 0);
+      if (g->master_driven) c->set(flag::TrackingMaster, tracking);
     }
     if (slot_id == Slot::MasterOffset) continue;
     sum_p += g->k.p;
@@ -1392,6 +1393,8 @@ void Planner::update_status(AxisRt& a) noexcept {
   setb(TimeCamStatus, std::holds_alternative<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]));
   setb(TimeCamPendingStatus, a.pending_cam.valid());
   position_cam_status(a, ms);
+  const auto* tc = std::get_if<CamGen>(&a.gen[static_cast<std::size_t>(Slot::TimeCam)]);
+  setb(TimeCamLockStatus, tc && tc->master_driven && tc->md.lock_status());
   const bool torque_mode = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
   setb(DirectVelocityControlStatus, a.direct_active && !torque_mode);
   setb(DirectTorqueControlStatus, a.direct_active && torque_mode);
@@ -1626,8 +1629,7 @@ void Planner::drop_pending_cam(AxisRt& a) noexcept {
 Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
   if (a.homing) return Err::HomeInProcess;
-  if (p.master_driven) return Err::FeatureNotSupported;  // master-driven MATC: not yet
-  if (p.lock_direction != LockDirection::None) return Err::MdscLockDirConflict;  // time driven needs none
+  if (Err e = matc_mode_checks(a, p); e != Err::None) return e;  // lock direction, mode, MDAC (planner_md.cpp)
   cam::CamProfile* prof = p.cam_profile < kMaxCamProfiles ? cam_profiles_[p.cam_profile] : nullptr;
   if (!prof || !prof->calculated()) return Err::CamProfileNotCalculated;
   bool bad_slave = false, bad_master = false;
@@ -1654,6 +1656,8 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
   if (active) return Err::IllegalDynamicChange;  // immediate on an axis already time camming [seed 004]
   CamGen g;
   int bad = 0;
+  if (p.master_driven)
+    if (Err e = matc_md_setup(a, p, g); e != Err::None) return e;
   if (prof->acquire() != cam::CamError::None) return Err::CamProfileNotCalculated;
   if (g.cm.start(*prof, cfg, &bad) != cam::CamError::None) {
     prof->release();
@@ -1665,6 +1669,11 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
   g.t0_cycle = cycle_;
   g.owner = r.control;
   g.owner_gen = c.generation;
+  promote_pending(a, 2);  // a queued MDAC master takes over as this MATC goes IP [seed 000]
+  if (g.master_driven) {
+    c.set(flag::AC, true);
+    if (ControlTag* m = owner_tag(g.md.mdac, g.md.mdac_gen)) m->set(flag::AC, true);
+  }
   a.gen[static_cast<std::size_t>(Slot::TimeCam)] = g;
   a.cam_dir = dir;
   c.set(flag::DN, true);
@@ -1673,7 +1682,7 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
 }
 
 void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
-  const double x = static_cast<double>(cycle_ - g.t0_cycle) * T_ - g.x_offset;
+  const double x = cam_coordinate(g);  // time, or master travel (master driven)
   cam::CamMotionOutput o = g.cm.step(x);
   // a pending cam takes over exactly at the end of the current pass [seed 004]
   const bool once = g.cm.config().mode == cam::ExecutionMode::Once;
@@ -1681,15 +1690,18 @@ void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
   g.last_pass = o.pass;
   if (a.pending_cam.valid()) {
     const double end = once ? g.cm.pass_end(0) : g.cm.pass_end(pass_before);
-    if (once ? x >= end : o.pass != pass_before) {
+    if (once ? x >= end : o.pass > pass_before) {
       const cam::CamMotionOutput at_end = g.cm.step(end);
       ControlTag* old = owner_tag(g.owner, g.owner_gen);
       if (old) {
         old->set(flag::IP, false);
+        old->set(flag::AC, false);
+        old->set(flag::TrackingMaster, false);
         if (once) old->set(flag::PC, true);  // Once: PC; Continuous: IP cleared
       }
       const std::uint64_t t0 = g.t0_cycle;
       const double xo = g.x_offset + end;
+      const CamGen md_from = g;  // the pending cam runs in this cam's mode, master and lock state [seed 000]
       g.k = Kin{at_end.position, 0, 0};
       fold(a, Slot::TimeCam, false);  // base += position at the pass end: no jump
       PendingCam pc = a.pending_cam;
@@ -1701,6 +1713,14 @@ void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
         n.x_offset = xo;
         n.owner = pc.owner;
         n.owner_gen = pc.owner_gen;
+        n.master_driven = md_from.master_driven;
+        n.md = md_from.md;
+        n.md_rate = md_from.md_rate;
+        n.md_cycle = md_from.md_cycle;
+        if (n.master_driven) {
+          if (ControlTag* nt = owner_tag(n.owner, n.owner_gen)) nt->set(flag::AC, true);
+          if (ControlTag* m = owner_tag(n.md.mdac, n.md.mdac_gen)) m->set(flag::AC, true);
+        }
         a.gen[static_cast<std::size_t>(Slot::TimeCam)] = n;
         auto& ng = std::get<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]);
         step_cam(a, ng);
@@ -1710,8 +1730,7 @@ void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
       return;
     }
   }
-  g.k = Kin{o.position, o.velocity, o.acceleration};
-  if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) c->segment = static_cast<std::int32_t>(o.segment);
+  cam_output(g, o);  // velocity x master rate when master driven; SEGMENT; TrackingMaster
   if (o.complete) {  // Once: PC, the axis holds the end position, TimeCamStatus cleared
     if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) c->set(flag::PC, true);
     fold(a, Slot::TimeCam, true);
@@ -1731,6 +1750,7 @@ void Planner::compute_order() noexcept {
       if (auto* g = std::get_if<GearGen>(&s)) m = g->master;
       if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) m = p->master;
       if (auto* pc = std::get_if<PosCamGen>(&s)) m = pc->master;
+      if (auto* cg = std::get_if<CamGen>(&s); cg && cg->master_driven) m = cg->md.master;
       if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
     }
     for (std::size_t k = n; k < kSlots; ++k) out[k] = kNoAxis;

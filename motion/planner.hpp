@@ -20,6 +20,7 @@
 #include "motion/axis.hpp"
 #include "motion/cam/cam_motion.hpp"
 #include "motion/control_tag.hpp"
+#include "motion/master_follow.hpp"
 #include "motion/profile.hpp"
 #include "motion/signatures.hpp"
 #include "motion/types.hpp"
@@ -191,6 +192,12 @@ struct CamGen {
   bool scurve = false;
   ControlId owner = kNoControl;
   std::uint32_t owner_gen = 0;
+  /// master-driven MATC (InstructionMode masterdrivenmode): cam coordinate =
+  /// master travel in the lock direction (md.u - x_offset) instead of time
+  bool master_driven = false;
+  MasterFollow md{};
+  double md_rate = 0.0;            ///< master travel per second in the lock direction, last step
+  std::uint64_t md_cycle = ~0ull;  ///< cycle md was last advanced (a takeover steps twice per cycle)
 };
 
 /// A pending MATC waiting for the end of the current pass (or for an immediate cam).
@@ -392,6 +399,11 @@ class Planner {
   double master_offset(const AxisRt& a) const noexcept;     ///< total master offset the cam sees
   const AxisConfig* position_cam_master(const AxisRt& a) const noexcept;  ///< null: no position cam (ERR 33)
   void position_cam_status(const AxisRt& a, std::uint32_t& ms) const noexcept;
+  // master-driven MATC (motion/planner_md.cpp)
+  Err matc_mode_checks(const AxisRt& a, const MatcParams& p) const noexcept;
+  Err matc_md_setup(const AxisRt& a, const MatcParams& p, CamGen& g) const noexcept;
+  double cam_coordinate(CamGen& g) noexcept;
+  void cam_output(CamGen& g, const cam::CamMotionOutput& o) noexcept;
   void drop_pending_cam(AxisRt& a) noexcept;
   void end_direct(AxisRt& a, bool keep_direct_status) noexcept;
   void break_links(AxisRt& slave) noexcept;
