@@ -93,6 +93,7 @@ constexpr std::array kControlFlags{
     Named{"EN", motion::flag::EN}, Named{"DN", motion::flag::DN}, Named{"ER", motion::flag::ER},
     Named{"PC", motion::flag::PC}, Named{"IP", motion::flag::IP}, Named{"AC", motion::flag::AC},
     Named{"ACCEL", motion::flag::ACCEL}, Named{"DECEL", motion::flag::DECEL},
+    Named{"TrackingMaster", motion::flag::TrackingMaster},
 };
 constexpr std::array kControlMembers{
     Named{"ERR", kErr}, Named{"EXERR", kExerr}, Named{"STATE", kState}, Named{"SEGMENT", kSegment},
@@ -178,7 +179,7 @@ std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* erro
     if (const Named* n = find(kControlFlags, member)) return TagRef{TagRef::Kind::kControlFlag, *ctl, n->value, false};
     if (const Named* n = find(kControlMembers, member)) return TagRef{TagRef::Kind::kControl, *ctl, n->value, false};
     if (error)
-      *error = fmt::format("'{}' is a MOTION_INSTRUCTION; members: EN DN ER PC IP AC ACCEL DECEL ERR EXERR STATE "
+      *error = fmt::format("'{}' is a MOTION_INSTRUCTION; members: EN DN ER PC IP AC ACCEL DECEL TrackingMaster ERR EXERR STATE "
                            "SEGMENT STATUS, not '{}'",
                            base, member);
     return std::nullopt;

@@ -104,5 +104,30 @@ TEST(TagTable, CipDriveAttributes) {
   EXPECT_NEAR(r.read("Controller.Time"), 0.2, 1e-12);
 }
 
+TEST(TagTable, TrackingMasterIsReadableByItsLogixName) {
+  HostRig r;
+  std::string ctl;
+  ASSERT_EQ(r.host->execute("MSO(Master, mso0)", &ctl), std::nullopt);
+  ASSERT_EQ(r.host->execute("MDAC(Master, X, mdac0, jog, command)", &ctl), std::nullopt);
+  // a master-driven jog (1 unit per master unit) on the virtual Master, slaved to X (at rest)
+  ASSERT_EQ(r.host->execute("MAJ(Master, maj0, Forward, 1, UnitsPerMasterUnit, 10, UnitsPerMasterUnit2, 10, "
+                            "UnitsPerMasterUnit2, Trapezoidal, 0, 0, UnitsPerMasterUnit3, Disabled, Programmed, 0, "
+                            "ImmediateForwardOnly)",
+                            &ctl),
+            std::nullopt);
+  r.cycles(5);
+  EXPECT_EQ(r.read("maj0.IP"), 1.0);
+  EXPECT_EQ(r.read("maj0.TrackingMaster"), 0.0);  // the master has not moved: still on the ramp
+  ASSERT_EQ(r.host->execute("MSO(X, mso1)", &ctl), std::nullopt);
+  r.cycles(500);
+  ASSERT_EQ(r.read("X.ServoActionStatus"), 1.0);
+  ASSERT_EQ(r.host->execute("MAJ(X, maj1, Forward, 10, UnitsPerSec, 1000, UnitsPerSec2, 1000, UnitsPerSec2, "
+                            "Trapezoidal, 100, 100, %ofTime, Disabled, Programmed, 0, None)",
+                            &ctl),
+            std::nullopt);
+  r.cycles(200);
+  EXPECT_EQ(r.read("MAJ0.trackingmaster"), 1.0);  // ramp done: tracking (case-insensitive like every Logix name)
+}
+
 }  // namespace
 }  // namespace canmotion::rt
