@@ -340,6 +340,7 @@ Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, b
   g.use_actual = l.use_actual;
   g.locked = immediate;
   g.following = immediate;  // Move/JogLockStatus set at once for immediate locks
+  g.lock_pos -= m.frame_offset;  // LockPosition is a master position (user frame); mp is drive frame
   g.prev_mp = mp;
   g.u = 0;
   g.mdac = l.ctl;

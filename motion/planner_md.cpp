@@ -48,7 +48,7 @@ Err Planner::matc_md_setup(const AxisRt& a, const MatcParams& p, CamGen& g) cons
   g.md.master = l.master;
   g.md.use_actual = l.use_actual;
   g.md.lock = p.lock_direction;
-  g.md.lock_pos = p.lock_position;
+  g.md.lock_pos = p.lock_position - m.frame_offset;  // user frame (MRP, homing) -> drive frame
   // None and Immediate locks: locked from the start (TimeCamLockStatus set at once
   // for Immediate); Position locks wait for the master to cross LockPosition [seed 004]
   g.md.locked = p.lock_direction == LockDirection::None || lock_immediate(p.lock_direction);

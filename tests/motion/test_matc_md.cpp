@@ -435,3 +435,28 @@ TEST(TrackingMaster, MasterDrivenMoveTracksInCruiseOnly) {
   EXPECT_FALSE(tracked_in_ramp);
   EXPECT_FALSE(m.r.tag("m").get(flag::TrackingMaster));  // cleared at PC
 }
+
+// LockPosition is a master position as the user sees it (after MRP / homing).
+TEST(MatcMd, LockPositionIsInTheMastersUserFrame) {
+  for (const bool cam : {true, false}) {
+    SCOPED_TRACE(cam ? "MATC" : "MAM");
+    MdRig m;
+    ASSERT_EQ(m.r.exec("MRP(X, mrp, absolute, command, 100);"), Err::None);  // X user position 100 (drive 0)
+    m.r.exec("MDAC(Y, X, l, all, command);");
+    if (cam) {
+      ASSERT_EQ(m.r.exec(md_matc("t", "fast", 1, 1, "continuous", "immediate", 102.0, "positionforwardonly")),
+                Err::None);
+    } else {
+      ASSERT_EQ(m.r.exec("MAM(Y,t,incremental,100,1,unitspermasterunit,1e6,unitspermasterunit2,1e6,"
+                         "unitspermasterunit2,trapezoidal,0,0,unitspermasterunit3,disabled,programmed,102,"
+                         "positionforwardonly,0,0);"),
+                Err::None);
+    }
+    m.jog("X", "jx", 10);
+    m.r.step(150);  // user 101.5
+    EXPECT_EQ(m.pos("Y"), 0.0);
+    m.r.step(100);  // user 102.5
+    EXPECT_GT(m.pos("Y"), 0.0);
+    EXPECT_NEAR(m.pos("Y"), (cam ? 10.0 : 1.0) * (m.pos("X") - 102.0), 1e-6);
+  }
+}
