@@ -122,6 +122,35 @@ void BM_StepPositionCam1000Cubic(benchmark::State& st) {
     if (!b.p->control(static_cast<ControlId>(100 + i + 1)).ip()) throw std::runtime_error("MAPC refused");
   }
   b.step();
+// MATC on a 1000-point cubic profile: half the axes are virtual masters
+// jogging, each other axis runs the cam, master driven (through an MDAC Time
+// Cam link, forward-only lock) or time driven for comparison. One pass is 10
+// master units (0.1 s at 100 units/s), so every segment of the profile is
+// visited many times. ns_per_cam = planner step / number of cam axes.
+void cam_bench(benchmark::State& st, bool master_driven) {
+  Bench b;
+  constexpr int kPoints = 1000;
+  std::vector<cam::CamPoint> pts(kPoints);
+  for (int i = 0; i < kPoints; ++i) {
+    const double x = 0.01 * i;
+    pts[static_cast<std::size_t>(i)] = cam::CamPoint{x, 5.0 * x - std::sin(6.283185307179586 * x / 10.0), 1};
+  }
+  auto prof = std::make_unique<cam::CamProfile>(kPoints);
+  if (!cam::mccp(cam::MccpRequest{pts, 0, kPoints, 0.0, 0.0}, *prof).ok()) throw std::runtime_error("mccp");
+  b.p->attach_cam_profile(0, prof.get());
+  b.sym.cam_profiles["prof"] = 0;
+  for (int i = 0; i < kAxes; i += 2) {
+    const std::string m = "a" + std::to_string(i), s = "a" + std::to_string(i + 1);
+    b.sym.controls["md" + std::to_string(i)] = static_cast<ControlId>(200 + i);
+    b.run("MAJ(" + m + ", mv" + std::to_string(i) +
+          ", 0, 100, unitspersec, 1e6, unitspersec2, 1e6, unitspersec2, trapezoidal, 0, 0, unitspersec3, disabled, programmed, 0, none);");
+    if (master_driven) b.run("MDAC(" + s + ", " + m + ", md" + std::to_string(i) + ", timecam, command);");
+    b.run("MATC(" + s + ", mv" + std::to_string(i + 1) + ", same, prof[0], 1, " + (master_driven ? "1" : "0.01") +
+          ", continuous, immediate, 0, " + (master_driven ? "immediateforwardonly, masterdrivenmode);" : "none, timedrivenmode);"));
+  }
+  b.step();
+  for (int i = 1; i < kAxes; i += 2)
+    if (!b.p->axis(static_cast<AxisId>(i)).motion(motion_status::TimeCamStatus)) throw std::runtime_error("cam not running");
   for (auto _ : st) {
     b.step();
     benchmark::DoNotOptimize(b.out[1].position);
@@ -131,6 +160,12 @@ void BM_StepPositionCam1000Cubic(benchmark::State& st) {
   st.counters["ns_per_cam_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes / 2),
                                                       benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
+  if (!(b.p->axis(1).command_velocity > 0)) throw std::runtime_error("cam not moving");
+  st.counters["ns_per_cam"] = benchmark::Counter(static_cast<double>(st.iterations() * (kAxes / 2)),
+                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+void BM_StepCamMasterDriven1000(benchmark::State& st) { cam_bench(st, true); }
+void BM_StepCamTimeDriven1000(benchmark::State& st) { cam_bench(st, false); }
 
 // plan_move for an S-curve from a moving state (a merge): the planning maths alone
 void BM_PlanSCurveMoveFromMotion(benchmark::State& st) {
@@ -195,6 +230,8 @@ BENCHMARK(BM_StepJog);
 BENCHMARK(BM_StepGearReal);
 BENCHMARK(BM_StepGearFractional);
 BENCHMARK(BM_StepPositionCam1000Cubic);
+BENCHMARK(BM_StepCamMasterDriven1000);
+BENCHMARK(BM_StepCamTimeDriven1000);
 BENCHMARK(BM_PlanSCurveMoveFromMotion);
 BENCHMARK(BM_PlanSCurveMoveRestToRest);
 BENCHMARK(BM_StartSCurveMam);
