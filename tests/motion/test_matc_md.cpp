@@ -460,3 +460,17 @@ TEST(MatcMd, LockPositionIsInTheMastersUserFrame) {
     EXPECT_NEAR(m.pos("Y"), (cam ? 10.0 : 1.0) * (m.pos("X") - 102.0), 1e-6);
   }
 }
+
+// The master is stepped before its cam slave even when its axis id is higher:
+// the slave sees the master's command of the same cycle (no one-cycle lag).
+TEST(MatcMd, MasterWithAHigherAxisIdIsSteppedFirst) {
+  MdRig m;
+  ASSERT_EQ(m.r.exec("MDAC(Y, Z, l, timecam, command);"), Err::None);  // Z (id 2) drives Y (id 1)
+  ASSERT_EQ(m.r.exec(md_matc("t", "fast", 1, 1, "continuous", "immediate", 0, "immediateforwardonly")), Err::None);
+  m.jog("Z", "jz", 10);
+  for (int i = 0; i < 50; ++i) {
+    m.r.step();
+    ASSERT_NEAR(m.pos("Y"), 10.0 * m.pos("Z"), 1e-9) << "cycle " << i;
+  }
+  EXPECT_GT(m.pos("Y"), 0.0);
+}

@@ -264,7 +264,7 @@ TEST(Seed000Mdac, MasterReferenceChangeOfAMovingSlaveErrsAndKeepsTheOriginal) {
   r.exec("MSO(M, a);");
   r.exec("MSO(S, b);");
   r.step();
-  // at rest: the reference may change (same master: no queue, takes effect)
+  // at rest the reference may change: l1 is queued and takes effect when the MATC goes IP
   ASSERT_EQ(r.exec("MDAC(S, M, l0, timecam, actual);"), Err::None);
   ASSERT_EQ(r.exec("MDAC(S, M, l1, timecam, command);"), Err::None);
   ASSERT_EQ(r.exec(matc("S", "c", "p", "immediate")), Err::None);
