@@ -11,7 +11,6 @@
 ///   X.DriveState  X.Statusword  X.Controlword  X.LastEmcy  X.TpdoMissed  (CIP drive axes)
 ///   X.DirectCommandVelocity  X.DirectCommandTorque  (writable: the MDS command, live;
 ///                                                    read back as the last value written)
-///   mag1.EN .DN .ER .PC .IP .AC .ACCEL .DECEL .ERR .EXERR .STATE .SEGMENT .STATUS
 ///   mag1.EN .DN .ER .PC .IP .AC .ACCEL .DECEL .TrackingMaster .ERR .EXERR .STATE .SEGMENT .STATUS
 ///   cam1[0].Status    (CAM_PROFILE status: 0 not calculated, 2 calculated, n in use by n-2 cams)
 ///   Controller.Cycle  Controller.Time  and the statistics the owner registers

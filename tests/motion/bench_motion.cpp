@@ -122,6 +122,16 @@ void BM_StepPositionCam1000Cubic(benchmark::State& st) {
     if (!b.p->control(static_cast<ControlId>(100 + i + 1)).ip()) throw std::runtime_error("MAPC refused");
   }
   b.step();
+  for (auto _ : st) {
+    b.step();
+    benchmark::DoNotOptimize(b.out[1].position);
+  }
+  st.counters["ns_per_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes),
+                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["ns_per_cam_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes / 2),
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // MATC on a 1000-point cubic profile: half the axes are virtual masters
 // jogging, each other axis runs the cam, master driven (through an MDAC Time
 // Cam link, forward-only lock) or time driven for comparison. One pass is 10
@@ -155,11 +165,6 @@ void cam_bench(benchmark::State& st, bool master_driven) {
     b.step();
     benchmark::DoNotOptimize(b.out[1].position);
   }
-  st.counters["ns_per_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes),
-                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  st.counters["ns_per_cam_axis"] = benchmark::Counter(static_cast<double>(st.iterations() * kAxes / 2),
-                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-}
   if (!(b.p->axis(1).command_velocity > 0)) throw std::runtime_error("cam not moving");
   st.counters["ns_per_cam"] = benchmark::Counter(static_cast<double>(st.iterations() * (kAxes / 2)),
                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);

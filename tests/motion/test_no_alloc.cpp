@@ -44,7 +44,7 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
   r.add_axis("C", e);
   r.add_axis("P", e);  // position cam slave of X (MAPC, master offset moves)
   r.add_axis("S", e);  // master-driven MATC slave of X
-  r.add_axis("P", e);  // master-driven MATC with a position lock
+  r.add_axis("Q", e);  // master-driven MATC with a position lock
   cam::CamProfile prof(8);  // allocated at configuration time
   const std::array<cam::CamPoint, 3> pts{{{0.0, 0.0, 1}, {0.5, 2.0, 1}, {1.0, 3.0, 1}}};
   ASSERT_TRUE(cam::mccp(cam::MccpRequest{pts, 0, 3, 0.0, 0.0}, prof).ok());
@@ -78,14 +78,14 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
       r.req("MAS(P, s3, positioncam, no, 0, unitspersec2, no, 0, unitspersec3);"),
       r.req("MAPC(P, X, pc3, same, prof[0], 1, 1, persistent, bidirectional, 5, 0, command, reverseonly);"),
       // master-driven MATC with lock directions, pending blend, reversal, stop
-      r.req("MSO(S, on4);"), r.req("MSO(P, on5);"),
-      r.req("MDAC(S, X, lt, timecam, command);"), r.req("MDAC(P, X, lp, all, command);"),
+      r.req("MSO(S, on6);"), r.req("MSO(Q, on7);"),
+      r.req("MDAC(S, X, lt, timecam, command);"), r.req("MDAC(Q, X, lp, all, command);"),
       r.req("MATC(S, mt, same, prof[0], 1, 1, continuous, immediate, 0, immediatereverseonly, masterdrivenmode);"),
-      r.req("MATC(P, mp, opposite, prof[0], 1, 2, continuous, immediate, 26, positionreverseonly, masterdrivenmode);"),
+      r.req("MATC(Q, mp, opposite, prof[0], 1, 2, continuous, immediate, 45, positionreverseonly, masterdrivenmode);"),
       r.req("MATC(S, mt2, same, prof[0], 2, 1, once, pending, 0, immediateforwardonly, masterdrivenmode);"),
       r.req(maj("X", "jr", 1, 20, 1000, 1000)),
       r.req(maj("X", "jf", 0, 20, 1000, 1000)),
-      r.req("MAJ(P,mj,forward,1,unitspermasterunit,10,unitspermasterunit2,10,unitspermasterunit2,trapezoidal,0,0,"
+      r.req("MAJ(Q,mj,forward,1,unitspermasterunit,10,unitspermasterunit2,10,unitspermasterunit2,trapezoidal,0,0,"
             "unitspermasterunit3,disabled,programmed,0,immediateforwardonly);"),
       r.req("MAS(S, st, timecam, no, 0, unitspersec2, no, 0, unitspersec3);"),
       r.req("MGS(g, gs, faststop);"),
@@ -99,7 +99,7 @@ TEST(NoAlloc, UpdateAndExecuteAllocateNothing) {
     for (int k = 0; k < 200; ++k) {
       r.step();
       s_locked = s_locked || r.axis("S").motion(motion_status::TimeCamLockStatus);
-      p_locked = p_locked || r.axis("P").motion(motion_status::TimeCamLockStatus);
+      p_locked = p_locked || r.axis("Q").motion(motion_status::TimeCamLockStatus);
       blended = blended || r.tag("mt2").ac();
     }
   }
