@@ -511,6 +511,7 @@ Err Planner::execute(const Request& r) noexcept {
           else if constexpr (std::is_same_v<P, MdsParams>) return start_mds(r, p, axes_[p.axis], exerr);
           else if constexpr (std::is_same_v<P, MatcParams>) return start_matc(r, p, axes_[p.axis], exerr);
           else if constexpr (std::is_same_v<P, MapcParams>) return start_mapc(r, p, axes_[p.slave], exerr);
+          else if constexpr (std::is_same_v<P, MccpParams>) return start_mccp(r, p, exerr);
           else if constexpr (std::is_same_v<P, MgsParams>) return start_group(r, p.group, p.mode, exerr);
           else if constexpr (std::is_same_v<P, MgsdParams> || std::is_same_v<P, MgsrParams>)
             return start_group(r, p.group, GroupStopMode::Programmed, exerr);
@@ -816,6 +817,7 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   else if (old) start = Kin{0, old->k.v, old->scurve ? old->k.a : 0.0};
   const Kin rest = offset ? (old ? old->k : Kin{}) : a.cmd;
   if (dy.seconds && (rest.v != 0 || rest.a != 0)) return Err::AxisNotAtRest;
+  if (Err e = check_event_distance(r, exerr); e != Err::None) return e;  // planner_mccp.cpp
   // distance
   const double cur = user_command(a);
   const double U = a.cfg.unwind;
@@ -918,6 +920,7 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
     c.set(flag::AC, true);
     if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
   }
+  write_calculated_data(r, g, c);  // planner_mccp.cpp
   a.gen[static_cast<std::size_t>(slot)] = g;
   if (g.speed > 0) a.last_speed = g.speed;
   c.set(flag::DN, true);

@@ -250,6 +250,13 @@ struct PendingPosCam {
 
 /// Capacity of the CAM_PROFILE registry (config: one entry per CAM_PROFILE array tag).
 inline constexpr std::size_t kMaxCamProfiles = 64;
+/// Capacity of the CAM array registry (config `arrays:` entries of type CAM,
+/// the operands of MCCP). Bound: like CAM_PROFILE arrays, one per cam table.
+inline constexpr std::size_t kMaxCamArrays = 64;
+/// Capacity of the REAL array registry (config `arrays:` entries of type
+/// REAL: MAM EventDistance / CalculatedData). Bound: one pair per axis that
+/// reports events.
+inline constexpr std::size_t kMaxRealArrays = 64;
 
 /// Per-axis generator slots. Generators superpose: the command position is
 /// base + the sum of the slot offsets. Bound: one slot per kind of motion
@@ -272,6 +279,7 @@ struct MdacParams;
 struct MdsParams;
 struct MatcParams;
 struct MapcParams;
+struct MccpParams;
 
 // ------------------------------------------------------------------ planner
 /// The planner. All state is inside (fixed arrays); update() is noexcept,
@@ -309,6 +317,14 @@ class Planner {
   /// Register the CAM_PROFILE array tag `id` (the binder's cam_profiles id).
   /// The profile must outlive the planner. Not realtime (configuration).
   bool attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noexcept;
+  /// Register the CAM array tag `id` (the binder's cams id): MCCP reads its
+  /// points. The storage must outlive the planner and is written only by the
+  /// thread running update() (motion/planner_mccp.cpp). Not realtime.
+  bool attach_cam_array(std::uint16_t id, std::span<cam::CamPoint> points) noexcept;
+  /// Register the REAL array tag `id` (the binder's real_arrays id): MAM
+  /// reads EventDistance from it and writes CalculatedData into it. Same
+  /// ownership rules as attach_cam_array. Not realtime.
+  bool attach_real_array(std::uint16_t id, std::span<double> values) noexcept;
 
   /// Axis tag (status) of an axis. Realtime-safe.
   const AxisTag& axis(AxisId id) const noexcept { return axes_[id].tag; }
@@ -389,6 +405,10 @@ class Planner {
   Err start_mdac(const Request&, const MdacParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_mds(const Request&, const MdsParams&, AxisRt&, std::int8_t& exerr) noexcept;
   Err start_matc(const Request&, const MatcParams&, AxisRt&, std::int8_t& exerr) noexcept;
+  // motion/planner_mccp.cpp: MCCP, MAM EventDistance / CalculatedData
+  Err start_mccp(const Request&, const MccpParams&, std::int8_t& exerr) noexcept;
+  Err check_event_distance(const Request&, std::int8_t& exerr) const noexcept;
+  void write_calculated_data(const Request&, const ProfileGen& g, ControlTag& c) noexcept;
   void step_cam(AxisRt& a, CamGen& g) noexcept;
   // MAPC and master offset moves (motion/planner_mapc.cpp)
   Err start_mapc(const Request&, const MapcParams&, AxisRt&, std::int8_t& exerr) noexcept;
@@ -441,6 +461,8 @@ class Planner {
   std::array<ControlTag, kMaxControlTags> controls_{};
   std::array<GroupOp, kMaxGroups> groups_{};
   std::array<cam::CamProfile*, kMaxCamProfiles> cam_profiles_{};
+  std::array<std::span<cam::CamPoint>, kMaxCamArrays> cam_arrays_{};
+  std::array<std::span<double>, kMaxRealArrays> real_arrays_{};
   std::array<AxisId, kMaxAxes> order_{};  ///< step order: masters before slaves
   std::size_t order_n_ = 0;
 };

@@ -179,7 +179,7 @@ constexpr std::array<InstrSig, kInstrCount> kTable{{
     {Instr::MAG, "MAG", kMag, true},
     {Instr::MCD, "MCD", kMcd, true},
     {Instr::MRP, "MRP", kMrp, true},
-    {Instr::MCCP, "MCCP", kMccp, false},
+    {Instr::MCCP, "MCCP", kMccp, true},
     {Instr::MAPC, "MAPC", kMapc, true},
     {Instr::MATC, "MATC", kMatc, true},
     {Instr::MDAC, "MDAC", kMdac, true},

@@ -56,6 +56,7 @@ std::string_view err_name(Err e) noexcept {
     case Err::MdscInvalidModeOrMasterChange: return "MDSC Invalid Mode Or Master Change";
     case Err::FeatureNotSupported: return "Feature Not Supported";
     case Err::AxisNotAtRest: return "Axis Not At Rest";
+    case Err::CalculatedDataArraySize: return "Calculated Data Array Size Error";
   }
   return "Unknown Error";
 }

@@ -163,6 +163,7 @@ enum class Err : std::int16_t {
   MdscIdleMasterSlaveMoving = 97,
   FeatureNotSupported = 99,
   AxisNotAtRest = 100,
+  CalculatedDataArraySize = 101,  ///< MAM CalculatedData shorter than EventDistance (reference 3.3)
   MdscInvalidModeOrMasterChange = 105,
 };
 
