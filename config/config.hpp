@@ -141,6 +141,25 @@ struct CamSettings {
   Location where;
 };
 
+/// One `arrays:` entry: a Logix array tag that programs read and write at
+/// run time. CAM arrays hold MCCP's input points, CAM_PROFILE arrays receive
+/// MCCP's result, REAL arrays are MAM EventDistance / CalculatedData operands.
+struct ArraySettings {
+  enum class Type : std::uint8_t { kCam, kCamProfile, kReal };
+  /// Largest CAM / CAM_PROFILE array: bounds MCCP's run time in the cycle
+  /// (O(points); see motion/cam/README.md "MCCP as an instruction").
+  static constexpr std::size_t kMaxCamElements = 10000;
+  /// All REAL array elements together: they are published in the status
+  /// snapshot every cycle (rt::kMaxRealElements).
+  static constexpr std::size_t kMaxRealElements = 1024;
+  std::string name;
+  Type type = Type::kReal;
+  std::size_t size = 0;                ///< declared dimension (elements)
+  std::vector<CamPoint> cam_values;    ///< CAM: initial points (the rest are 0, linear)
+  std::vector<double> real_values;     ///< REAL: initial values (the rest are 0)
+  Location where;
+};
+
 /// A whole, validated configuration.
 struct Config {
   std::string path;
@@ -148,6 +167,7 @@ struct Config {
   std::vector<BusSettings> buses;
   std::vector<AxisSettings> axes;
   std::vector<CamSettings> cams;
+  std::vector<ArraySettings> arrays;  ///< `arrays:` (CAM, CAM_PROFILE and REAL array tags)
   std::vector<Diagnostic> warnings;  ///< e.g. bus load over 70 %
 
   [[nodiscard]] const BusSettings* find_bus(std::string_view name) const noexcept;

@@ -22,6 +22,7 @@
 #include "config/config.hpp"
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/cob_id.hpp"
+#include "motion/planner.hpp"
 
 namespace canmotion::config {
 
@@ -516,6 +517,59 @@ class Loader {
     return c;
   }
 
+  /// One `arrays:` entry: {name, type: CAM | CAM_PROFILE | REAL, size, values}.
+  ArraySettings array(const YAML::Node& n, const std::string& path) {
+    using T = ArraySettings::Type;
+    ArraySettings a;
+    a.where = loc(n);
+    if (!check_map(n, path, {"name", "type", "size", "values"})) return a;
+    if (!string(n, path, "name", a.name)) error(n, path + ".name", "missing: every array needs a name");
+    if (!n["type"]) error(n, path + ".type", "missing: CAM, CAM_PROFILE or REAL");
+    else enumeration(n, path, "type", a.type, {{"CAM", T::kCam}, {"CAM_PROFILE", T::kCamProfile}, {"REAL", T::kReal}});
+    const std::size_t max = a.type == T::kReal ? ArraySettings::kMaxRealElements : ArraySettings::kMaxCamElements;
+    if (!n["size"]) error(n, path + ".size", fmt::format("missing: the number of elements, 1 .. {}", max));
+    else scalar(n, path, "size", a.size, std::size_t{1}, max, "elements");
+    const YAML::Node v = n["values"];
+    if (!v) return a;
+    const std::string vp = path + ".values";
+    if (a.type == T::kCamProfile) {
+      error(v, vp, "a CAM_PROFILE array has no initial values: MCCP calculates it");
+      return a;
+    }
+    if (!v.IsSequence()) {
+      error(v, vp, a.type == T::kCam ? "must be a list of [master, slave] or [master, slave, linear|cubic]"
+                                     : "must be a list of numbers");
+      return a;
+    }
+    if (a.size > 0 && v.size() > a.size)
+      error(v, vp, fmt::format("{} values do not fit in size {}", v.size(), a.size));
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const YAML::Node e = v[i];
+      const std::string key = fmt::format("{}[{}]", vp, i);
+      if (a.type == T::kReal) {
+        double x = 0;
+        if (!e.IsScalar() || !YAML::convert<double>::decode(e, x) || !std::isfinite(x))
+          error(e, key, fmt::format("must be a finite number, got '{}'", e.IsScalar() ? e.Scalar() : "<non-scalar>"));
+        a.real_values.push_back(x);
+        continue;
+      }
+      CamPoint cp;
+      if (!e.IsSequence() || (e.size() != 2 && e.size() != 3) || !YAML::convert<double>::decode(e[0], cp.master) ||
+          !YAML::convert<double>::decode(e[1], cp.slave) || !std::isfinite(cp.master) || !std::isfinite(cp.slave)) {
+        error(e, key, "must be [master, slave] or [master, slave, linear|cubic] with finite numbers");
+        continue;
+      }
+      if (e.size() == 3) {
+        const std::string t = lower_compact(e[2].Scalar());
+        if (t == "cubic" || t == "1") cp.cubic = true;
+        else if (t != "linear" && t != "0")
+          error(e[2], key, fmt::format("segment type must be linear (0) or cubic (1), got '{}'", e[2].Scalar()));
+      }
+      a.cam_values.push_back(cp);
+    }
+    return a;
+  }
+
   Config document(const YAML::Node& root) {
     Config cfg;
     cfg.path = file_;
@@ -523,7 +577,7 @@ class Loader {
       error_at({1, 1}, "", "the file is empty; it needs at least `axes:`");
       return cfg;
     }
-    if (!check_map(root, "", {"controller", "buses", "drives", "axes", "cams"})) return cfg;
+    if (!check_map(root, "", {"controller", "buses", "drives", "axes", "cams", "arrays"})) return cfg;
     if (root["controller"]) cfg.controller = controller(root["controller"]);
     if (const YAML::Node b = root["buses"]) {
       if (!b.IsSequence()) error(b, "buses", "must be a list of buses");
@@ -544,10 +598,45 @@ class Loader {
       else
         for (std::size_t i = 0; i < c.size(); ++i) cfg.cams.push_back(cam(c[i], fmt::format("cams[{}]", i)));
     }
+    if (const YAML::Node a = root["arrays"]) {
+      if (!a.IsSequence()) error(a, "arrays", "must be a list of {name, type, size, values}");
+      else
+        for (std::size_t i = 0; i < a.size(); ++i) cfg.arrays.push_back(array(a[i], fmt::format("arrays[{}]", i)));
+    }
     return cfg;
   }
 
   // ---- cross-checks ---------------------------------------------------------
+  /// `arrays:` names (unique among cams, arrays and axes) and the registry
+  /// capacities (motion::kMaxCamArrays, kMaxCamProfiles, kMaxRealArrays,
+  /// ArraySettings::kMaxRealElements).
+  template <class Unique>
+  void array_checks(const Config& cfg, Unique& unique) {
+    using T = ArraySettings::Type;
+    std::size_t cams = 0, profiles = cfg.cams.size(), reals = 0, real_elems = 0;
+    for (std::size_t i = 0; i < cfg.arrays.size(); ++i) {
+      const ArraySettings& a = cfg.arrays[i];
+      const std::string key = fmt::format("arrays[{}]", i);
+      unique(a.name, a.where, key + ".name", "tag");
+      if (!a.name.empty() && (a.name.find_first_of(".[] ") != std::string::npos ||
+                              !(std::isalpha(static_cast<unsigned char>(a.name[0])) || a.name[0] == '_')))
+        error_at(a.where, key + ".name",
+                 fmt::format("'{}' is not a tag name (a letter or '_', then letters, digits or '_')", a.name));
+      if (a.type == T::kCam && ++cams == motion::kMaxCamArrays + 1)
+        error_at(a.where, key, fmt::format("at most {} CAM arrays", motion::kMaxCamArrays));
+      if (a.type == T::kCamProfile && ++profiles == motion::kMaxCamProfiles + 1)
+        error_at(a.where, key, fmt::format("at most {} CAM_PROFILE arrays, `cams:` entries included", motion::kMaxCamProfiles));
+      if (a.type == T::kReal) {
+        if (++reals == motion::kMaxRealArrays + 1) error_at(a.where, key, fmt::format("at most {} REAL arrays", motion::kMaxRealArrays));
+        real_elems += a.size;
+        if (real_elems > ArraySettings::kMaxRealElements && real_elems - a.size <= ArraySettings::kMaxRealElements)
+          error_at(a.where, key + ".size",
+                   fmt::format("REAL arrays may hold {} elements together; this one brings the total to {}",
+                               ArraySettings::kMaxRealElements, real_elems));
+      }
+    }
+  }
+
   void cross_check(Config& cfg) {
     std::map<std::string, Location> names;
     auto unique = [&](const std::string& name, Location l, const std::string& key, const char* what) {
@@ -560,6 +649,7 @@ class Loader {
     names.clear();
     for (std::size_t i = 0; i < cfg.axes.size(); ++i) unique(cfg.axes[i].name, cfg.axes[i].where, fmt::format("axes[{}].name", i), "axis");
     for (std::size_t i = 0; i < cfg.cams.size(); ++i) unique(cfg.cams[i].name, cfg.cams[i].where, fmt::format("cams[{}].name", i), "tag");
+    array_checks(cfg, unique);
 
     const auto ip = interpolation_period(cfg.controller.period_s);
     if (!ip)

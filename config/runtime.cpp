@@ -125,6 +125,18 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       cs.points.push_back({p.master, p.slave, p.cubic ? motion::cam::kSegmentCubic : motion::cam::kSegmentLinear});
     spec.cams.push_back(std::move(cs));
   }
+  for (const ArraySettings& a : cfg.arrays) {
+    rt::ArraySpec as;
+    as.name = a.name;
+    as.size = a.size;
+    as.type = a.type == ArraySettings::Type::kCam          ? rt::ArraySpec::Type::kCam
+              : a.type == ArraySettings::Type::kCamProfile ? rt::ArraySpec::Type::kCamProfile
+                                                           : rt::ArraySpec::Type::kReal;
+    for (const CamPoint& p : a.cam_values)
+      as.cam_values.push_back({p.master, p.slave, p.cubic ? motion::cam::kSegmentCubic : motion::cam::kSegmentLinear});
+    as.real_values = a.real_values;
+    spec.arrays.push_back(std::move(as));
+  }
   try {
     rt.controller = std::make_unique<rt::Controller>(std::move(spec));
   } catch (const std::invalid_argument& e) {

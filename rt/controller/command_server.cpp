@@ -134,7 +134,9 @@ struct CommandServer::Impl {
       return s_.host.tags().read(s_.status(), tag, error);
     }
     std::optional<std::string> write(std::string_view tag, double value) override {
-      return s_.host.write(tag, value);
+      auto e = s_.host.write(tag, value);
+      if (!e) seq_ = s_.host.last_seq();  // an array element write: settled() waits for the RT thread
+      return e;
     }
     void declare(std::string_view tag) override { s_.host.declare(tag); }
 

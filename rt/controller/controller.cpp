@@ -1,5 +1,6 @@
 #include "rt/controller/controller.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <limits>
@@ -77,6 +78,7 @@ Controller::Controller(ControllerSpec spec)
       throw std::invalid_argument("cam '" + cs.name + "': the planner refused the profile");
     cams_.push_back(std::move(prof));
   }
+  build_arrays();
   axes_.resize(spec_.axes.size());
   for (std::size_t a = 0; a < spec_.axes.size(); ++a) {
     AxisSpec& s = spec_.axes[a];
@@ -122,6 +124,7 @@ std::optional<std::uint16_t> Controller::cam_id(std::string_view name) const {
   const std::string want = lower_name(name);
   for (std::size_t c = 0; c < spec_.cams.size(); ++c)
     if (lower_name(spec_.cams[c].name) == want) return static_cast<std::uint16_t>(c);
+  if (const auto a = find_array(name); a && a->type == ArraySpec::Type::kCamProfile) return a->id;
   return std::nullopt;
 }
 
@@ -268,7 +271,14 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
     } else if (!commands_.try_pop(c)) {
       break;
     }
-    if (c.kind == Command::Kind::kInstruction) {
+    if (c.kind == Command::Kind::kWriteArray && nreq > 0) {
+      held_ = c;  // program order: an instruction queued before it runs first (this cycle)
+      deferred = true;
+      break;
+    }
+    if (c.kind == Command::Kind::kWriteArray) {
+      apply_write(c);
+    } else if (c.kind == Command::Kind::kInstruction) {
       if (nreq == requests_.size()) {
         held_ = c;
         deferred = true;
@@ -389,6 +399,7 @@ void Controller::publish(std::int64_t now_ns) noexcept {
   s.commands_deferred = deferred_;
   s.halted = halt_ == Halt::kHalted;
   for (std::size_t c = 0; c < cams_.size(); ++c) s.cam_status[c] = cams_[c]->status();
+  std::copy(real_store_.begin(), real_store_.end(), s.real_values.begin());  // <= kMaxRealElements
   snapshot_->commit();
 }
 

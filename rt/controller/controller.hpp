@@ -75,12 +75,41 @@ struct CamSpec {
   double end_slope = 0.0;
 };
 
+/// All REAL array elements together: they are copied into every status
+/// snapshot. Bound: EventDistance / CalculatedData arrays hold a few events
+/// per move; 1024 covers 64 arrays of 16 (config ArraySettings::kMaxRealElements).
+inline constexpr std::size_t kMaxRealElements = 1024;
+
+/// An array tag declared in the configuration (`arrays:`): a CAM array (MCCP
+/// input, written by programs), a CAM_PROFILE array (MCCP output) or a REAL
+/// array (MAM EventDistance / CalculatedData). Storage is allocated when the
+/// Controller is built; nothing is resized afterwards.
+struct ArraySpec {
+  enum class Type : std::uint8_t { kCam, kCamProfile, kReal };
+  std::string name;
+  Type type = Type::kReal;
+  std::size_t size = 0;
+  std::vector<motion::cam::CamPoint> cam_values;  ///< CAM: initial points (rest zero, linear)
+  std::vector<double> real_values;                ///< REAL: initial values (rest zero)
+};
+
+/// A resolved array tag (Controller::find_array). `id` is the planner id of
+/// its kind: CAM array id, CAM_PROFILE id (after the `cams:` profiles), REAL
+/// array id. `offset` is a REAL array's first element in Status::real_values.
+struct ArrayRef {
+  ArraySpec::Type type = ArraySpec::Type::kReal;
+  std::uint16_t id = 0;
+  std::uint32_t size = 0;
+  std::uint32_t offset = 0;
+};
+
 /// Everything a Controller is built from (config::build_runtime makes it from a file).
 struct ControllerSpec {
   std::int64_t period_ns = 1'000'000;
   std::vector<BusSpec> buses;
   std::vector<AxisSpec> axes;
   std::vector<CamSpec> cams;
+  std::vector<ArraySpec> arrays;
 };
 
 /// A command to the RT thread. Trivially copyable (lives in an SPSC ring).
@@ -94,6 +123,8 @@ struct Command {
                       ///< then no more cyclic traffic (Status::halted)
     kDirectCommand,   ///< MDS live command: write `value` to axis `axis`'s DirectCommandVelocity
                       ///< (direct_torque false) or DirectCommandTorque (true); no effect without an active MDS
+    kWriteArray,    ///< a program writes one array element (Controller::write_array); applied in
+                    ///< program order: never in the same cycle after an instruction
   };
   Kind kind = Kind::kInstruction;
   motion::Request request{};
@@ -101,7 +132,13 @@ struct Command {
   std::uint64_t seq = 0;  ///< set by submit(); echoed as Status::done_seq
   std::uint16_t axis = 0;     ///< kDirectCommand
   bool direct_torque = false; ///< kDirectCommand
-  double value = 0.0;         ///< kDirectCommand: units/s or torque units
+  double value = 0.0;         ///< kDirectCommand: units/s or torque units; kWriteArray: the value
+  // kWriteArray: element `element` of array `array` (ArrayRef::id of `array_type`;
+  // for REAL the flat element index offset + i), CAM member 0 Master, 1 Slave, 2 SegmentType.
+  ArraySpec::Type array_type = ArraySpec::Type::kReal;
+  std::uint8_t member = 0;
+  std::uint16_t array = 0;
+  std::uint32_t element = 0;
 };
 
 /// Something the RT thread reports. Trivially copyable.
@@ -178,6 +215,8 @@ struct Status {
   /// CAM_PROFILE[0].Status of each cam profile (0 not calculated, 1 calculating,
   /// 2 calculated, n = in use by n - 2 cams).
   std::array<std::int32_t, motion::kMaxCamProfiles> cam_status{};
+  /// REAL array elements (ArrayRef::offset + index); only the configured ones are written.
+  std::array<double, kMaxRealElements> real_values{};
 };
 
 class Controller {
@@ -230,6 +269,18 @@ class Controller {
   /// Cam profile id of `name` (case-insensitive), or nullopt.
   [[nodiscard]] std::optional<std::uint16_t> cam_id(std::string_view name) const;
   [[nodiscard]] std::size_t cam_count() const noexcept { return cams_.size(); }
+  /// The array tag `name` (case-insensitive) of the `arrays:` section, or nullopt.
+  [[nodiscard]] std::optional<ArrayRef> find_array(std::string_view name) const;
+  /// Write one element of an array tag (CAM: member 0 Master, 1 Slave,
+  /// 2 SegmentType; REAL: member ignored) through the command ring, so the RT
+  /// thread applies it in program order. Returns the command's sequence
+  /// number, or 0 when the ring is full or the element does not exist.
+  /// Thread-safe (non-RT).
+  std::uint64_t write_array(const ArrayRef& a, std::uint32_t element, std::uint8_t member, double value);
+  /// A CAM array element as last written by a program. The RT thread never
+  /// writes CAM arrays, so this non-RT copy is what MCCP sees once the writes
+  /// queued so far are applied. Thread-safe (non-RT).
+  [[nodiscard]] double read_cam_point(const ArrayRef& a, std::uint32_t element, std::uint8_t member) const;
   [[nodiscard]] double period_s() const noexcept { return static_cast<double>(spec_.period_ns) * 1e-9; }
   [[nodiscard]] std::uint64_t cycles() const noexcept { return cycle_.load(std::memory_order_acquire); }
 
@@ -262,12 +313,19 @@ class Controller {
   void publish(std::int64_t now_ns) noexcept;
   void record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noexcept;
   void emit(const Event& e) noexcept;
+  void build_arrays();                              ///< controller_arrays.cpp (constructor)
+  void apply_write(const Command& c) noexcept;      ///< controller_arrays.cpp (RT)
 
   ControllerSpec spec_;
   motion::Planner planner_;
   std::vector<BusRt> buses_;
   std::vector<AxisRt> axes_;
   std::vector<std::unique_ptr<motion::cam::CamProfile>> cams_;  ///< attached to the planner, same ids
+  // `arrays:` storage, sized in build_arrays(), never resized.
+  std::vector<std::vector<motion::cam::CamPoint>> cam_arrays_;   ///< RT copy (planner-attached)
+  std::vector<std::vector<motion::cam::CamPoint>> cam_shadow_;   ///< non-RT copy, under names_mu_
+  std::vector<double> real_store_;                               ///< all REAL arrays, planner-attached spans
+  std::vector<ArrayRef> array_refs_;                             ///< per spec_.arrays entry
   std::array<motion::AxisFeedback, motion::kMaxAxes> fb_{};
   std::array<motion::AxisOutput, motion::kMaxAxes> out_{};
   std::array<motion::Request, kMaxRequestsPerCycle> requests_{};

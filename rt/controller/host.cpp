@@ -23,6 +23,12 @@ std::optional<std::string> ControllerHost::bind(std::string_view call, motion::R
   for (const auto& [name, value] : tags_.user_tags()) sym.numeric_tags.emplace(name, value);
   for (const auto& cam : c_.spec().cams)
     sym.cam_profiles.emplace(cam.name, *c_.cam_id(cam.name));
+  for (const auto& arr : c_.spec().arrays) {  // `arrays:` tags, by kind
+    const auto ref = c_.find_array(arr.name);
+    if (arr.type == ArraySpec::Type::kCam) sym.cams.emplace(arr.name, ref->id);
+    else if (arr.type == ArraySpec::Type::kCamProfile) sym.cam_profiles.emplace(arr.name, ref->id);
+    else sym.real_arrays.emplace(arr.name, ref->id);
+  }
   return motion::bind_call(pc, sym, out);
 }
 
@@ -36,6 +42,7 @@ std::optional<std::string> ControllerHost::check_tag(std::string_view tag, bool 
   const auto t = tags_.resolve(tag, &e);
   if (for_write) {
     if (t && !t->writable) return fmt::format("tag '{}' is read-only", tag);
+    if (!t && tag.find('.') != std::string_view::npos) return e;  // e.g. an array element out of range
     return std::nullopt;  // a new numeric tag is created by its first assignment
   }
   if (t) return std::nullopt;
@@ -77,7 +84,10 @@ void ControllerHost::declare(std::string_view tag) {
 }
 
 std::optional<std::string> ControllerHost::write(std::string_view tag, double value) {
-  return tags_.write(tag, value, true);
+  auto e = tags_.write(tag, value, true);
+  // An array element write is a command to the RT thread: settled() waits for it.
+  if (!e && tags_.last_write_seq() > last_seq_) last_seq_ = tags_.last_write_seq();
+  return e;
 }
 
 }  // namespace canmotion::rt

@@ -100,6 +100,20 @@ constexpr std::array kControlMembers{
     Named{"STATUS", kStatusMember},
 };
 
+constexpr std::array kCamMembers{Named{"Master", 0}, Named{"Slave", 1}, Named{"SegmentType", 2}};
+
+/// `name[index]` -> name and index; nullopt when `base` is not of that form.
+std::optional<std::pair<std::string_view, std::uint32_t>> split_index(std::string_view base) {
+  const std::size_t br = base.find('[');
+  if (br == std::string_view::npos || br == 0 || base.back() != ']' || base.size() < br + 3) return std::nullopt;
+  std::uint32_t idx = 0;
+  for (std::size_t i = br + 1; i + 1 < base.size(); ++i) {
+    if (!std::isdigit(static_cast<unsigned char>(base[i])) || idx > 100'000'000u) return std::nullopt;
+    idx = idx * 10 + static_cast<std::uint32_t>(base[i] - '0');
+  }
+  return std::make_pair(base.substr(0, br), idx);
+}
+
 template <std::size_t N>
 const Named* find(const std::array<Named, N>& a, std::string_view name) {
   for (const Named& n : a)
@@ -128,6 +142,34 @@ std::vector<std::string_view> TagTable::axis_members() {
 }
 
 std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* error) {
+  // Array tags of `arrays:`: pts[i].Master / .Slave / .SegmentType, ed[i].
+  {
+    const std::size_t d = name.find('.');
+    const std::string_view base = name.substr(0, d);
+    const std::string_view member = d == std::string_view::npos ? std::string_view{} : name.substr(d + 1);
+    if (const auto si = split_index(base)) {
+      if (const auto a = c_.find_array(si->first); a && a->type != ArraySpec::Type::kCamProfile) {
+        const bool cam = a->type == ArraySpec::Type::kCam;
+        if (si->second >= a->size) {
+          if (error)
+            *error = fmt::format("{}[{}]: array '{}' has {} elements ([0] .. [{}])", si->first, si->second, si->first,
+                                 a->size, a->size - 1);
+          return std::nullopt;
+        }
+        if (!cam) {
+          if (d == std::string_view::npos) return TagRef{TagRef::Kind::kRealElement, a->id, 0, true, a->offset + si->second};
+          if (error) *error = fmt::format("'{}' is a REAL array: write {}[{}] without a member", si->first, si->first, si->second);
+          return std::nullopt;
+        }
+        if (const Named* n = find(kCamMembers, member)) return TagRef{TagRef::Kind::kCamPoint, a->id, n->value, true, si->second};
+        if (error)
+          *error = fmt::format("'{}' is a CAM array; its elements have the members Master, Slave and SegmentType, "
+                               "e.g. {}[{}].Master",
+                               si->first, si->first, si->second);
+        return std::nullopt;
+      }
+    }
+  }
   const std::size_t dot = name.find('.');
   if (dot == std::string_view::npos) {
     if (auto it = user_.find(lower(name)); it != user_.end())
@@ -197,6 +239,13 @@ double TagTable::read(const Status& s, const TagRef& t) const {
   switch (t.kind) {
     case TagRef::Kind::kUser: return 0.0;  // read through the name (see read(s, name))
     case TagRef::Kind::kCamStatus: return s.cam_status[t.index];
+    case TagRef::Kind::kCamPoint: {
+      ArrayRef a;
+      a.type = ArraySpec::Type::kCam;
+      a.id = t.index;
+      return c_.read_cam_point(a, t.element, t.member);
+    }
+    case TagRef::Kind::kRealElement: return t.element < s.real_values.size() ? s.real_values[t.element] : 0.0;
     case TagRef::Kind::kController: return stats_.at(t.index).second();
     case TagRef::Kind::kControlFlag: return s.controls[t.index].get(t.member) ? 1.0 : 0.0;
     case TagRef::Kind::kControl: {
@@ -262,6 +311,19 @@ std::optional<std::string> TagTable::write(std::string_view name, double value, 
     c.value = value;
     if (c_.submit(c) == 0) return std::string("the controller's command queue is full; try again");
     direct_[(static_cast<std::uint32_t>(t->index) << 8) | t->member] = value;
+    return std::nullopt;
+  }
+  if (t && (t->kind == TagRef::Kind::kCamPoint || t->kind == TagRef::Kind::kRealElement)) {
+    if (!std::isfinite(value)) return fmt::format("{}: {} is not a finite number", name, value);
+    if (t->kind == TagRef::Kind::kCamPoint && t->member == 2 &&
+        (value != std::trunc(value) || std::abs(value) > 2147483647.0))
+      return fmt::format("{}: SegmentType is a DINT (0 linear, 1 cubic), got {}", name, value);
+    const auto si = split_index(name.substr(0, name.find('.')));
+    const auto a = c_.find_array(si->first);
+    const std::uint32_t element = t->kind == TagRef::Kind::kCamPoint ? t->element : t->element - a->offset;
+    const std::uint64_t seq = c_.write_array(*a, element, t->member, value);
+    if (seq == 0) return std::string("the command queue to the RT thread is full; try again");
+    last_write_seq_ = seq;
     return std::nullopt;
   }
   if (!t) {

@@ -13,6 +13,8 @@
 ///                                                    read back as the last value written)
 ///   mag1.EN .DN .ER .PC .IP .AC .ACCEL .DECEL .TrackingMaster .ERR .EXERR .STATE .SEGMENT .STATUS
 ///   cam1[0].Status    (CAM_PROFILE status: 0 not calculated, 2 calculated, n in use by n-2 cams)
+///   pts[i].Master  pts[i].Slave  pts[i].SegmentType   (CAM arrays of `arrays:`, read/write)
+///   ed[i]             (REAL arrays of `arrays:`, read/write; MAM EventDistance / CalculatedData)
 ///   Controller.Cycle  Controller.Time  and the statistics the owner registers
 ///   user numeric tags (created by `tag := value;`)
 ///
@@ -33,11 +35,15 @@ namespace canmotion::rt {
 
 /// A resolved tag.
 struct TagRef {
-  enum class Kind : std::uint8_t { kAxis, kMotionBit, kAxisStatusBit, kAxisFaultBit, kControl, kControlFlag, kController, kUser, kCamStatus };
+  enum class Kind : std::uint8_t { kAxis, kMotionBit, kAxisStatusBit, kAxisFaultBit, kControl, kControlFlag, kController, kUser, kCamStatus,
+                                   kCamPoint, kRealElement };
   Kind kind = Kind::kAxis;
   std::uint16_t index = 0;  ///< axis id, control id, or statistic/user slot
   std::uint8_t member = 0;  ///< attribute number, bit number or member number
   bool writable = false;
+  /// kCamPoint: element index (index = CAM array id, member 0 Master / 1 Slave /
+  /// 2 SegmentType); kRealElement: position in Status::real_values.
+  std::uint32_t element = 0;
 };
 
 /// Resolves names and reads values. One per Controller, used from non-RT
@@ -52,10 +58,14 @@ class TagTable {
   [[nodiscard]] double read(const Status& s, const TagRef& t) const;
   /// Resolve and read in one go.
   std::optional<double> read(const Status& s, std::string_view name, std::string* error);
-  /// Write a writable tag: a user tag (created when `create` is true), or an
+  /// Write a writable tag: a user tag (created when `create` is true), an
   /// axis's DirectCommandVelocity / DirectCommandTorque (queued for the RT
-  /// thread; acts on an active MDS, see Command::Kind::kDirectCommand).
+  /// thread; acts on an active MDS, see Command::Kind::kDirectCommand), or an
+  /// array element (queued to the RT thread; see last_write_seq()).
   std::optional<std::string> write(std::string_view name, double value, bool create);
+  /// Command sequence number of the last array element write (0 = none):
+  /// the write is applied once Status::done_seq reaches it.
+  [[nodiscard]] std::uint64_t last_write_seq() const noexcept { return last_write_seq_; }
 
   /// Extra read-only controller statistics (e.g. `Controller.LatencyMaxUs`),
   /// evaluated when read.
@@ -72,6 +82,7 @@ class TagTable {
   std::map<std::string, double, std::less<>> user_;  // lower-case name -> value
   std::vector<std::pair<std::string, std::function<double()>>> stats_;
   std::map<std::uint32_t, double> direct_;  // (axis << 8 | attribute) -> last DirectCommand* written
+  std::uint64_t last_write_seq_ = 0;
 };
 
 }  // namespace canmotion::rt
