@@ -56,8 +56,8 @@ TEST(ConfigArrays, ErrorsNameFileLineColumnAndKey) {
     std::string want;
   };
   const Case cases[] = {
-      {"arrays:\n  - {name: a, type: CAM}\n", "arr.yaml:9:5: error: arrays[0].size: missing: the number of elements, 1 .. 10000"},
-      {"arrays:\n  - {name: a, type: CAM, size: 10001}\n", "arrays[0].size: must be 1 .. 10000 elements, got 10001"},
+      {"arrays:\n  - {name: a, type: CAM}\n", "arr.yaml:9:5: error: arrays[0].size: missing: the number of elements, 1 .. 4096"},
+      {"arrays:\n  - {name: a, type: CAM, size: 4097}\n", "arrays[0].size: must be 1 .. 4096 elements, got 4097"},
       {"arrays:\n  - {name: a, type: INT, size: 3}\n", "arrays[0].type: 'INT' is not one of: CAM (0), CAM_PROFILE (1), REAL (2)"},
       {"arrays:\n  - {name: a, type: REAL, size: 2, values: [1, 2, 3]}\n", "arrays[0].values: 3 values do not fit in size 2"},
       {"arrays:\n  - {name: a, type: REAL, size: 2, values: [1, x]}\n", "arrays[0].values[1]: must be a finite number, got 'x'"},

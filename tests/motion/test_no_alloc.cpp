@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <new>
+#include <vector>
 
 #include "motion/cam/cam_profile.hpp"
 #include "rig.hpp"
@@ -120,4 +121,47 @@ TEST(NoAlloc, CounterSeesAnAllocation) {
   g_count = false;
   delete p;
   EXPECT_EQ(g_allocs.load(), before + 1);
+}
+
+// MCCP as an instruction and MAM EventDistance / CalculatedData (issue #5):
+// the calculation writes into storage attached at configuration.
+TEST(NoAlloc, MccpAndCalculatedDataAllocateNothing) {
+  test::Rig r;
+  AxisConfig c;
+  c.max_speed = 100;
+  r.add_axis("X", c);
+  std::vector<cam::CamPoint> pts(200);
+  for (std::size_t i = 0; i < pts.size(); ++i) pts[i] = {0.01 * static_cast<double>(i), 0.1 * static_cast<double>(i % 7), 1};
+  cam::CamProfile prof(200);
+  std::vector<double> ed{0.0, 1.0, 5.0}, cd(3);
+  r.p->attach_cam_array(0, pts);
+  r.p->attach_cam_profile(0, &prof);
+  r.p->attach_real_array(0, ed);
+  r.p->attach_real_array(1, cd);
+  r.sym.cams["pts"] = 0;
+  r.sym.cam_profiles["prof"] = 0;
+  r.sym.real_arrays["ed"] = 0;
+  r.sym.real_arrays["cd"] = 1;
+  const std::vector<Request> script = {
+      r.req("MSO(X, on);"),
+      r.req("MCCP(mc, pts[0], 200, 0, 0, prof[0]);"),
+      r.req("MCCP(mc2, pts[0], 1, 0, 0, prof[0]);"),  // ERR 26
+      r.req("MAM(X,m,1,20,10,unitspersec,50,unitspersec2,50,unitspersec2,scurve,50,50,%oftime,disabled,programmed,0,"
+            "none,ed,cd);"),
+      r.req("MATC(X, t, same, prof[0], 1, 1, once, immediate, 0, none, timedrivenmode);"),
+  };
+  r.queue.reserve(16);
+  r.step();
+  const long before = g_allocs.load();  // the counter is shared with the other tests
+  g_count = true;
+  for (const Request& q : script) {
+    r.queue.push_back(q);
+    r.step(100);
+  }
+  g_count = false;
+  EXPECT_EQ(g_allocs.load() - before, 0);
+  EXPECT_TRUE(r.tag("mc").dn());
+  EXPECT_EQ(r.tag("mc2").err, 26);
+  EXPECT_TRUE(r.tag("m").get(flag::CalculatedDataAvailable));
+  EXPECT_GT(cd[0], cd[1]);
 }
