@@ -3,10 +3,13 @@
 # script that fills a CAM array tag, calculates a CAM_PROFILE with MCCP and
 # cams an axis with it. The same script run on the profile the configuration
 # computed from the same points must print the same positions, digit for digit.
-# Usage: mccp-test.sh CANMOTIOND WORKDIR
+# Then the same tags through canmotionctl get/set on a running daemon.
+# Usage: mccp-test.sh CANMOTIOND WORKDIR [CANMOTIONCTL]
 set -uo pipefail
-bin="$1" work="$2"
+bin="$1" work="$2" ctl="${3:-}"
 mkdir -p "$work"
+pid=
+trap '[ -n "$pid" ] && kill -KILL "$pid" 2>/dev/null' EXIT
 fail() { echo "mccp-test: FAIL: $*" >&2; exit 1; }
 
 # (a bus is declared although no axis uses it: canmotiond --sim needs one)
@@ -73,4 +76,29 @@ printf 'pts[16].Slave := 1;\n' > "$work/range.script"
 out=$("$bin" --config "$work/mccp.yaml" --sim --script "$work/range.script" -q 2>&1); rc=$?
 [[ $rc == 2 ]] || fail "out-of-range script exit $rc, want 2: $out"
 grep -q "range.script:1:1: pts\[16\]: array 'pts' has 16 elements (\[0\] .. \[15\])" <<<"$out" || fail "range message: $out"
+
+# canmotionctl set/get of array elements, MCCP as a call (when the tool is given).
+if [[ -n "$ctl" ]]; then
+  sock="$work/d.sock"
+  rm -f "$sock"
+  "$bin" --config "$work/mccp.yaml" --sim --socket "$sock" --duration 1000000 --quiet >"$work/d.out" 2>"$work/d.err" &
+  pid=$!
+  for _ in $(seq 1 200); do [ -S "$sock" ] && break; sleep 0.05; done
+  [ -S "$sock" ] || fail "no socket: $(cat "$work/d.err")"
+  export CANMOTIOND_SOCKET=$sock
+  i=0
+  for p in "0 0 1" "0.2 1 1" "0.5 4 0" "0.7 5 1" "1 2 0"; do
+    read -r m sl ty <<<"$p"
+    "$ctl" set "pts[$i].Master" "$m" >/dev/null && "$ctl" set "pts[$i].Slave" "$sl" >/dev/null &&
+      "$ctl" set "pts[$i].SegmentType" "$ty" >/dev/null || fail "set pts[$i]"
+    i=$((i + 1))
+  done
+  [ "$("$ctl" get 'pts[3].Slave')" = 5 ] || fail "get pts[3].Slave: $("$ctl" get 'pts[3].Slave')"
+  out=$("$ctl" 'MCCP(mc, pts[0], 5, 0.5, -2, prof[0])') || fail "MCCP call: $out"
+  grep -q '^mc EN=1 DN=1 ER=0 ' <<<"$out" || fail "MCCP reply: $out"
+  [ "$("$ctl" get 'prof[0].Status')" = 2 ] || fail "prof[0].Status after MCCP"
+  out=$("$ctl" set 'pts[16].Slave' 1 2>&1) && fail "set outside the array succeeded: $out"
+  grep -q "array 'pts' has 16 elements" <<<"$out" || fail "set outside the array: $out"
+  kill -TERM "$pid"; wait "$pid"; pid=
+fi
 echo "mccp-test: run-time MCCP profile cams exactly like the configured one; errors as documented"
