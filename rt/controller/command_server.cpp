@@ -167,6 +167,7 @@ struct CommandServer::Impl {
     // kPending: an instruction call
     std::uint64_t seq = 0;
     std::string control;
+    std::string reply;  ///< kPending after SET of an array element: the reply once applied
     Wall::time_point since{};
     // kScriptText / kScript
     std::string script_name;
@@ -560,6 +561,11 @@ struct CommandServer::Impl {
 
   void finish_call(Client& c) {
     c.mode = Mode::kIdle;
+    if (!c.reply.empty()) {  // a SET of an array element
+      send_line(c, c.reply);
+      c.reply.clear();
+      return;
+    }
     if (c.control.empty()) return send_line(c, "OK executed");
     const auto id = ctl.find_control(c.control);
     if (!id) return send_line(c, fmt::format("ERR control tag '{}' vanished", c.control));
@@ -589,7 +595,16 @@ struct CommandServer::Impl {
     if (w.size() != 3) return send_line(c, "ERR SET needs a tag and a value: SET Distance 12.5");
     const auto v = number(w[2]);
     if (!v) return send_line(c, fmt::format("ERR SET {}: '{}' is not a finite number", w[1], w[2]));
+    const std::uint64_t before = host.last_seq();
     if (auto e = host.write(w[1], *v)) return send_line(c, "ERR " + *e);
+    if (host.last_seq() != before) {  // an array element: reply once the RT thread applied it
+      c.control.clear();
+      c.reply = fmt::format("OK {}={}", w[1], script::format_value(*v));
+      c.seq = host.last_seq();
+      c.since = Wall::now();
+      c.mode = Mode::kPending;
+      return;
+    }
     send_line(c, fmt::format("OK {}={}", w[1], script::format_value(*v)));
   }
 
