@@ -21,6 +21,21 @@ std::optional<std::string> ControllerHost::bind(std::string_view call, motion::R
     if (control_tag) *control_tag = pc.operands[i].text;
   }
   for (const auto& [name, value] : tags_.user_tags()) sym.numeric_tags.emplace(name, value);
+  // REAL array elements as numeric operands (`MAM(X, m, 0, ed[1], ...)`): their
+  // current value from the status snapshot, as for any numeric tag.
+  for (std::size_t i = 0; i < pc.operands.size() && i < sig.operands.size(); ++i) {
+    const motion::StOperand& op = pc.operands[i];
+    const auto k = sig.operands[i].kind;
+    if (op.kind != motion::StOperand::Kind::Tag || !op.index ||
+        (k != motion::OperandKind::Real && k != motion::OperandKind::Int && k != motion::OperandKind::Enum))
+      continue;
+    const auto arr = c_.find_array(op.text);
+    if (!arr || arr->type != ArraySpec::Type::kReal) continue;
+    const std::string name = op.text + "[" + std::to_string(*op.index) + "]";
+    std::string e;
+    if (const auto v = tags_.read(refresh(), name, &e)) sym.numeric_tags.emplace(name, *v);
+    else return fmt::format("operand {} ({}): {}", i, sig.operands[i].name, e);
+  }
   for (const auto& cam : c_.spec().cams)
     sym.cam_profiles.emplace(cam.name, *c_.cam_id(cam.name));
   for (const auto& arr : c_.spec().arrays) {  // `arrays:` tags, by kind

@@ -155,6 +155,24 @@ TEST(ArrayTags, EventDistanceAndCalculatedDataAsRealArrays) {
   EXPECT_TRUE(s.controls[*id].get(motion::flag::CalculatedDataAvailable));
 }
 
+TEST(ArrayTags, RealElementsAreNumericOperands) {
+  ArrayRig r;
+  r.step();
+  r.write("ed[2]", 12.5);
+  r.step();
+  r.exec("MSO(X, on1)");
+  r.exec("MAM(X, m, 0, ed[2], 50, unitspersec, 500, unitspersec2, 500, unitspersec2, trapezoidal, 0, 0, "
+         "unitspersec3, disabled, programmed, 0, none, 0, 0)");
+  r.step(2000);
+  EXPECT_EQ(r.read("m.PC"), 1.0);
+  EXPECT_DOUBLE_EQ(r.read("X.CommandPosition"), 12.5);
+  std::string c;
+  const auto e = r.host->execute("MAM(X, m, 0, ed[3], 50, unitspersec, 500, unitspersec2, 500, unitspersec2, "
+                                 "trapezoidal, 0, 0, unitspersec3, disabled, programmed, 0, none, 0, 0)", &c);
+  ASSERT_TRUE(e);
+  EXPECT_NE(e->find("array 'ed' has 3 elements"), std::string::npos) << *e;
+}
+
 TEST(ArrayTags, ErrorsNameTheArrayAndWhatIsValid) {
   ArrayRig r;
   r.step();
