@@ -36,6 +36,13 @@ out=$("$bin" --config "$ex/demo.yaml" --sim --script "$work/bad.script" -q 2>&1)
 [[ $rc == 2 ]] || fail "bad script exit $rc, want 2: $out"
 grep -q 'bad.script:1:1:' <<<"$out" || fail "bad script message: $out"
 
-# 5. --help works and names the options.
+# 5. A configuration without buses (virtual axes only) runs in --sim.
+printf 'controller: {period_ms: 1}\naxes:\n  - {name: V, type: AXIS_VIRTUAL}\n' > "$work/nobus.yaml"
+printf 'MSO(V, mso1);\nMAJ(V, maj1, 0, 10, unitspersec, 100, unitspersec2, 100, unitspersec2, trapezoidal, 100, 100, %%oftime, disabled, programmed, 0, none);\nWAIT 1;\nPRINT V.CommandVelocity;\n' > "$work/nobus.script"
+out=$("$bin" --config "$work/nobus.yaml" --sim --script "$work/nobus.script" -q 2>&1); rc=$?
+[[ $rc == 0 ]] || fail "no-bus configuration exit $rc: $out"
+grep -q 'V.CommandVelocity=10$' <<<"$out" || fail "no-bus run: $out"
+
+# 6. --help works and names the options.
 "$bin" --help | grep -q -- '--script' || fail "--help"
 echo "daemon-test: statistics tags, exit statuses 0/1/2 and messages as documented"

@@ -397,9 +397,9 @@ int run(const Options& o) {
     // inline between cycles so that runs are deterministic.
     exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
       const auto t = static_cast<std::int64_t>(info.cycle) * period.count();
-      rt.sim->begin_cycle(t);
+      if (rt.sim) rt.sim->begin_cycle(t);  // null when the configuration has no buses (virtual axes only)
       ctl.cycle(t);
-      rt.sim->end_cycle(t);
+      if (rt.sim) rt.sim->end_cycle(t);
       try {
         ended = housekeeping(info.cycle + 1);
       } catch (...) {
