@@ -24,6 +24,12 @@ std::size_t SimBus::Endpoint::receive(std::span<TimedFrame> out) noexcept {
     if (++rx_head_ == rx_.size()) rx_head_ = 0;
     --rx_count_;
   }
+  // An empty ring starts again at its first slot: the few slots a cycle
+  // uses stay in the cache instead of sweeping the whole ring.
+  if (rx_count_ == 0) {
+    rx_head_ = 0;
+    open_ = false;  // the owner has seen the opener (see set_accept)
+  }
   return n;
 }
 
@@ -39,16 +45,18 @@ std::size_t SimBus::Endpoint::poll_events(std::span<BusEvent> out) noexcept {
 
 BusState SimBus::Endpoint::state() const noexcept { return bus_.state_; }
 
-void SimBus::Endpoint::push(const TimedFrame& f) noexcept {
+void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns) noexcept {
   if (rx_count_ == rx_.size()) {
     ++counters_.rx_dropped;
-    push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, f.t_ns});
+    push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, t_ns});
     return;
   }
   std::size_t tail = rx_head_ + rx_count_;  // < 2 * size: one wrap at most
   if (tail >= rx_.size()) tail -= rx_.size();
-  rx_[tail] = f;
+  rx_[tail].frame = f;
+  rx_[tail].t_ns = t_ns;
   ++rx_count_;
+  if (filtered_ && in(openers_, f)) open_ = true;
   ++counters_.rx_frames;
 }
 
@@ -88,6 +96,10 @@ void SimBus::set_state(BusState s) noexcept {
 SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
   if (state_ == BusState::kBusOff) return SendResult::kBusOff;
   ++counters_.sent;
+  if (faults_.empty()) {  // no fault injection: straight to the wire
+    deliver(&from, f, now_ns_);
+    return SendResult::kOk;
+  }
   Frame frame = f;
   for (Rule& r : faults_) {
     if (r.fault.cob_id != SimFault::kAnyId && r.fault.cob_id != f.id) continue;
@@ -121,12 +133,12 @@ SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
   return SendResult::kOk;
 }
 
-void SimBus::deliver(const Endpoint* from, const Frame& f, std::int64_t t_ns) noexcept {
+void SimBus::deliver(const Endpoint* from, const Frame& frame, std::int64_t t_ns) noexcept {
   ++counters_.delivered;
-  const TimedFrame tf{f, t_ns};
-  if (tap_) tap_(tf, name_);
+  const Frame f = frame;  // read the sender's frame once, written straight into each ring
+  if (tap_) tap_(TimedFrame{f, t_ns}, name_);
   for (auto& ep : endpoints_) {
-    if (ep.get() != from) ep->push(tf);
+    if (ep.get() != from && ep->accepts(f)) ep->push(f, t_ns);
   }
 }
 
