@@ -45,8 +45,9 @@ std::size_t SimBus::Endpoint::poll_events(std::span<BusEvent> out) noexcept {
 
 BusState SimBus::Endpoint::state() const noexcept { return bus_.state_; }
 
-void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns) noexcept {
-  if (rx_count_ == rx_.size()) {
+// Inlined into deliver(), its only caller (once per frame and endpoint).
+[[gnu::always_inline]] inline void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns) noexcept {
+  if (rx_count_ == rx_.size()) [[unlikely]] {
     ++counters_.rx_dropped;
     push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, t_ns});
     return;

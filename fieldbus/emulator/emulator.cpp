@@ -799,7 +799,7 @@ void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
     const std::uint8_t t = m.transmission_type;
     if (t >= 241 && t <= 253) continue;  // RTR-only / reserved: not sent on SYNC
     ++tpdo_sync_count_[p];
-    if (t >= 1 && t <= 240 && tpdo_sync_count_[p] % t != 0) continue;
+    if (t >= 2 && t <= 240 && tpdo_sync_count_[p] % t != 0) continue;  // (1: every SYNC, no division)
     can::Frame f;
     f.id = m.cob_id;
     f.len = m.size_bytes;
@@ -866,10 +866,14 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
   // Motor: advances by the interpolation period 0x60C2, only here.
   const cia402::InterpolationPeriod ip{static_cast<std::uint8_t>(val(hot_.ip_value)),
                                         static_cast<std::int8_t>(sval(hot_.ip_index))};
-  std::int64_t period_ns = cia402::interpolation_period_ns(ip);
-  if (period_ns <= 0) period_ns = 1'000'000;
+  if (!sync_period_.valid || ip.value != sync_period_.ip.value || ip.index != sync_period_.ip.index) {
+    std::int64_t ns = cia402::interpolation_period_ns(ip);
+    if (ns <= 0) ns = 1'000'000;
+    sync_period_ = SyncPeriod{ip, ns, static_cast<double>(ns) / 1e9, true};
+  }
+  const std::int64_t period_ns = sync_period_.ns;
   sync_period_ns_ = period_ns;
-  advance_motor(static_cast<double>(period_ns) / 1e9);
+  advance_motor(sync_period_.dt);
   // Following error monitoring (CSP, Operation enabled).
   const auto window = static_cast<std::uint32_t>(val(hot_.fe_window));
   if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kCsp) &&

@@ -326,6 +326,15 @@ class Emulator final : public canopen::SdoServerBackend {
   EmulatorCounters counters_{};
   canopen::FrameSink* out_ = nullptr;  // sink of the frame being handled (SDO writes of 0x6040)
   std::uint64_t accept_gen_ = 0;       // see accept_generation()
+  /// 0x60C2 as last seen by handle_sync() and the period it gives (computed
+  /// again only when 0x60C2 changes).
+  struct SyncPeriod {
+    cia402::InterpolationPeriod ip{};
+    std::int64_t ns = 0;
+    double dt = 0;
+    bool valid = false;
+  };
+  SyncPeriod sync_period_{};
 };
 
 }  // namespace canmotion::emulator
