@@ -46,7 +46,8 @@ std::size_t SimBus::Endpoint::poll_events(std::span<BusEvent> out) noexcept {
 BusState SimBus::Endpoint::state() const noexcept { return bus_.state_; }
 
 // Inlined into deliver(), its only caller (once per frame and endpoint).
-[[gnu::always_inline]] inline void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns) noexcept {
+[[gnu::always_inline]] inline void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns, std::size_t word,
+                                                          std::uint64_t bit) noexcept {
   if (rx_count_ == rx_.size()) [[unlikely]] {
     ++counters_.rx_dropped;
     push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, t_ns});
@@ -57,7 +58,7 @@ BusState SimBus::Endpoint::state() const noexcept { return bus_.state_; }
   rx_[tail].frame = f;
   rx_[tail].t_ns = t_ns;
   ++rx_count_;
-  if (filtered_ && in(openers_, f)) open_ = true;
+  if (filtered_ && (openers_[word] & bit) != 0) open_ = true;
   ++counters_.rx_frames;
 }
 
@@ -138,8 +139,14 @@ void SimBus::deliver(const Endpoint* from, const Frame& frame, std::int64_t t_ns
   ++counters_.delivered;
   const Frame f = frame;  // read the sender's frame once, written straight into each ring
   if (tap_) tap_(TimedFrame{f, t_ns}, name_);
+  // Where the id sits in the endpoints' filter sets (Endpoint::accepts, once for all).
+  const bool standard = (f.flags & (kExtended | kError)) == 0 && f.id < 2048;
+  const std::size_t word = standard ? f.id >> 6 : 0;
+  const std::uint64_t bit = standard ? std::uint64_t{1} << (f.id & 63u) : 0;
   for (auto& ep : endpoints_) {
-    if (ep.get() != from && ep->accepts(f)) ep->push(f, t_ns);
+    Endpoint& e = *ep;
+    if (&e == from || (e.filtered_ && !e.open_ && (e.accept_[word] & bit) == 0)) continue;
+    e.push(f, t_ns, word, bit);
   }
 }
 

@@ -99,7 +99,8 @@ class SimBus {
    private:
     friend class SimBus;
     Endpoint(SimBus& bus, std::string name, std::size_t capacity);
-    void push(const Frame& f, std::int64_t t_ns) noexcept;
+    /// `word`/`bit`: where f's id sits in the filter sets (0 for an extended or error frame).
+    void push(const Frame& f, std::int64_t t_ns, std::size_t word, std::uint64_t bit) noexcept;
     void push_event(const BusEvent& e) noexcept;
     SimBus& bus_;
     std::string name_;
@@ -114,10 +115,10 @@ class SimBus {
       if ((f.flags & (kExtended | kError)) != 0 || f.id >= 2048) return false;
       return ((set[f.id >> 6] >> (f.id & 63u)) & 1u) != 0;
     }
-    IdSet accept_{};
-    IdSet openers_{};
     bool filtered_ = false;
     bool open_ = false;  ///< an opener was pushed and the ring has not been emptied since
+    IdSet accept_{};
+    IdSet openers_{};
   };
 
   /// `name` is the interface name used in traces ("sim0").
