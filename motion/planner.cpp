@@ -1389,7 +1389,8 @@ void Planner::update_status(AxisRt& a) noexcept {
   const auto* gr = std::get_if<GearGen>(&a.gen[static_cast<std::size_t>(Slot::Gear)]);
   setb(GearingStatus, gr != nullptr);
   setb(GearingLockStatus, gr && gr->locked);
-  setb(StoppingStatus, any_stopping(a));
+  const bool stopping = any_stopping(a);
+  setb(StoppingStatus, stopping);
   setb(HomingStatus, a.homing);
   setb(AxisHomedStatus, a.homed);
   setb(AccelStatus, a.cmd.v * a.cmd.a > 0 || (a.cmd.v == 0 && a.cmd.a != 0));
@@ -1420,7 +1421,7 @@ void Planner::update_status(AxisRt& a) noexcept {
   if (a.cfg.inhibited) t.cip_state = CipAxisState::AxisInhibited;
   else if (a.shutdown) t.cip_state = CipAxisState::Shutdown;
   else if (a.faulted) t.cip_state = CipAxisState::MajorFaulted;
-  else if (a.servo) t.cip_state = any_stopping(a) ? CipAxisState::Stopping : CipAxisState::Running;
+  else if (a.servo) t.cip_state = stopping ? CipAxisState::Stopping : CipAxisState::Running;
   else if (a.enable_req) t.cip_state = CipAxisState::Starting;
   else t.cip_state = CipAxisState::Stopped;
   // tags in the user frame
@@ -1759,6 +1760,21 @@ void Planner::compute_order() noexcept {
     }
     for (std::size_t k = n; k < kSlots; ++k) out[k] = kNoAxis;
   };
+  // The masters of every axis, once per cycle (the walk below visits an axis
+  // several times). Usually no axis follows another: then the order is the
+  // axis order, which is what the walk would give.
+  std::array<std::array<AxisId, kSlots>, kMaxAxes> masters;  // [i] set for present axes
+  bool linked = false;
+  for (std::size_t i = 0; i < axis_count_; ++i) {
+    if (!axes_[i].present) continue;
+    masters_of(static_cast<AxisId>(i), masters[i]);
+    linked = linked || masters[i][0] != kNoAxis;
+  }
+  if (!linked) {
+    for (std::size_t i = 0; i < axis_count_; ++i)
+      if (axes_[i].present) order_[order_n_++] = static_cast<AxisId>(i);
+    return;
+  }
   struct Frame { AxisId axis; std::uint8_t next; };
   std::array<Frame, kMaxAxes> stack{};
   for (std::size_t i = 0; i < axis_count_; ++i) {
@@ -1768,8 +1784,7 @@ void Planner::compute_order() noexcept {
     mark[i] = 1;
     while (sp > 0) {
       Frame& f = stack[sp - 1];
-      std::array<AxisId, kSlots> ms{};
-      masters_of(f.axis, ms);
+      const std::array<AxisId, kSlots>& ms = masters[f.axis];
       bool pushed = false;
       while (f.next < kSlots) {
         const AxisId m = ms[f.next++];

@@ -24,6 +24,12 @@ std::size_t SimBus::Endpoint::receive(std::span<TimedFrame> out) noexcept {
     if (++rx_head_ == rx_.size()) rx_head_ = 0;
     --rx_count_;
   }
+  // An empty ring starts again at its first slot: the few slots a cycle
+  // uses stay in the cache instead of sweeping the whole ring.
+  if (rx_count_ == 0) {
+    rx_head_ = 0;
+    open_ = false;  // the owner has seen the opener (see set_accept)
+  }
   return n;
 }
 
@@ -39,16 +45,20 @@ std::size_t SimBus::Endpoint::poll_events(std::span<BusEvent> out) noexcept {
 
 BusState SimBus::Endpoint::state() const noexcept { return bus_.state_; }
 
-void SimBus::Endpoint::push(const TimedFrame& f) noexcept {
-  if (rx_count_ == rx_.size()) {
+// Inlined into deliver(), its only caller (once per frame and endpoint).
+[[gnu::always_inline]] inline void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns, std::size_t word,
+                                                          std::uint64_t bit) noexcept {
+  if (rx_count_ == rx_.size()) [[unlikely]] {
     ++counters_.rx_dropped;
-    push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, f.t_ns});
+    push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, t_ns});
     return;
   }
   std::size_t tail = rx_head_ + rx_count_;  // < 2 * size: one wrap at most
   if (tail >= rx_.size()) tail -= rx_.size();
-  rx_[tail] = f;
+  rx_[tail].frame = f;
+  rx_[tail].t_ns = t_ns;
   ++rx_count_;
+  if (filtered_ && (openers_[word] & bit) != 0) open_ = true;
   ++counters_.rx_frames;
 }
 
@@ -88,6 +98,10 @@ void SimBus::set_state(BusState s) noexcept {
 SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
   if (state_ == BusState::kBusOff) return SendResult::kBusOff;
   ++counters_.sent;
+  if (faults_.empty()) {  // no fault injection: straight to the wire
+    deliver(&from, f, now_ns_);
+    return SendResult::kOk;
+  }
   Frame frame = f;
   for (Rule& r : faults_) {
     if (r.fault.cob_id != SimFault::kAnyId && r.fault.cob_id != f.id) continue;
@@ -121,12 +135,18 @@ SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
   return SendResult::kOk;
 }
 
-void SimBus::deliver(const Endpoint* from, const Frame& f, std::int64_t t_ns) noexcept {
+void SimBus::deliver(const Endpoint* from, const Frame& frame, std::int64_t t_ns) noexcept {
   ++counters_.delivered;
-  const TimedFrame tf{f, t_ns};
-  if (tap_) tap_(tf, name_);
+  const Frame f = frame;  // read the sender's frame once, written straight into each ring
+  if (tap_) tap_(TimedFrame{f, t_ns}, name_);
+  // Where the id sits in the endpoints' filter sets (Endpoint::accepts, once for all).
+  const bool standard = (f.flags & (kExtended | kError)) == 0 && f.id < 2048;
+  const std::size_t word = standard ? f.id >> 6 : 0;
+  const std::uint64_t bit = standard ? std::uint64_t{1} << (f.id & 63u) : 0;
   for (auto& ep : endpoints_) {
-    if (ep.get() != from) ep->push(tf);
+    Endpoint& e = *ep;
+    if (&e == from || (e.filtered_ && !e.open_ && (e.accept_[word] & bit) == 0)) continue;
+    e.push(f, t_ns, word, bit);
   }
 }
 

@@ -101,6 +101,8 @@ class SdoClient {
   /// True when nothing is running or queued.
   [[nodiscard]] bool idle() const noexcept { return phase_ == Phase::kIdle && queue_count_ == 0 && !tx_pending_; }
   [[nodiscard]] std::size_t queued() const noexcept { return queue_count_; }
+  /// Finished transfers waiting for poll()/poll_tag().
+  [[nodiscard]] std::size_t results() const noexcept { return result_count_; }
   [[nodiscard]] std::uint64_t completed() const noexcept { return completed_; }
   [[nodiscard]] std::uint64_t failed() const noexcept { return failed_; }
 

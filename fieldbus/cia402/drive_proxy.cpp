@@ -528,7 +528,7 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   // results stay for whoever queued them (the application's own transfers).
   // Only set_mode() queues kModeWriteTag writes, and only when 0x6060 is not
   // in an RPDO: otherwise skip the poll (and the ~300-byte SdoResult).
-  if (mode_slot_.pdo < 0) {
+  if (mode_slot_.pdo < 0 && master_.sdo(cfg_.node).results() > 0) {
     canopen::SdoResult r;
     while (master_.sdo(cfg_.node).poll_tag(kModeWriteTag, r)) {
       if (r.ok() && mdisp_slot_.pdo < 0) fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);
@@ -562,11 +562,23 @@ void DriveProxy::on_sync_sent() noexcept { expect_tpdo_ = phase_ == Phase::kOper
 // ============================================================================
 // DriveNetwork
 // ============================================================================
-DriveNetwork::DriveNetwork(const NetworkConfig& cfg) : master_(cfg.master), events_(kEventCapacity) { index_.fill(-1); }
+DriveNetwork::DriveNetwork(const NetworkConfig& cfg) : master_(cfg.master), events_(kEventCapacity) {
+  index_.fill(-1);
+  tpdo_owner_.fill(-1);
+}
 
 DriveProxy& DriveNetwork::add_drive(const DriveConfig& cfg) {
   drives_.push_back(std::make_unique<DriveProxy>(cfg, master_));
   index_[cfg.node] = static_cast<std::int16_t>(drives_.size() - 1);
+  // Only where classify() would route the frame to this drive anyway (at most
+  // 127 drives, so the index fits).
+  const DriveProxy& d = *drives_.back();
+  for (std::uint8_t p = 0; p < d.pdos().tpdo_count; ++p) {
+    const std::uint32_t id = d.pdos().tpdo[p].cob_id & 0x7FFu;
+    const canopen::CobInfo c = canopen::classify(id);
+    if (c.kind == canopen::FrameKind::kTpdo && c.node == cfg.node)
+      tpdo_owner_[id] = static_cast<std::int8_t>(drives_.size() - 1);
+  }
   return *drives_.back();
 }
 
@@ -576,6 +588,13 @@ DriveProxy* DriveNetwork::drive(std::uint8_t node) noexcept {
 }
 
 void DriveNetwork::on_frame(const can::TimedFrame& f) noexcept {
+  // A TPDO of one of our drives (the master ignores TPDOs): straight to it.
+  if ((f.frame.flags & (can::kExtended | can::kError)) == 0 && f.frame.id < tpdo_owner_.size()) {
+    if (const std::int8_t k = tpdo_owner_[f.frame.id]; k >= 0) {
+      drives_[static_cast<std::size_t>(k)]->on_frame(f);
+      return;
+    }
+  }
   if (master_.on_frame(f)) return;
   const canopen::CobInfo c = canopen::classify(f.frame.id);
   if (c.kind != canopen::FrameKind::kTpdo) return;

@@ -305,6 +305,9 @@ class DriveNetwork {
   canopen::Master master_;
   std::vector<std::unique_ptr<DriveProxy>> drives_;
   std::array<std::int16_t, 128> index_{};
+  /// The drive (index in drives_) whose TPDO has this standard COB-ID, or -1:
+  /// on_frame() hands TPDOs over without classifying them twice.
+  std::array<std::int8_t, 2048> tpdo_owner_{};
   std::vector<canopen::NodeEvent> events_;
   std::size_t ev_head_ = 0;
   std::size_t ev_count_ = 0;

@@ -280,7 +280,10 @@ std::uint64_t Emulator::get(std::uint16_t index, std::uint8_t sub) const noexcep
   return e ? e->value : 0;
 }
 std::int64_t Emulator::get_signed(std::uint16_t index, std::uint8_t sub) const noexcept { return sval(find(index, sub)); }
-void Emulator::set(std::uint16_t index, std::uint8_t sub, std::uint64_t v) noexcept { put(find(index, sub), v); }
+void Emulator::set(std::uint16_t index, std::uint8_t sub, std::uint64_t v) noexcept {
+  put(find(index, sub), v);
+  ++accept_gen_;  // e.g. 0x1005 (SYNC COB-ID): the accepted identifiers may change
+}
 std::int64_t Emulator::read_int(std::uint16_t index, std::uint8_t sub) const noexcept {
   if (index == obj::kStatusword && sub == 0) return statusword();
   return get_signed(index, sub);
@@ -340,6 +343,7 @@ void Emulator::rebuild_pdos() noexcept {
   rpdo_active_count_ = 0;
   for (std::uint8_t p = 0; p < 4; ++p)
     if (rpdo_valid_[p]) rpdo_active_[rpdo_active_count_++] = p;
+  ++accept_gen_;
 }
 
 SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::uint64_t v) const noexcept {
@@ -551,6 +555,28 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
     }
   }
   out_ = nullptr;
+}
+
+void Emulator::accepted_ids(std::array<std::uint64_t, 2048 / 64>& ids,
+                            std::array<std::uint64_t, 2048 / 64>& openers) const noexcept {
+  // Keep in step with on_frame(): exactly the identifiers it can act on.
+  ids = {};
+  openers = {};
+  auto add = [](std::array<std::uint64_t, 2048 / 64>& set, std::uint32_t id) noexcept {
+    if (id < 2048) set[id >> 6] |= std::uint64_t{1} << (id & 63u);
+  };
+  add(ids, canopen::cob::kNmt);
+  add(ids, static_cast<std::uint32_t>(val(hot_.sync_cob) & 0x7FFu));
+  add(ids, canopen::cob::sdo_rx(cfg_.node));
+  // Only NMT (reset: the defaults again) and SDO writes (0x1005, 0x14xx,
+  // 0x16xx) change what is accepted; SYNC, RPDOs and heartbeats do not.
+  add(openers, canopen::cob::kNmt);
+  add(openers, canopen::cob::sdo_rx(cfg_.node));
+  // Heartbeats 0x701..0x77F (any producer: the consumer entries 0x1016 pick theirs).
+  static_assert(canopen::cob::kHeartbeatBase % 128 == 0);
+  ids[canopen::cob::kHeartbeatBase >> 6] |= ~std::uint64_t{1};  // 0x701..0x73F
+  ids[(canopen::cob::kHeartbeatBase >> 6) + 1] = ~std::uint64_t{0};  // 0x740..0x77F
+  for (std::uint8_t k = 0; k < rpdo_active_count_; ++k) add(ids, rpdo_[rpdo_active_[k]].cob_id);
 }
 
 void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
@@ -773,7 +799,7 @@ void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
     const std::uint8_t t = m.transmission_type;
     if (t >= 241 && t <= 253) continue;  // RTR-only / reserved: not sent on SYNC
     ++tpdo_sync_count_[p];
-    if (t >= 1 && t <= 240 && tpdo_sync_count_[p] % t != 0) continue;
+    if (t >= 2 && t <= 240 && tpdo_sync_count_[p] % t != 0) continue;  // (1: every SYNC, no division)
     can::Frame f;
     f.id = m.cob_id;
     f.len = m.size_bytes;
@@ -840,10 +866,14 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
   // Motor: advances by the interpolation period 0x60C2, only here.
   const cia402::InterpolationPeriod ip{static_cast<std::uint8_t>(val(hot_.ip_value)),
                                         static_cast<std::int8_t>(sval(hot_.ip_index))};
-  std::int64_t period_ns = cia402::interpolation_period_ns(ip);
-  if (period_ns <= 0) period_ns = 1'000'000;
+  if (!sync_period_.valid || ip.value != sync_period_.ip.value || ip.index != sync_period_.ip.index) {
+    std::int64_t ns = cia402::interpolation_period_ns(ip);
+    if (ns <= 0) ns = 1'000'000;
+    sync_period_ = SyncPeriod{ip, ns, static_cast<double>(ns) / 1e9, true};
+  }
+  const std::int64_t period_ns = sync_period_.ns;
   sync_period_ns_ = period_ns;
-  advance_motor(static_cast<double>(period_ns) / 1e9);
+  advance_motor(sync_period_.dt);
   // Following error monitoring (CSP, Operation enabled).
   const auto window = static_cast<std::uint32_t>(val(hot_.fe_window));
   if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kCsp) &&

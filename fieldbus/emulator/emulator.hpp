@@ -111,6 +111,18 @@ class Emulator final : public canopen::SdoServerBackend {
   /// This is how the emulator attaches to a SimBus endpoint or a SocketCanBus.
   void service(can::Transport& bus, std::int64_t now_ns) noexcept;
 
+  /// The standard identifiers on_frame() acts on (NMT, SYNC, this node's SDO
+  /// requests, heartbeats, the valid RPDOs), as bits (id % 64 of word
+  /// id / 64); every other frame, and every extended or error frame, is
+  /// ignored. `openers`: those of them that may change the set (NMT and SDO
+  /// requests: resets, writes of 0x1005 or of the RPDO parameters), after
+  /// which the set must be asked for again. For an acceptance filter in
+  /// front of the emulator (SimWorld). Realtime-safe.
+  void accepted_ids(std::array<std::uint64_t, 2048 / 64>& ids, std::array<std::uint64_t, 2048 / 64>& openers) const noexcept;
+  /// Changes whenever the set accepted_ids() returns may have changed
+  /// (any dictionary write through set(), a PDO rebuild, a reset).
+  [[nodiscard]] std::uint64_t accept_generation() const noexcept { return accept_gen_; }
+
   /// Inject a fault with EMCY `code` (as writing 0x2000 does).
   void inject_fault(std::uint16_t code) noexcept { pending_fault_ = code; }
 
@@ -313,6 +325,16 @@ class Emulator final : public canopen::SdoServerBackend {
   std::size_t delay_head_ = 0;
   EmulatorCounters counters_{};
   canopen::FrameSink* out_ = nullptr;  // sink of the frame being handled (SDO writes of 0x6040)
+  std::uint64_t accept_gen_ = 0;       // see accept_generation()
+  /// 0x60C2 as last seen by handle_sync() and the period it gives (computed
+  /// again only when 0x60C2 changes).
+  struct SyncPeriod {
+    cia402::InterpolationPeriod ip{};
+    std::int64_t ns = 0;
+    double dt = 0;
+    bool valid = false;
+  };
+  SyncPeriod sync_period_{};
 };
 
 }  // namespace canmotion::emulator

@@ -8,6 +8,22 @@
 
 namespace canmotion::rt {
 
+namespace {
+// std::round (half away from zero) without the libm call, for results that
+// are converted to integers (the sign of a zero does not matter). x - trunc(x)
+// is exact below 2^52, so halves are detected exactly; NaN and larger values
+// come back unchanged, as from std::round.
+inline double round_half_away(double x) noexcept {
+  constexpr double kAllIntegral = 4503599627370496.0;  // 2^52: from here on every double is an integer
+  if (!(std::abs(x) < kAllIntegral)) return x;
+  const double t = static_cast<double>(static_cast<std::int64_t>(x));  // trunc
+  const double d = x - t;
+  if (d >= 0.5) return t + 1.0;
+  if (d <= -0.5) return t - 1.0;
+  return t;
+}
+}  // namespace
+
 motion::DriveState drive_state_of(cia402::State s, bool operational) noexcept {
   using S = cia402::State;
   switch (s) {
@@ -30,7 +46,7 @@ class Controller::RecordingSink final : public canopen::FrameSink {
       ++b.rejected;
       return false;
     }
-    c_.record(bus_, can::TimedFrame{f, now_ns}, true);
+    if (c_.trace_on_.load(std::memory_order_relaxed)) c_.record(bus_, can::TimedFrame{f, now_ns}, true);
     return true;
   }
   std::int64_t now_ns = 0;
@@ -157,7 +173,7 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
 void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   BusRt& bus = buses_[b];
   // Bus events first: a bus-off reported now applies to this cycle's feedback.
-  std::array<can::BusEvent, 16> ev{};
+  std::array<can::BusEvent, 16>& ev = bus_ev_;
   for (std::size_t n; (n = bus.transport->poll_events(ev)) > 0;) {
     for (std::size_t i = 0; i < n; ++i) {
       if (ev[i].kind == can::BusEvent::Kind::kStateChanged || ev[i].kind == can::BusEvent::Kind::kRestarted) {
@@ -233,14 +249,14 @@ void Controller::apply(std::size_t a, const motion::AxisOutput& out) noexcept {
   // Targets in drive units, saturated to the object's range.
   auto sat32 = [](double v) noexcept -> std::int32_t {
     if (!(v == v)) return 0;
-    v = std::round(v);
+    v = round_half_away(v);
     if (v > std::numeric_limits<std::int32_t>::max()) return std::numeric_limits<std::int32_t>::max();
     if (v < std::numeric_limits<std::int32_t>::min()) return std::numeric_limits<std::int32_t>::min();
     return static_cast<std::int32_t>(v);
   };
   p.set_target_position(sat32(out.position * ax.conv));
   p.set_target_velocity(sat32(out.velocity * ax.conv));
-  const double t = std::round(out.torque);
+  const double t = round_half_away(out.torque);
   p.set_target_torque(static_cast<std::int16_t>(t > 32767 ? 32767 : (t < -32768 ? -32768 : t)));
 }
 

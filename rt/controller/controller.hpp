@@ -330,6 +330,7 @@ class Controller {
   std::array<motion::AxisOutput, motion::kMaxAxes> out_{};
   std::array<motion::Request, kMaxRequestsPerCycle> requests_{};
   std::array<can::TimedFrame, kRxBatch> rx_{};
+  std::array<can::BusEvent, 16> bus_ev_{};  ///< receive()'s bus events (a member: not re-initialised each call)
   std::array<double, motion::kMaxAxes> max_err_{};
   std::optional<Command> held_;  ///< a command popped but deferred to the next cycle
   /// Controlled stop of the buses (Command::kPreOperational).

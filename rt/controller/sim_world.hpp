@@ -57,7 +57,13 @@ class SimWorld {
     std::unique_ptr<emulator::Emulator> emu;
     can::SimBus::Endpoint* ep = nullptr;
     bool connected = true;
+    bool filtered = false;         ///< ep's acceptance filter is set ...
+    std::uint64_t accept_gen = 0;  ///< ... from this emu->accept_generation()
   };
+  /// Set the drive endpoint's acceptance filter to the identifiers its
+  /// emulator acts on, when they changed: the drive is not handed the other
+  /// nodes' PDOs that it would only drop. Realtime-safe.
+  static void refresh_filter(Drive& d) noexcept;
   std::vector<Bus> buses_;
   std::vector<Drive> drives_;
 };
