@@ -242,3 +242,45 @@ TEST(Mag, ActualMasterReferenceOnACipMaster) {
   r.step();
   EXPECT_DOUBLE_EQ(r.axis("S").command_position, 3.0);
 }
+
+// Property: while the clutch ramps the slave to gearing speed, its command
+// velocity never changes by more than AccelRate x period per cycle, whatever
+// the ratio, its sign, the master speed and whether the master is still
+// accelerating; and the slave locks, within the time the ramp needs.
+TEST(MagProperty, ClutchRampsRespectTheAccelRate) {
+  const std::uint64_t seed = canmotion::motion::test::prop_seed() + 21;
+  const auto count = canmotion::motion::test::prop_count(200);
+  canmotion::motion::test::Rng rng(seed);
+  for (std::uint64_t k = 0; k < count; ++k) {
+    Rig r = geared_rig();
+    const double v = (rng.coin() ? 1 : -1) * rng.uni(5, 200);              // master jog speed
+    const double ma = rng.coin(0.3) ? rng.uni(50, 500) : 1e6;              // master still accelerating?
+    const double ratio = std::round((rng.coin() ? 1 : -1) * rng.uni(0.1, 5) * 1e5) / 1e5;
+    const double acc = std::round(rng.uni(50, 5000));                      // clutch accel, units/s^2
+    r.exec(maj("M", "j", v > 0 ? 0 : 1, std::fabs(v), ma, ma));
+    r.step(1 + static_cast<int>(rng.uni(0, 20)));
+    ASSERT_EQ(r.exec(mag("g", "same", ratio, "enabled", acc)), Err::None) << "seed=" << seed << " case " << k;
+    const double dv_max = acc * 0.001 * (1 + 1e-9) + 1e-9;
+    double prev = r.axis("S").command_velocity;
+    // ramp time to the final gear speed, plus the master's own ramp, plus margin
+    const int bound = static_cast<int>((std::fabs(ratio * v) / acc + std::fabs(v) / ma) * 1000) + 50;
+    int n = 0;
+    while (!r.axis("S").motion(motion_status::GearingLockStatus) && n < bound) {
+      r.step();
+      ++n;
+      const double vel = r.axis("S").command_velocity;
+      if (!r.axis("S").motion(motion_status::GearingLockStatus)) {
+        ASSERT_LE(std::fabs(vel - prev), dv_max)
+            << "seed=" << seed << " case " << k << " cycle " << n << " ratio " << ratio << " master " << v
+            << " accel " << acc;
+      }
+      prev = vel;
+    }
+    ASSERT_TRUE(r.axis("S").motion(motion_status::GearingLockStatus))
+        << "seed=" << seed << " case " << k << ": not locked after " << n << " cycles (ratio " << ratio
+        << ", master " << v << ", accel " << acc << ")";
+    r.step(static_cast<int>(std::fabs(v) / ma * 1000) + 5);
+    EXPECT_NEAR(r.axis("S").command_velocity, ratio * v, 1e-6 * std::fabs(ratio * v) + 1e-9)
+        << "seed=" << seed << " case " << k;
+  }
+}
