@@ -12,6 +12,25 @@
 
 namespace canmotion::motion::test {
 
+/// A virtual axis with the given maximum speed and acceleration = deceleration.
+inline AxisConfig axis_cfg(double max_speed, double max_accel) {
+  AxisConfig c;
+  c.max_speed = max_speed;
+  c.max_accel = c.max_decel = max_accel;
+  return c;
+}
+
+/// An AXIS_CIP_DRIVE for MDS: 200 units/s and 1000 (per mille) at 100 %.
+inline AxisConfig cip_direct(AxisConfig::DirectMode mode, double velocity_command = 0.0) {
+  AxisConfig c;
+  c.type = AxisType::CipDrive;
+  c.max_speed = 200;
+  c.max_torque = 1000;
+  c.direct_mode = mode;
+  c.direct_velocity_command = velocity_command;
+  return c;
+}
+
 struct Rig {
   std::unique_ptr<Planner> p = std::make_unique<Planner>(0.001);
   Symbols sym;

@@ -21,12 +21,7 @@ using canmotion::motion::test::Rng;
 
 namespace {
 
-AxisConfig cfg() {
-  AxisConfig c;
-  c.max_speed = 1e6;
-  c.max_accel = c.max_decel = 1e9;
-  return c;
-}
+AxisConfig cfg() { return canmotion::motion::test::axis_cfg(1e6, 1e9); }
 
 /// A random calculated profile: 2..6 points, increasing master values, linear
 /// or cubic segments.

@@ -14,12 +14,7 @@ using canmotion::motion::test::Rig;
 
 namespace {
 
-AxisConfig cfg() {
-  AxisConfig c;
-  c.max_speed = 1000;
-  c.max_accel = c.max_decel = 10000;
-  return c;
-}
+AxisConfig cfg() { return canmotion::motion::test::axis_cfg(1000, 10000); }
 
 Rig rig3() {
   Rig r;

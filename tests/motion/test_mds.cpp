@@ -13,12 +13,7 @@ using canmotion::motion::test::Rig;
 namespace {
 
 AxisConfig cip(AxisConfig::DirectMode mode = AxisConfig::DirectMode::Velocity) {
-  AxisConfig c;
-  c.type = AxisType::CipDrive;
-  c.max_speed = 200;
-  c.max_torque = 1000;
-  c.direct_mode = mode;
-  return c;
+  return canmotion::motion::test::cip_direct(mode);
 }
 
 }  // namespace

@@ -17,13 +17,7 @@ using canmotion::motion::test::Rig;
 namespace {
 
 AxisConfig cip(AxisConfig::DirectMode mode = AxisConfig::DirectMode::Velocity) {
-  AxisConfig c;
-  c.type = AxisType::CipDrive;
-  c.max_speed = 200;
-  c.max_torque = 1000;
-  c.direct_mode = mode;
-  c.direct_velocity_command = 25;
-  return c;
+  return canmotion::motion::test::cip_direct(mode, 25);
 }
 
 /// An enabled CIP axis "D" under MDS (control tag "m"), one cycle stepped.

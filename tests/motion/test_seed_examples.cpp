@@ -17,12 +17,7 @@ using canmotion::motion::test::Rig;
 
 namespace {
 
-AxisConfig cfg() {
-  AxisConfig c;
-  c.max_speed = 1000;
-  c.max_accel = c.max_decel = 1e6;
-  return c;
-}
+AxisConfig cfg() { return canmotion::motion::test::axis_cfg(1000, 1e6); }
 
 /// Virtual axes, servo on, the standard group "g".
 Rig rig(std::initializer_list<const char*> axes) {
