@@ -807,7 +807,8 @@ void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
     const auto& cache = tpdo_entries_[p];
     for (std::uint8_t i = 0; i < m.count; ++i) {
       const MappedEntry& me = cache[i];
-      const std::uint64_t v = me.is_statusword ? statusword() : val(me.entry);
+      // handle_sync() calls this right after update_outputs() stored statusword() in 0x6041.
+      const std::uint64_t v = me.is_statusword ? val(hot_.statusword) : val(me.entry);
       if (me.aligned) {
         canopen::store_le(f.data.data() + me.byte_offset, me.bytes, v);
       } else {
