@@ -709,9 +709,12 @@ void Emulator::advance_motor(double dt) noexcept {
                         static_cast<std::int16_t>(sval(hot_.target_torque) + sval(hot_.torque_offset))};
   // Delay line: the setpoint used now is the one received lag_cycles SYNCs ago.
   const std::size_t len = cfg_.lag_cycles + 1;
+  // delay_head_ < len (lag_cycles is fixed at construction), so the slot
+  // lag_cycles back, (head + len - lag_cycles) % len, is the next one: no division.
   delay_[delay_head_] = now_sp;
-  const Setpoint sp = delay_[(delay_head_ + len - cfg_.lag_cycles) % len];
-  delay_head_ = (delay_head_ + 1) % len;
+  const std::size_t next = delay_head_ + 1 == len ? 0 : delay_head_ + 1;
+  const Setpoint sp = delay_[next];
+  delay_head_ = next;
 
   const double vmax = std::min(cfg_.max_velocity, static_cast<double>(val(hot_.max_profile_velocity)));
   double amax = cfg_.max_acceleration;
