@@ -1751,6 +1751,7 @@ void Planner::compute_order() noexcept {
   order_n_ = 0;
   auto masters_of = [this](AxisId i, std::array<AxisId, kSlots>& out) noexcept {
     std::size_t n = 0;
+    out.fill(kNoAxis);  // the first n are overwritten below
     for (const auto& s : axes_[i].gen) {
       if (std::holds_alternative<std::monostate>(s)) continue;  // empty slot: no master
       AxisId m = kNoAxis;
@@ -1760,7 +1761,6 @@ void Planner::compute_order() noexcept {
       if (auto* cg = std::get_if<CamGen>(&s); cg && cg->master_driven) m = cg->md.master;
       if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
     }
-    for (std::size_t k = n; k < kSlots; ++k) out[k] = kNoAxis;
   };
   // The masters of every axis, once per cycle (the walk below visits an axis
   // several times). Usually no axis follows another: then the order is the
