@@ -1203,7 +1203,7 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
     if (p < a.cfg.soft_limit_neg) active |= bit(ExceptionKind::SoftOvertravelNeg);
   }
   std::uint32_t alarms = 0, faults = 0;
-  for (unsigned k = 0; k < static_cast<unsigned>(ExceptionKind::Count); ++k) {
+  for (unsigned k = 0; active != 0 && k < static_cast<unsigned>(ExceptionKind::Count); ++k) {  // usually none active
     if (!(active & (1u << k))) continue;
     const ExceptionAction act = a.cfg.action(static_cast<ExceptionKind>(k));
     if (act == ExceptionAction::Alarm) alarms |= 1u << k;
@@ -1214,7 +1214,7 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
   a.tag.exception_faults |= faults;
   // the most severe action of the new faults wins
   ExceptionAction worst = ExceptionAction::Ignore;
-  for (unsigned k = 0; k < static_cast<unsigned>(ExceptionKind::Count); ++k)
+  for (unsigned k = 0; fresh != 0 && k < static_cast<unsigned>(ExceptionKind::Count); ++k)
     if (fresh & (1u << k)) worst = most_severe(worst, a.cfg.action(static_cast<ExceptionKind>(k)));
   if (fresh & bit(ExceptionKind::SoftOvertravelPos)) a.tag.motion_fault_status |= 1u << motion_fault::SoftTravelLimitPositive;
   if (fresh & bit(ExceptionKind::SoftOvertravelNeg)) a.tag.motion_fault_status |= 1u << motion_fault::SoftTravelLimitNegative;
@@ -1262,6 +1262,7 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
                                                 Slot::MasterOffset, Slot::PositionCam, Slot::StopAll};
   for (const Slot slot_id : kStepOrder) {
     const auto s = static_cast<std::size_t>(slot_id);
+    if (std::holds_alternative<std::monostate>(a.gen[s])) continue;  // empty slot: nothing below applies
     if (auto* pc = std::get_if<PosCamGen>(&a.gen[s])) {
       step_position_cam(a, *pc);
       if (auto* still = std::get_if<PosCamGen>(&a.gen[s])) {
@@ -1750,7 +1751,9 @@ void Planner::compute_order() noexcept {
   order_n_ = 0;
   auto masters_of = [this](AxisId i, std::array<AxisId, kSlots>& out) noexcept {
     std::size_t n = 0;
+    out.fill(kNoAxis);  // the first n are overwritten below
     for (const auto& s : axes_[i].gen) {
+      if (std::holds_alternative<std::monostate>(s)) continue;  // empty slot: no master
       AxisId m = kNoAxis;
       if (auto* g = std::get_if<GearGen>(&s)) m = g->master;
       if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) m = p->master;
@@ -1758,7 +1761,6 @@ void Planner::compute_order() noexcept {
       if (auto* cg = std::get_if<CamGen>(&s); cg && cg->master_driven) m = cg->md.master;
       if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
     }
-    for (std::size_t k = n; k < kSlots; ++k) out[k] = kNoAxis;
   };
   // The masters of every axis, once per cycle (the walk below visits an axis
   // several times). Usually no axis follows another: then the order is the

@@ -14,7 +14,7 @@ namespace canmotion::cia402 {
 namespace {
 
 /// Write `v` into entry `entry` of `m` in `f` (payload length m.size_bytes). Realtime-safe.
-inline void put_entry(can::Frame& f, const canopen::PdoMap& m, std::int8_t entry, std::uint64_t v) noexcept {
+[[gnu::always_inline]] inline void put_entry(can::Frame& f, const canopen::PdoMap& m, std::int8_t entry, std::uint64_t v) noexcept {
   const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(entry)];
   // Byte-aligned entries inside the payload (all CiA 402 objects): direct store.
   if (((e.bit_offset | e.bits) % 8) == 0 && e.bit_offset / 8u + e.bits / 8u <= f.len) {

@@ -709,9 +709,12 @@ void Emulator::advance_motor(double dt) noexcept {
                         static_cast<std::int16_t>(sval(hot_.target_torque) + sval(hot_.torque_offset))};
   // Delay line: the setpoint used now is the one received lag_cycles SYNCs ago.
   const std::size_t len = cfg_.lag_cycles + 1;
+  // delay_head_ < len (lag_cycles is fixed at construction), so the slot
+  // lag_cycles back, (head + len - lag_cycles) % len, is the next one: no division.
   delay_[delay_head_] = now_sp;
-  const Setpoint sp = delay_[(delay_head_ + len - cfg_.lag_cycles) % len];
-  delay_head_ = (delay_head_ + 1) % len;
+  const std::size_t next = delay_head_ + 1 == len ? 0 : delay_head_ + 1;
+  const Setpoint sp = delay_[next];
+  delay_head_ = next;
 
   const double vmax = std::min(cfg_.max_velocity, static_cast<double>(val(hot_.max_profile_velocity)));
   double amax = cfg_.max_acceleration;
@@ -807,7 +810,8 @@ void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
     const auto& cache = tpdo_entries_[p];
     for (std::uint8_t i = 0; i < m.count; ++i) {
       const MappedEntry& me = cache[i];
-      const std::uint64_t v = me.is_statusword ? statusword() : val(me.entry);
+      // handle_sync() calls this right after update_outputs() stored statusword() in 0x6041.
+      const std::uint64_t v = me.is_statusword ? val(hot_.statusword) : val(me.entry);
       if (me.aligned) {
         canopen::store_le(f.data.data() + me.byte_offset, me.bytes, v);
       } else {
