@@ -3,6 +3,8 @@
 // from them (the array tags exist and MCCP runs on them).
 #include <gtest/gtest.h>
 
+#include "tests/config/config_errors.hpp"
+
 #include <string>
 
 #include "config/config.hpp"
@@ -21,15 +23,7 @@ cams:
     points: [[0, 0, cubic], [1, 2, cubic], [2, 0]]
 )";
 
-std::string errors_of(const std::string& yaml) {
-  try {
-    (void)load_string(yaml, "arr.yaml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "loaded without error:\n" << yaml;
-  return {};
-}
+std::string errors_of(const std::string& yaml) { return test::errors_of(yaml, "arr.yaml"); }
 
 TEST(ConfigArrays, LoadsTheThreeTypesWithInitialValues) {
   const Config c = load_string(kHead + R"(arrays:

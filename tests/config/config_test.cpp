@@ -2,6 +2,8 @@
 // column and key; nothing is returned when anything is wrong.
 #include <gtest/gtest.h>
 
+#include "tests/config/config_errors.hpp"
+
 #include <string>
 
 #include "config/config.hpp"
@@ -43,16 +45,7 @@ cams:
     points: [[0, 0], [90, 45, cubic], [180, 90, cubic]]
 )";
 
-/// Load text that must fail; return the whole message.
-std::string errors_of(const std::string& yaml) {
-  try {
-    (void)load_string(yaml, "test.yaml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "configuration was accepted:\n" << yaml;
-  return {};
-}
+using test::errors_of;
 
 TEST(Config, LoadsAGoodFile) {
   const Config c = load_string(kGood, "good.yaml");

@@ -5,6 +5,8 @@
 // reaches the drive proxy.
 #include <gtest/gtest.h>
 
+#include "tests/config/config_errors.hpp"
+
 #include <string>
 
 #include "config/runtime.hpp"
@@ -49,15 +51,7 @@ axes:
     node: 4
 )";
 
-std::string errors_of(const std::string& yaml) {
-  try {
-    (void)load_string(yaml, "test.yaml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "configuration was accepted:\n" << yaml;
-  return {};
-}
+using test::errors_of;
 
 std::string replaced(std::string y, const std::string& from, const std::string& to) {
   const auto i = y.find(from);

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "motion/cam/cam_profile.hpp"
+#include "poscam_rig.hpp"
 #include "rig.hpp"
 
 using namespace canmotion::motion;
@@ -24,41 +25,13 @@ namespace {
 
 using namespace motion_status;
 
-struct OffRig {
-  Rig r;
-  cam::CamProfile lin{4}, cub{8};
-  explicit OffRig(AxisType master_type = AxisType::Virtual) {
-    AxisConfig c;
-    c.max_speed = 1000;
-    r.add_axis("S", c);
-    AxisConfig m = c;
-    m.type = master_type;
-    r.add_axis("M", m);
-    EXPECT_EQ(r.exec("MSO(S, on);"), Err::None);
-    if (master_type == AxisType::Virtual) {
-      EXPECT_EQ(r.exec("MSO(M, on2);"), Err::None);
-    }
-    const std::array<cam::CamPoint, 2> l{{{0.0, 0.0, 0}, {10.0, 20.0, 0}}};
-    EXPECT_TRUE(cam::mccp(cam::MccpRequest{l, 0, 2, 0.0, 0.0}, lin).ok());
-    const std::array<cam::CamPoint, 5> q{{{0.0, 0.0, 1}, {2.0, 1.0, 1}, {5.0, 6.0, 1}, {8.0, 7.0, 1}, {10.0, 10.0, 1}}};
-    EXPECT_TRUE(cam::mccp(cam::MccpRequest{q, 0, 5, 0.0, 0.0}, cub).ok());
-    r.p->attach_cam_profile(0, &lin);
-    r.p->attach_cam_profile(1, &cub);
-    r.sym.cam_profiles["lin"] = 0;
-    r.sym.cam_profiles["cub"] = 1;
-    r.step();
-  }
+/// The position-cam rig, plus starting a continuous or once MAPC named pc.
+struct OffRig : canmotion::motion::test::PcRig {
+  using PcRig::PcRig;
   void cam(const std::string& prof = "lin", const std::string& mode = "continuous", const std::string& ref = "command") {
     ASSERT_EQ(r.exec("MAPC(S, M, pc, same, " + prof + "[0], 1, 1, " + mode + ", immediate, 0, 0, " + ref +
                      ", bidirectional);"),
               Err::None);
-  }
-  double m() { return r.axis("M").command_position; }
-  double s() { return r.axis("S").command_position; }
-  bool bit(unsigned b) { return r.axis("S").motion(b); }
-  void move_master(double target, double speed = 10) {
-    ASSERT_EQ(r.exec(mam("M", "mm", 0, target, speed, 1e5, 1e5)), Err::None);
-    r.step_until([&] { return r.tag("mm").pc(); });
   }
 };
 
