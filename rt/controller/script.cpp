@@ -37,6 +37,7 @@ std::string format_value(double v) {
     while (!s.empty() && s.back() == '0') s.pop_back();
     if (!s.empty() && s.back() == '.') s.pop_back();
   }
+  if (s == "-0") s = "0";  // a tiny negative value rounds to zero: no sign
   return s;
 }
 

@@ -186,6 +186,10 @@ TEST(ScriptLoad, AssignedTagsMayBeReadLater) {
 TEST(ScriptFormat, Values) {
   EXPECT_EQ(format_value(3), "3");
   EXPECT_EQ(format_value(-0.5), "-0.5");
+  EXPECT_EQ(format_value(-1e-9), "0") << "no '-0' for a value that rounds to zero";
+  EXPECT_EQ(format_value(-0.0), "0");
+  EXPECT_EQ(format_value(-0.0000004), "0");
+  EXPECT_EQ(format_value(-0.000001), "-0.000001");
   EXPECT_EQ(format_value(1.0 / 3.0), "0.333333");
   EXPECT_EQ(format_value(100.25), "100.25");
 }
