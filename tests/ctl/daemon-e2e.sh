@@ -22,6 +22,16 @@ fail() {
   exit 1
 }
 
+# wait_socket WHAT: wait up to 10 s for canmotiond ($pid) to create $sock.
+wait_socket() {
+  for _ in $(seq 1 200); do
+    [ -S "$sock" ] && return 0
+    kill -0 "$pid" 2>/dev/null || fail "canmotiond$1 exited before creating $sock"
+    sleep 0.05
+  done
+  fail "no socket $sock after 10 s$1"
+}
+
 # The daemon's own --script shares user tags with the socket's clients: it
 # waits for a tag that canmotionctl sets.
 cat >"$dir/daemon.script" <<'SCRIPT'
@@ -33,12 +43,7 @@ start=$(date +%s.%N)
 "$daemon" --config "$config" --sim --socket "$sock" --script "$dir/daemon.script" --duration 1000000 --quiet \
   >"$dir/daemon.out" 2>"$dir/daemon.err" &
 pid=$!
-for _ in $(seq 1 200); do
-  [ -S "$sock" ] && break
-  kill -0 "$pid" 2>/dev/null || fail "canmotiond exited before creating $sock"
-  sleep 0.05
-done
-[ -S "$sock" ] || fail "no socket $sock after 10 s"
+wait_socket ""
 mode=$(stat -c %a "$sock")
 [ "$mode" = 660 ] || fail "socket mode is $mode, not 660"
 
@@ -96,12 +101,7 @@ grep -q 'socket: client .* connected: pid' "$dir/daemon.err" || fail "connection
 # clock; STATS then includes the executive's latency statistics, also as tags.
 "$daemon" --config "$config" --socket "$sock" --quiet >"$dir/daemon.out" 2>"$dir/daemon.err" &
 pid=$!
-for _ in $(seq 1 200); do
-  [ -S "$sock" ] && break
-  kill -0 "$pid" 2>/dev/null || fail "canmotiond (real time) exited before creating $sock"
-  sleep 0.05
-done
-[ -S "$sock" ] || fail "no socket $sock after 10 s (real time)"
+wait_socket " (real time)"
 sleep 0.3
 out=$("$ctl" stats) || fail "stats (real time): $out"
 echo "$out"
