@@ -25,6 +25,7 @@ struct Idx {
       mcd_ajerk, mcd_chg_djerk, mcd_djerk, mcd_speed_units, mcd_accel_units, mcd_decel_units, mcd_jerk_units;
   int mrp_type, mrp_select, mrp_pos;
   int mgs_mode;
+  int mds_speed, matc_dir, matc_dscale, matc_tscale;
 };
 const Idx& idx() noexcept {
   static const Idx k{
@@ -45,6 +46,8 @@ const Idx& idx() noexcept {
       operand_index(Instr::MRP, "Type"), operand_index(Instr::MRP, "PositionSelect"),
       operand_index(Instr::MRP, "Position"),
       operand_index(Instr::MGS, "StopMode"),
+      operand_index(Instr::MDS, "Speed"), operand_index(Instr::MATC, "Direction"),
+      operand_index(Instr::MATC, "DistanceScaling"), operand_index(Instr::MATC, "TimeScaling"),
   };
   return k;
 }
@@ -327,8 +330,8 @@ Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, b
   const AxisRt& m = axes_[l.master];
   const double mp = l.use_actual ? m.fb_pos : m.cmd.p;
   const double mv = l.use_actual ? m.fb_vel : m.cmd.v;
-  const bool immediate = g.lock == LockDirection::ImmediateForwardOnly || g.lock == LockDirection::ImmediateReverseOnly;
-  const bool fwd = g.lock == LockDirection::ImmediateForwardOnly || g.lock == LockDirection::PositionForwardOnly;
+  const bool immediate = lock_immediate(g.lock);
+  const bool fwd = lock_forward(g.lock);
   const double udot = immediate ? std::max(0.0, fwd ? mv : -mv) : 0.0;
   if (start.v != 0 || start.a != 0) {
     // the slave's present motion, per unit of master travel
@@ -1263,29 +1266,27 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
   for (const Slot slot_id : kStepOrder) {
     const auto s = static_cast<std::size_t>(slot_id);
     if (std::holds_alternative<std::monostate>(a.gen[s])) continue;  // empty slot: nothing below applies
+    // cams may end (fold) or hand over (pending) while stepping: add what the slot holds afterwards
+    const auto add_slot = [&] {
+      if (const GenRef r = gen_ref(a.gen[s]); r.k) {
+        sum_p += r.k->p;
+        sum_v += r.k->v;
+        sum_a += r.k->a;
+      }
+    };
     if (auto* pc = std::get_if<PosCamGen>(&a.gen[s])) {
       step_position_cam(a, *pc);
-      if (auto* still = std::get_if<PosCamGen>(&a.gen[s])) {
-        sum_p += still->k.p;
-        sum_v += still->k.v;
-        sum_a += still->k.a;
-      }
+      add_slot();
       continue;
     }
     if (auto* cg = std::get_if<CamGen>(&a.gen[s])) {
       step_cam(a, *cg);
-      if (auto* still = std::get_if<CamGen>(&a.gen[s])) {
-        sum_p += still->k.p;
-        sum_v += still->k.v;
-        sum_a += still->k.a;
-      }
+      add_slot();
       continue;
     }
     if (auto* gg = std::get_if<GearGen>(&a.gen[s])) {
       step_gear(*gg);
-      sum_p += gg->k.p;
-      sum_v += gg->k.v;
-      sum_a += gg->k.a;
+      add_slot();
       continue;
     }
     auto* g = std::get_if<ProfileGen>(&a.gen[s]);
@@ -1566,7 +1567,7 @@ Err Planner::start_mds(const Request& r, const MdsParams& p, AxisRt& a, std::int
   const double full = torque ? a.cfg.max_torque : a.cfg.max_speed;
   const double cmd = p.percent_of_maximum ? p.speed / 100.0 * full : p.speed;
   if (!std::isfinite(cmd)) {
-    exerr = static_cast<std::int8_t>(operand_index(Instr::MDS, "Speed"));
+    exerr = static_cast<std::int8_t>(idx().mds_speed);
     return Err::ParameterOutOfRange;
   }
   ControlTag& c = controls_[r.control];
@@ -1641,7 +1642,7 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
   bool bad_slave = false, bad_master = false;
   const cam::CamScaling sc{p.distance_scaling, p.time_scaling};
   if (cam::check_scaling(sc, bad_slave, bad_master) != cam::CamError::None) {
-    exerr = static_cast<std::int8_t>(operand_index(Instr::MATC, bad_slave ? "DistanceScaling" : "TimeScaling"));
+    exerr = static_cast<std::int8_t>(bad_slave ? idx().matc_dscale : idx().matc_tscale);
     return Err::ParameterOutOfRange;
   }
   const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.cam_dir);
@@ -1667,7 +1668,7 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
   if (prof->acquire() != cam::CamError::None) return Err::CamProfileNotCalculated;
   if (g.cm.start(*prof, cfg, &bad) != cam::CamError::None) {
     prof->release();
-    exerr = static_cast<std::int8_t>(operand_index(Instr::MATC, "Direction"));
+    exerr = static_cast<std::int8_t>(idx().matc_dir);
     return Err::ParameterOutOfRange;
   }
   fold(a, Slot::TimeCam, true);

@@ -174,8 +174,7 @@ struct GearGen {
   double master_ref = 0.0;     ///< master position at lock (units, drive frame)
   std::int64_t master_ref_counts = 0;
   double offset_at_lock = 0.0;
-  Kin k{};                     ///< offset of this generator, velocity, acceleration
-  bool scurve = false;         ///< (gear ramps are trapezoidal)
+  Kin k{};                     ///< offset of this generator, velocity, acceleration (gear ramps are trapezoidal)
   ControlId owner = kNoControl;
   std::uint32_t owner_gen = 0;
 };
@@ -189,7 +188,6 @@ struct CamGen {
   double x_offset = 0.0;       ///< cam time = (cycle - t0_cycle) * T - x_offset (pending takeovers)
   std::int64_t last_pass = 0;  ///< pass of the last step (a pending cam waits for its end)
   Kin k{};
-  bool scurve = false;
   ControlId owner = kNoControl;
   std::uint32_t owner_gen = 0;
   /// master-driven MATC (InstructionMode masterdrivenmode): cam coordinate =
@@ -229,7 +227,6 @@ struct PosCamGen {
   double travel = 0.0;          ///< master travel since the lock as the cam follows it
   double offset_base = 0.0;     ///< sum of the finished master offset moves (master units)
   double x_shift = 0.0;         ///< cam coordinate of the takeover (pending cams)
-  double x = 0.0;               ///< cam coordinate of the last step
   std::int64_t last_pass = 0;
   Kin k{};
   ControlId owner = kNoControl;

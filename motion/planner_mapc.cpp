@@ -68,8 +68,7 @@ const AxisConfig* Planner::position_cam_master(const AxisRt& a) const noexcept {
 double Planner::master_offset(const AxisRt& a) const noexcept {
   const auto* pc = std::get_if<PosCamGen>(&a.gen[kPosCam]);
   if (!pc) return 0.0;
-  const auto* o = std::get_if<ProfileGen>(&a.gen[kOffset]);
-  return pc->offset_base + (o ? o->k.p : 0.0);
+  return pc->offset_base + slot_kin(a, Slot::MasterOffset).p;
 }
 
 void Planner::add_master_offset(AxisRt& a, double d) noexcept {
@@ -231,12 +230,8 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
     g.travel = mp - g.lock_mp;  // exact, no accumulated rounding
     g.slipping = false;
   }
-  double off = g.offset_base, off_v = 0.0, off_a = 0.0;
-  if (const auto* o = std::get_if<ProfileGen>(&a.gen[kOffset])) {
-    off += o->k.p;
-    off_v = o->k.v;
-    off_a = o->k.a;
-  }
+  const Kin ko = slot_kin(a, Slot::MasterOffset);  // the master offset move (only a ProfileGen runs there)
+  const double off = g.offset_base + ko.p, off_v = ko.v, off_a = ko.a;
   const double x = g.travel + off - g.x_shift;
   const cam::CamMotionOutput o = g.cm.step(x);
   const bool continuous = g.cm.config().mode == cam::ExecutionMode::Continuous;
@@ -307,7 +302,6 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
     }
   }
   g.last_pass = o.pass;
-  g.x = x;
   g.inside = o.range == cam::CamRange::Inside;
   const double xd = mv + off_v, xdd = ma + off_a;
   g.k = Kin{o.position, o.velocity * xd, o.acceleration * xd * xd + o.velocity * xdd};

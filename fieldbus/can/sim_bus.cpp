@@ -139,7 +139,8 @@ void SimBus::deliver(const Endpoint* from, const Frame& frame, std::int64_t t_ns
   ++counters_.delivered;
   const Frame f = frame;  // read the sender's frame once, written straight into each ring
   if (tap_) tap_(TimedFrame{f, t_ns}, name_);
-  // Where the id sits in the endpoints' filter sets (Endpoint::accepts, once for all).
+  // Where the id sits in the endpoints' filter sets, once for all: an endpoint
+  // takes the frame unless it is filtered, not opened, and the id's bit is clear.
   const bool standard = (f.flags & (kExtended | kError)) == 0 && f.id < 2048;
   const std::size_t word = standard ? f.id >> 6 : 0;
   const std::uint64_t bit = standard ? std::uint64_t{1} << (f.id & 63u) : 0;

@@ -91,10 +91,6 @@ class SimBus {
       filtered_ = true;
     }
     void clear_accept() noexcept { filtered_ = open_ = false; }
-    [[nodiscard]] bool accepts(const Frame& f) const noexcept {
-      if (!filtered_ || open_) return true;
-      return in(accept_, f);
-    }
 
    private:
     friend class SimBus;
@@ -111,10 +107,6 @@ class SimBus {
     std::size_t ev_head_ = 0;
     std::size_t ev_count_ = 0;
     BusCounters counters_{};
-    static bool in(const IdSet& set, const Frame& f) noexcept {
-      if ((f.flags & (kExtended | kError)) != 0 || f.id >= 2048) return false;
-      return ((set[f.id >> 6] >> (f.id & 63u)) & 1u) != 0;
-    }
     bool filtered_ = false;
     bool open_ = false;  ///< an opener was pushed and the ring has not been emptied since
     IdSet accept_{};

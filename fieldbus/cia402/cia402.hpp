@@ -8,11 +8,27 @@
 /// Everything here is constexpr, noexcept and realtime-safe.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string_view>
 
 namespace canmotion::cia402 {
+
+/// Round to the nearest integer, halves away from zero (as std::round), without
+/// the libm call: the master and the emulator use it to turn user units into
+/// drive counts. Callers convert the result to an integer, so the sign of a
+/// zero result does not matter. x - trunc(x) is exact below 2^52, so halves
+/// are detected exactly; NaN, infinities and larger values come back unchanged.
+inline double round_half_away(double x) noexcept {
+  constexpr double kAllIntegral = 4503599627370496.0;  // 2^52: from here on every double is an integer
+  if (!(std::abs(x) < kAllIntegral)) return x;
+  const double t = static_cast<double>(static_cast<std::int64_t>(x));  // trunc
+  const double d = x - t;
+  if (d >= 0.5) return t + 1.0;
+  if (d <= -0.5) return t - 1.0;
+  return t;
+}
 
 // ============================================================================
 // Object indices (CiA 402-2)

@@ -61,7 +61,7 @@ double Emulator::cst_step(double torque_cmd, double velocity_cmd, double dt, dou
   const auto set_point = static_cast<double>(val(hot_.slat_set_point));
   const std::int64_t delay_ns = static_cast<std::int64_t>(val(hot_.slat_delay)) * 1'000'000;
   // Velocity Error = velocity command (0x60FF) - actual velocity.
-  slat_speed_ = cia402::slat_speed_control(c, slat_speed_, velocity_cmd - vel_, set_point, sync_period_ns_, delay_ns,
+  slat_speed_ = cia402::slat_speed_control(c, slat_speed_, velocity_cmd - vel_, set_point, sync_period_.ns, delay_ns,
                                            slat_held_ns_);
   if (slat_speed_) {
     // Speed control: the torque that removes speed_loop_gain of the error

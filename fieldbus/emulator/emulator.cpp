@@ -20,18 +20,7 @@ bool is_rpdo_map(std::uint16_t i) { return i >= 0x1600 && i <= 0x1603; }
 bool is_tpdo_comm(std::uint16_t i) { return i >= 0x1800 && i <= 0x1803; }
 bool is_tpdo_map(std::uint16_t i) { return i >= 0x1A00 && i <= 0x1A03; }
 
-// std::round (half away from zero) without the libm call; every caller
-// converts the result to an integer, so the sign of a zero result does not
-// matter. x - trunc(x) is exact, so halves are detected exactly.
-inline double round_half_away(double x) noexcept {
-  constexpr double kAllIntegral = 4503599627370496.0;  // 2^52: from here on every double is an integer
-  if (!(std::abs(x) < kAllIntegral)) return x;           // also NaN and infinities, as std::round
-  const double t = static_cast<double>(static_cast<std::int64_t>(x));  // trunc
-  const double d = x - t;
-  if (d >= 0.5) return t + 1.0;
-  if (d <= -0.5) return t - 1.0;
-  return t;
-}
+using cia402::round_half_away;
 
 std::uint8_t error_register_for(std::uint16_t code) {
   std::uint8_t r = canopen::kErrGeneric;
@@ -876,7 +865,6 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
     sync_period_ = SyncPeriod{ip, ns, static_cast<double>(ns) / 1e9, true};
   }
   const std::int64_t period_ns = sync_period_.ns;
-  sync_period_ns_ = period_ns;
   advance_motor(sync_period_.dt);
   // Following error monitoring (CSP, Operation enabled).
   const auto window = static_cast<std::uint32_t>(val(hot_.fe_window));

@@ -313,7 +313,6 @@ class Emulator final : public canopen::SdoServerBackend {
   double ramp_acc_ = 0;             // CSV ramp: acceleration of the S-curve (counts/s^2)
   bool slat_speed_ = false;         // CST SLAT: in speed control
   std::int64_t slat_held_ns_ = 0;   // CST SLAT: time the torque->speed condition has held
-  std::int64_t sync_period_ns_ = 1'000'000;  // period of the present SYNC (for SLAT time delay)
   double torque_ = 0;               // motor torque at the last SYNC (per mille)
   static constexpr std::size_t kMaxLag = 64;  // bound of lag_cycles
   struct Setpoint {

@@ -134,8 +134,10 @@ struct CommandServer::Impl {
       return s_.host.tags().read(s_.status(), tag, error);
     }
     std::optional<std::string> write(std::string_view tag, double value) override {
+      const std::uint64_t before = s_.host.last_seq();
       auto e = s_.host.write(tag, value);
-      if (!e) seq_ = s_.host.last_seq();  // an array element write: settled() waits for the RT thread
+      // a write that queued a command (array element): settled() waits for the RT thread
+      if (!e && s_.host.last_seq() != before) seq_ = s_.host.last_seq();
       return e;
     }
     void declare(std::string_view tag) override { s_.host.declare(tag); }
@@ -300,8 +302,9 @@ struct CommandServer::Impl {
       throw std::runtime_error(fmt::format("cannot listen on socket '{}': {}", opt.path, errno_text(e)));
     }
 
-    // Register the executive's statistics as Controller.<field> tags.
-    if (opt.cycle_stats) {
+    // Register the executive's statistics as Controller.<field> tags (the
+    // owner of a shared host registers them there itself).
+    if (opt.cycle_stats && !opt.shared_host) {
       for (std::string_view name : stat_tag_names()) {
         auto get = opt.cycle_stats;
         const std::string n(name);

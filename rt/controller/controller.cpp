@@ -8,21 +8,7 @@
 
 namespace canmotion::rt {
 
-namespace {
-// std::round (half away from zero) without the libm call, for results that
-// are converted to integers (the sign of a zero does not matter). x - trunc(x)
-// is exact below 2^52, so halves are detected exactly; NaN and larger values
-// come back unchanged, as from std::round.
-inline double round_half_away(double x) noexcept {
-  constexpr double kAllIntegral = 4503599627370496.0;  // 2^52: from here on every double is an integer
-  if (!(std::abs(x) < kAllIntegral)) return x;
-  const double t = static_cast<double>(static_cast<std::int64_t>(x));  // trunc
-  const double d = x - t;
-  if (d >= 0.5) return t + 1.0;
-  if (d <= -0.5) return t - 1.0;
-  return t;
-}
-}  // namespace
+using cia402::round_half_away;
 
 motion::DriveState drive_state_of(cia402::State s, bool operational) noexcept {
   using S = cia402::State;

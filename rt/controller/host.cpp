@@ -57,7 +57,7 @@ std::optional<std::string> ControllerHost::check_tag(std::string_view tag, bool 
   const auto t = tags_.resolve(tag, &e);
   if (for_write) {
     if (t && !t->writable) return fmt::format("tag '{}' is read-only", tag);
-    if (!t && tag.find('.') != std::string_view::npos) return e;  // e.g. an array element out of range
+    if (!t && !TagTable::is_user_tag_name(tag)) return e;  // e.g. an array element out of range
     return std::nullopt;  // a new numeric tag is created by its first assignment
   }
   if (t) return std::nullopt;

@@ -298,6 +298,12 @@ std::optional<double> TagTable::read(const Status& s, std::string_view name, std
   return read(s, *t);
 }
 
+bool TagTable::is_user_tag_name(std::string_view name) noexcept {
+  if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; });
+}
+
 std::optional<std::string> TagTable::write(std::string_view name, double value, bool create) {
   std::string e;
   const auto t = resolve(name, &e);
@@ -327,9 +333,7 @@ std::optional<std::string> TagTable::write(std::string_view name, double value, 
     return std::nullopt;
   }
   if (!t) {
-    if (!create || name.find('.') != std::string_view::npos || name.empty() ||
-        !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_'))
-      return e;
+    if (!create || !is_user_tag_name(name)) return e;
     if (c_.axis_id(name) || c_.find_control(lower(name))) return fmt::format("'{}' is an axis or control tag, not a number", name);
   }
   user_[lower(name)] = value;

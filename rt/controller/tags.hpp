@@ -63,6 +63,9 @@ class TagTable {
   /// thread; acts on an active MDS, see Command::Kind::kDirectCommand), or an
   /// array element (queued to the RT thread; see last_write_seq()).
   std::optional<std::string> write(std::string_view name, double value, bool create);
+  /// True when `name` can be a user numeric tag: a letter or '_' followed by
+  /// letters, digits and '_' (no member '.', no array index '[i]').
+  static bool is_user_tag_name(std::string_view name) noexcept;
   /// Command sequence number of the last array element write (0 = none):
   /// the write is applied once Status::done_seq reaches it.
   [[nodiscard]] std::uint64_t last_write_seq() const noexcept { return last_write_seq_; }

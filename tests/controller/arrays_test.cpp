@@ -188,6 +188,14 @@ TEST(ArrayTags, ErrorsNameTheArrayAndWhatIsValid) {
   EXPECT_NE(w->find("DINT"), std::string::npos) << *w;
   EXPECT_TRUE(r.host->check_tag("pts[9].Slave", true));
   EXPECT_FALSE(r.host->check_tag("pts[7].Slave", true));
+  // An element out of range, or of an array that does not exist, is an error:
+  // it never becomes a user numeric tag named "ed[99]".
+  EXPECT_TRUE(r.host->check_tag("ed[99]", true));
+  EXPECT_TRUE(r.host->check_tag("nosuch[2]", true));
+  EXPECT_TRUE(r.host->write("ed[99]", 1.0));
+  EXPECT_TRUE(r.host->write("nosuch[2]", 1.0));
+  EXPECT_FALSE(r.host->read("ed[99]", &e));
+  EXPECT_FALSE(r.host->check_tag("NewTag_2", true)) << "a plain name still creates a user tag";
   EXPECT_TRUE(r.host->write("prof[0].Status", 0));  // read-only (MCCP and the cams set it)
   // an illegal segment type written as a tag reaches MCCP: ERR 28
   r.fill();
