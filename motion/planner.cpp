@@ -1755,11 +1755,7 @@ void Planner::compute_order() noexcept {
     out.fill(kNoAxis);  // the first n are overwritten below
     for (const auto& s : axes_[i].gen) {
       if (std::holds_alternative<std::monostate>(s)) continue;  // empty slot: no master
-      AxisId m = kNoAxis;
-      if (auto* g = std::get_if<GearGen>(&s)) m = g->master;
-      if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) m = p->master;
-      if (auto* pc = std::get_if<PosCamGen>(&s)) m = pc->master;
-      if (auto* cg = std::get_if<CamGen>(&s); cg && cg->master_driven) m = cg->md.master;
+      const AxisId m = master_of(s);
       if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
     }
   };

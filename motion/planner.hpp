@@ -265,6 +265,16 @@ inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
 /// The closed set of generator states. Issue 5 adds cam and direct states here.
 using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen, PosCamGen>;
 
+/// The master a generator follows (gear, master-driven move/jog/time cam,
+/// position cam), or kNoAxis. Realtime-safe.
+inline AxisId master_of(const Generator& s) noexcept {
+  if (auto* g = std::get_if<GearGen>(&s)) return g->master;
+  if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) return p->master;
+  if (auto* pc = std::get_if<PosCamGen>(&s)) return pc->master;
+  if (auto* cg = std::get_if<CamGen>(&s); cg && cg->master_driven) return cg->md.master;
+  return kNoAxis;
+}
+
 // typed instruction parameters (motion/instructions.hpp)
 struct MasParams;
 struct MajParams;

@@ -110,7 +110,7 @@ Err Planner::start_mapc(const Request& r, const MapcParams& p, AxisRt& a, std::i
   if (m.cfg.inhibited) return Err::AxisIsInhibited;
   if (p.slave == p.master) return Err::MasterAxisConflict;
   {
-    // the master must not follow the slave (gear, master-driven motion, position cam), directly or not
+    // the master must not follow the slave (gear, master-driven motion or time cam, position cam), directly or not
     std::array<std::uint8_t, kMaxAxes> seen{};
     std::array<AxisId, kMaxAxes> stack{};  // each axis is pushed at most once
     std::size_t sp = 0;
@@ -119,10 +119,7 @@ Err Planner::start_mapc(const Request& r, const MapcParams& p, AxisRt& a, std::i
     while (sp > 0) {
       const AxisId i = stack[--sp];
       for (const auto& s : axes_[i].gen) {
-        AxisId up = kNoAxis;
-        if (auto* g = std::get_if<GearGen>(&s)) up = g->master;
-        if (auto* q = std::get_if<ProfileGen>(&s); q && q->master_driven) up = q->master;
-        if (auto* c = std::get_if<PosCamGen>(&s)) up = c->master;
+        const AxisId up = master_of(s);  // gear, master-driven motion or cam, position cam
         if (up == p.slave) return Err::MasterAxisConflict;
         if (up < kMaxAxes && !seen[up]) {
           seen[up] = 1;

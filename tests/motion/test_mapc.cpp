@@ -533,3 +533,16 @@ TEST(MapcParse, KeywordsAndNumbersBindAlike) {
   EXPECT_TRUE(parse_and_bind("MAPC(S, M, k, same, lin[0], 1, 1, once, immediate, 0, 0, command);", c.r.sym, q)
                   .has_value());
 }
+
+// Circular through a master-driven time cam: M cams on S's travel (MDAC Time
+// Cam link + MATC master driven), so S may not position-cam on M.
+TEST(Mapc, MasterFollowingTheSlaveThroughAMasterDrivenCamIsAConflict) {
+  PcRig c;
+  ASSERT_EQ(c.r.exec("MDAC(M, S, md1, timecam, command);"), Err::None);
+  ASSERT_EQ(c.r.exec("MATC(M, mt1, same, lin[0], 1, 1, continuous, immediate, 0, immediateforwardonly, "
+                     "masterdrivenmode);"),
+            Err::None);
+  ASSERT_TRUE(c.r.tag("mt1").ip());
+  EXPECT_EQ(c.r.exec(PcRig::mapc("e", "lin", 1, 1, "once", "immediate")), Err::MasterAxisConflict);
+  EXPECT_EQ(c.lin.status(), 3) << "only the MATC uses the profile: the refused MAPC acquired nothing";
+}
