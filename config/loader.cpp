@@ -480,6 +480,67 @@ class Loader {
     return a;
   }
 
+  /// A list element that must be a finite real number (cam point coordinates,
+  /// REAL array values); `what` names it in the message ("master ", or "").
+  bool finite_number(const YAML::Node& e, const std::string& key, std::string_view what, double& out) {
+    if (e.IsScalar() && YAML::convert<double>::decode(e, out) && std::isfinite(out)) return true;
+    error(e, key, fmt::format("{}must be a finite number, got '{}'", what, e.IsScalar() ? e.Scalar() : "<non-scalar>"));
+    return false;
+  }
+
+  /// One cam point, `[master, slave]` or `[master, slave, linear|cubic]` (a
+  /// Logix CAM element: Master, Slave, SegmentType). The one parser of both
+  /// `cams[].points[]` and a CAM array's `values[]`: the same rules and the same
+  /// messages, reported at the offending element. nullopt once reported.
+  std::optional<CamPoint> cam_point(const YAML::Node& p, const std::string& key) {
+    if (!p.IsSequence() || (p.size() != 2 && p.size() != 3)) {
+      const std::string got = p.IsSequence() ? fmt::format("{} value{}", p.size(), p.size() == 1 ? "" : "s")
+                              : p.IsScalar() ? fmt::format("'{}'", p.Scalar())
+                              : p.IsMap()    ? std::string("a mapping")
+                                             : std::string("nothing");
+      error(p, key, fmt::format("must be [master, slave] or [master, slave, linear|cubic], got {}", got));
+      return std::nullopt;
+    }
+    CamPoint cp;
+    bool ok = finite_number(p[0], key, "master ", cp.master);
+    ok = finite_number(p[1], key, "slave ", cp.slave) && ok;
+    if (p.size() == 3) {
+      const std::string t = p[2].IsScalar() ? lower_compact(p[2].Scalar()) : std::string();
+      if (t == "cubic" || t == "1") cp.cubic = true;
+      else if (t != "linear" && t != "0") {
+        error(p[2], key, fmt::format("segment type must be linear (0) or cubic (1), got '{}'",
+                                     p[2].IsScalar() ? p[2].Scalar() : "<non-scalar>"));
+        ok = false;
+      }
+    }
+    if (!ok) return std::nullopt;
+    return cp;
+  }
+
+  /// A list of cam points (see cam_point): a `cams:` entry's `points`, or a CAM
+  /// array's `values`. `increasing`: master values must strictly increase (a
+  /// `cams:` entry is one cam, computed by MCCP at load). A CAM array's values
+  /// are not checked for order: one array may hold several cams, each given to
+  /// MCCP from its own start element, and MCCP checks the points it is given
+  /// (ERR 29). Every bad point is reported; returns the good ones.
+  std::vector<CamPoint> cam_points(const YAML::Node& list, const YAML::Node& parent, const std::string& key,
+                                   bool increasing) {
+    std::vector<CamPoint> out;
+    if (!list || !list.IsSequence()) {
+      error(list ? list : parent, key, "must be a list of [master, slave] or [master, slave, linear|cubic]");
+      return out;
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string k = fmt::format("{}[{}]", key, i);
+      const std::optional<CamPoint> cp = cam_point(list[i], k);
+      if (!cp) continue;
+      if (increasing && !out.empty() && cp->master <= out.back().master)
+        error(list[i], k, fmt::format("master values must increase: {} follows {}", cp->master, out.back().master));
+      out.push_back(*cp);
+    }
+    return out;
+  }
+
   CamSettings cam(const YAML::Node& n, const std::string& path) {
     CamSettings c;
     c.where = loc(n);
@@ -488,32 +549,9 @@ class Loader {
     scalar(n, path, "start_slope", c.start_slope, -1e12, 1e12);
     scalar(n, path, "end_slope", c.end_slope, -1e12, 1e12);
     const YAML::Node pts = n["points"];
-    if (!pts || !pts.IsSequence()) {
-      error(pts ? pts : n, path + ".points", "must be a list of [master, slave] or [master, slave, linear|cubic]");
-      return c;
-    }
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const YAML::Node p = pts[i];
-      const std::string key = fmt::format("{}.points[{}]", path, i);
-      if (!p.IsSequence() || (p.size() != 2 && p.size() != 3)) {
-        error(p, key, "must be [master, slave] or [master, slave, linear|cubic]");
-        continue;
-      }
-      CamPoint cp;
-      if (!YAML::convert<double>::decode(p[0], cp.master) || !YAML::convert<double>::decode(p[1], cp.slave)) {
-        error(p, key, "master and slave must be numbers");
-        continue;
-      }
-      if (p.size() == 3) {
-        const std::string t = lower_compact(p[2].Scalar());
-        if (t == "cubic" || t == "1") cp.cubic = true;
-        else if (t != "linear" && t != "0") error(p[2], key, fmt::format("segment type must be linear (0) or cubic (1), got '{}'", p[2].Scalar()));
-      }
-      if (!c.points.empty() && cp.master <= c.points.back().master)
-        error(p, key, fmt::format("master values must increase: {} follows {}", cp.master, c.points.back().master));
-      c.points.push_back(cp);
-    }
-    if (c.points.size() < 2) error(pts, path + ".points", fmt::format("needs at least 2 points, got {}", c.points.size()));
+    c.points = cam_points(pts, n, path + ".points", true);
+    if (pts && pts.IsSequence() && c.points.size() < 2)
+      error(pts, path + ".points", fmt::format("needs at least 2 points, got {}", c.points.size()));
     return c;
   }
 
@@ -536,36 +574,20 @@ class Loader {
       error(v, vp, "a CAM_PROFILE array has no initial values: MCCP calculates it");
       return a;
     }
-    if (!v.IsSequence()) {
-      error(v, vp, a.type == T::kCam ? "must be a list of [master, slave] or [master, slave, linear|cubic]"
-                                     : "must be a list of numbers");
+    if (v.IsSequence() && a.size > 0 && v.size() > a.size)
+      error(v, vp, fmt::format("{} values do not fit in size {}", v.size(), a.size));
+    if (a.type == T::kCam) {
+      a.cam_values = cam_points(v, n, vp, false);
       return a;
     }
-    if (a.size > 0 && v.size() > a.size)
-      error(v, vp, fmt::format("{} values do not fit in size {}", v.size(), a.size));
+    if (!v.IsSequence()) {
+      error(v, vp, "must be a list of numbers");
+      return a;
+    }
     for (std::size_t i = 0; i < v.size(); ++i) {
-      const YAML::Node e = v[i];
-      const std::string key = fmt::format("{}[{}]", vp, i);
-      if (a.type == T::kReal) {
-        double x = 0;
-        if (!e.IsScalar() || !YAML::convert<double>::decode(e, x) || !std::isfinite(x))
-          error(e, key, fmt::format("must be a finite number, got '{}'", e.IsScalar() ? e.Scalar() : "<non-scalar>"));
-        a.real_values.push_back(x);
-        continue;
-      }
-      CamPoint cp;
-      if (!e.IsSequence() || (e.size() != 2 && e.size() != 3) || !YAML::convert<double>::decode(e[0], cp.master) ||
-          !YAML::convert<double>::decode(e[1], cp.slave) || !std::isfinite(cp.master) || !std::isfinite(cp.slave)) {
-        error(e, key, "must be [master, slave] or [master, slave, linear|cubic] with finite numbers");
-        continue;
-      }
-      if (e.size() == 3) {
-        const std::string t = lower_compact(e[2].Scalar());
-        if (t == "cubic" || t == "1") cp.cubic = true;
-        else if (t != "linear" && t != "0")
-          error(e[2], key, fmt::format("segment type must be linear (0) or cubic (1), got '{}'", e[2].Scalar()));
-      }
-      a.cam_values.push_back(cp);
+      double x = 0;
+      finite_number(v[i], fmt::format("{}[{}]", vp, i), "", x);
+      a.real_values.push_back(x);
     }
     return a;
   }
