@@ -6,8 +6,24 @@
 #include <fmt/format.h>
 
 #include "fieldbus/canopen/cob_id.hpp"
+#include "fieldbus/canopen/object_names.hpp"
 
 namespace canmotion::config {
+
+namespace {
+
+/// An SDO write of index:sub (value 0) whose size is that of the object's data
+/// type in the one object table (canopen::known_objects()). consteval: an object
+/// missing from the table, or not expedited (1 .. 4 bytes), does not compile.
+consteval cia402::SdoWrite od_write(std::uint16_t index, std::uint8_t sub) {
+  const canopen::ObjectInfo* o = canopen::object_info(index, sub);
+  if (o == nullptr) throw "object not in canopen::known_objects()";
+  const std::size_t size = canopen::data_type_size(o->type);
+  if (size == 0 || size > 4) throw "not an expedited SDO object";
+  return {index, sub, static_cast<std::uint8_t>(size), 0};
+}
+
+}  // namespace
 
 std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
   std::vector<cia402::SdoWrite> w;
@@ -15,17 +31,21 @@ std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
   if (!d.present || a.axis.type != motion::AxisType::CipDrive) return w;
   namespace obj = cia402::obj;
   const double conv = a.axis.conversion_constant;
-  auto u32 = [&](std::uint16_t index, std::uint8_t sub, const std::optional<double>& v) {
-    if (v) w.push_back({index, sub, 4, static_cast<std::uint32_t>(std::llround(*v * conv))});
+  auto write = [&](cia402::SdoWrite x, std::uint32_t value) {
+    x.value = value;
+    w.push_back(x);
   };
-  u32(obj::kProfileAcceleration, 0, d.ramp_acceleration);
-  u32(obj::kProfileDeceleration, 0, d.ramp_deceleration);
-  u32(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub, d.ramp_velocity_positive);
-  u32(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub, d.ramp_velocity_negative);
-  if (d.ramp_jerk_control) w.push_back({obj::kRampJerkControl, 0, 1, *d.ramp_jerk_control});
-  w.push_back({obj::kSlatConfiguration, 0, 1, d.slat_configuration});
-  w.push_back({obj::kSlatSetPoint, 0, 4, static_cast<std::uint32_t>(std::llround(d.slat_set_point * conv))});
-  w.push_back({obj::kSlatTimeDelay, 0, 2, d.slat_time_delay_ms});
+  auto counts = [&](const cia402::SdoWrite& x, double v) { write(x, static_cast<std::uint32_t>(std::llround(v * conv))); };
+  if (d.ramp_acceleration) counts(od_write(obj::kProfileAcceleration, 0), *d.ramp_acceleration);
+  if (d.ramp_deceleration) counts(od_write(obj::kProfileDeceleration, 0), *d.ramp_deceleration);
+  if (d.ramp_velocity_positive)
+    counts(od_write(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub), *d.ramp_velocity_positive);
+  if (d.ramp_velocity_negative)
+    counts(od_write(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub), *d.ramp_velocity_negative);
+  if (d.ramp_jerk_control) write(od_write(obj::kRampJerkControl, 0), *d.ramp_jerk_control);
+  write(od_write(obj::kSlatConfiguration, 0), d.slat_configuration);
+  counts(od_write(obj::kSlatSetPoint, 0), d.slat_set_point);
+  write(od_write(obj::kSlatTimeDelay, 0), d.slat_time_delay_ms);
   return w;
 }
 
@@ -41,7 +61,11 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   d.start_timeout_ns = d.boot_timeout_ns;
   d.sdo_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.sdo_ms) * 1'000'000;
   d.transition_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.transition_ms) * 1'000'000;
-  if (a.drive.following_error_window > 0) d.extra_writes.push_back({0x6065, 0, 4, a.drive.following_error_window});
+  if (a.drive.following_error_window > 0) {
+    cia402::SdoWrite w = od_write(cia402::obj::kFollowingErrorWindow, 0);
+    w.value = a.drive.following_error_window;
+    d.extra_writes.push_back(w);
+  }
   d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
   for (const cia402::SdoWrite& w : direct_control_writes(a)) d.extra_writes.push_back(w);
   for (const SdoWrite& w : a.drive.sdo_writes)

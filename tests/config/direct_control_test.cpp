@@ -10,6 +10,7 @@
 #include <string>
 
 #include "config/runtime.hpp"
+#include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/cia402/cia402.hpp"
 
 namespace canmotion::config {
@@ -97,6 +98,38 @@ TEST(DirectControlConfig, LoadsAndBecomesDriveWritesInCounts) {
   EXPECT_EQ(d.mode_switch_timeout_ns, 40'000'000);
   EXPECT_TRUE(has_write(d.extra_writes, obj::kProfileAcceleration, 0, 4, 50'000));
   EXPECT_EQ(drive_config(c.axes[2], c.buses[0], 0.002).mode_switch_timeout_ns, 40'000'000);
+}
+
+TEST(DirectControlConfig, WriteSizesAreTheObjectTableSizes) {
+  // One axis with every direct_control object: ramps, jerk and SLAT.
+  const Config c = load_string(replaced(kYaml, "        jerk_control: 25\n",
+                                        "        jerk_control: 25\n      slat: {set_point: 1, time_delay_ms: 3}\n"
+                                        "    drive: {following_error_window: 900}\n"),
+                               "mds.yaml");
+  namespace obj = cia402::obj;
+  const std::vector<std::pair<std::uint16_t, std::uint8_t>> all = {
+      {obj::kProfileAcceleration, 0}, {obj::kProfileDeceleration, 0}, {obj::kRampVelocityLimit, 1},
+      {obj::kRampVelocityLimit, 2},   {obj::kRampJerkControl, 0},     {obj::kSlatConfiguration, 0},
+      {obj::kSlatSetPoint, 0},        {obj::kSlatTimeDelay, 0}};
+  const auto w = direct_control_writes(c.axes[0]);
+  ASSERT_EQ(w.size(), all.size());
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(w[i].index, all[i].first) << i;
+    EXPECT_EQ(w[i].sub, all[i].second) << i;
+  }
+  // Every write the configuration generates (direct_control and 0x6065; the
+  // user's own sdo_writes say their size) has the size of its object's data
+  // type in canopen::known_objects().
+  const cia402::DriveConfig d = drive_config(c.axes[0], c.buses[0], 0.002);
+  ASSERT_EQ(d.extra_writes.size(), all.size() + 1);
+  EXPECT_TRUE(has_write(d.extra_writes, obj::kFollowingErrorWindow, 0, 4, 900));
+  for (const cia402::SdoWrite& x : d.extra_writes) {
+    const canopen::ObjectInfo* o = canopen::object_info(x.index, x.sub);
+    ASSERT_NE(o, nullptr) << std::hex << x.index << ":" << int{x.sub};
+    EXPECT_EQ(x.size, canopen::data_type_size(o->type))
+        << std::hex << "0x" << x.index << ":" << int{x.sub} << " " << o->name << " is "
+        << canopen::data_type_name(o->type);
+  }
 }
 
 TEST(DirectControlConfig, ErrorsNameFileLineColumnAndKey) {
