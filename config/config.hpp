@@ -150,9 +150,8 @@ struct ArraySettings {
   /// (O(points), ~25 ns per point measured: 4096 points ~0.1 ms, a tenth of
   /// a 1 ms cycle; see motion/cam/README.md "MCCP as an instruction").
   static constexpr std::size_t kMaxCamElements = 4096;
-  /// All REAL array elements together: they are published in the status
-  /// snapshot every cycle (rt::kMaxRealElements).
-  static constexpr std::size_t kMaxRealElements = 1024;
+  // All REAL array elements together: at most rt::kMaxRealElements
+  // (rt/controller/controller.hpp; they are in every status snapshot).
   std::string name;
   Type type = Type::kReal;
   std::size_t size = 0;                ///< declared dimension (elements)

@@ -23,6 +23,7 @@
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/cob_id.hpp"
 #include "motion/planner.hpp"
+#include "rt/controller/controller.hpp"
 
 namespace canmotion::config {
 
@@ -564,7 +565,7 @@ class Loader {
     if (!string(n, path, "name", a.name)) error(n, path + ".name", "missing: every array needs a name");
     if (!n["type"]) error(n, path + ".type", "missing: CAM, CAM_PROFILE or REAL");
     else enumeration(n, path, "type", a.type, {{"CAM", T::kCam}, {"CAM_PROFILE", T::kCamProfile}, {"REAL", T::kReal}});
-    const std::size_t max = a.type == T::kReal ? ArraySettings::kMaxRealElements : ArraySettings::kMaxCamElements;
+    const std::size_t max = a.type == T::kReal ? rt::kMaxRealElements : ArraySettings::kMaxCamElements;
     if (!n["size"]) error(n, path + ".size", fmt::format("missing: the number of elements, 1 .. {}", max));
     else scalar(n, path, "size", a.size, std::size_t{1}, max, "elements");
     const YAML::Node v = n["values"];
@@ -631,7 +632,7 @@ class Loader {
   // ---- cross-checks ---------------------------------------------------------
   /// `arrays:` names (unique among cams, arrays and axes) and the registry
   /// capacities (motion::kMaxCamArrays, kMaxCamProfiles, kMaxRealArrays,
-  /// ArraySettings::kMaxRealElements).
+  /// rt::kMaxRealElements).
   template <class Unique>
   void array_checks(const Config& cfg, Unique& unique) {
     using T = ArraySettings::Type;
@@ -651,10 +652,10 @@ class Loader {
       if (a.type == T::kReal) {
         if (++reals == motion::kMaxRealArrays + 1) error_at(a.where, key, fmt::format("at most {} REAL arrays", motion::kMaxRealArrays));
         real_elems += a.size;
-        if (real_elems > ArraySettings::kMaxRealElements && real_elems - a.size <= ArraySettings::kMaxRealElements)
+        if (real_elems > rt::kMaxRealElements && real_elems - a.size <= rt::kMaxRealElements)
           error_at(a.where, key + ".size",
                    fmt::format("REAL arrays may hold {} elements together; this one brings the total to {}",
-                               ArraySettings::kMaxRealElements, real_elems));
+                               rt::kMaxRealElements, real_elems));
       }
     }
   }

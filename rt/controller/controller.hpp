@@ -77,7 +77,7 @@ struct CamSpec {
 
 /// All REAL array elements together: they are copied into every status
 /// snapshot. Bound: EventDistance / CalculatedData arrays hold a few events
-/// per move; 1024 covers 64 arrays of 16 (config ArraySettings::kMaxRealElements).
+/// per move; 1024 covers 64 arrays of 16. The one definition: the config loader checks `arrays:` against it.
 inline constexpr std::size_t kMaxRealElements = 1024;
 
 /// An array tag declared in the configuration (`arrays:`): a CAM array (MCCP

@@ -73,6 +73,27 @@ TEST(ConfigArrays, ErrorsNameFileLineColumnAndKey) {
   }
 }
 
+TEST(ConfigArrays, RealElementBoundIsTheControllers) {
+  // One bound (rt::kMaxRealElements): what the loader accepts, the Controller
+  // builds; one element more is refused at load, naming the bound.
+  const std::size_t max = rt::kMaxRealElements;
+  auto reals = [](std::size_t a, std::size_t b) {
+    return kHead + "arrays:\n  - {name: a, type: REAL, size: " + std::to_string(a) + "}\n  - {name: b, type: REAL, size: " +
+           std::to_string(b) + "}\n";
+  };
+  Runtime rt = build_runtime(load_string(reals(max - 1, 1), "arr.yaml"), true);
+  ASSERT_NE(rt.controller, nullptr);
+  std::string e = errors_of(reals(max, 1));
+  EXPECT_NE(e.find("arrays[1].size: REAL arrays may hold " + std::to_string(max) + " elements together; this one "
+                   "brings the total to " + std::to_string(max + 1)),
+            std::string::npos)
+      << e;
+  e = errors_of(reals(max + 1, 1));
+  EXPECT_NE(e.find("arrays[0].size: must be 1 .. " + std::to_string(max) + " elements, got " + std::to_string(max + 1)),
+            std::string::npos)
+      << e;
+}
+
 TEST(ConfigArrays, RuntimeHasTheArrayTagsAndMccpRunsOnThem) {
   Runtime rt = build_runtime(load_string(kHead + R"(arrays:
   - {name: pts, type: CAM, size: 10, values: [[0, 0, cubic], [1, 2, cubic], [2, 0]]}
