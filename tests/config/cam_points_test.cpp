@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "config/config.hpp"
-#include "config/runtime.hpp"
-#include "rt/controller/host.hpp"
+#include "tests/config/config_errors.hpp"
+#include "tests/config/runtime_rig.hpp"
 
 namespace canmotion::config {
 namespace {
@@ -25,16 +25,7 @@ std::string in_arrays(const std::string& point) {
   return kHead + "arrays:\n  - {name: c, type: CAM, size: 3, values: [[0, 0], " + point + ", [9, 9]]}\n";
 }
 
-/// The diagnostics of a file that must be refused; a test failure if it loads.
-std::vector<Diagnostic> refused(const std::string& yaml) {
-  try {
-    (void)load_string(yaml, "pts.yaml");
-  } catch (const ConfigError& e) {
-    return e.diagnostics();
-  }
-  ADD_FAILURE() << "configuration was accepted:\n" << yaml;
-  return {};
-}
+std::vector<Diagnostic> refused(const std::string& yaml) { return test::diagnostics_of(yaml, "pts.yaml"); }
 
 /// 1-based column of `what` in line `line` (1-based) of `yaml`, searched
 /// after the first point `[0, 0]`.
@@ -137,29 +128,24 @@ TEST(ConfigCamPoints, MastersMustIncreaseInACamButNotInACamArray) {
   EXPECT_EQ(d[0].message, "master values must increase: 0 follows 0");
   // A CAM array may hold several cams, each given to MCCP from its own start
   // element: its values load in any order, and MCCP checks what it is given.
-  Runtime rt = build_runtime(load_string(kHead + R"(arrays:
+  test::RuntimeRig r(load_string(kHead + R"(arrays:
   - {name: pts, type: CAM, size: 6, values: [[0, 0], [1, 1], [2, 0], [0, 0], [1, 2, cubic], [2, 0]]}
   - {name: prof, type: CAM_PROFILE, size: 6}
-)"), true);
-  rt::Controller& c = *rt.controller;
-  rt::ControllerHost host(c);
-  std::int64_t now = 0;
-  auto step = [&] { c.cycle(now); now += 1'000'000; };
-  step();
-  std::string e, ctl;
-  EXPECT_EQ(host.read("pts[3].Master", &e).value_or(-1), 0.0) << e;
-  EXPECT_EQ(host.read("pts[4].Slave", &e).value_or(-1), 2.0) << e;
-  ASSERT_FALSE(host.execute("MCCP(mc, pts[3], 3, 0, 0, prof[0])", &ctl));
-  step();
-  ASSERT_TRUE(host.settled());
-  EXPECT_EQ(host.read("mc.DN", &e).value_or(-1), 1.0) << e;
-  EXPECT_EQ(host.read("prof[0].Status", &e).value_or(-1), 2.0) << e;
+)"));
+  r.cycle();
+  EXPECT_EQ(r.read("pts[3].Master"), 0.0);
+  EXPECT_EQ(r.read("pts[4].Slave"), 2.0);
+  ASSERT_TRUE(r.execute("MCCP(mc, pts[3], 3, 0, 0, prof[0])"));
+  r.cycle();
+  ASSERT_TRUE(r.host.settled());
+  EXPECT_EQ(r.read("mc.DN"), 1.0);
+  EXPECT_EQ(r.read("prof[0].Status"), 2.0);
   // The whole array is not one cam: MCCP refuses it (ERR 29, illegal cam order).
-  ASSERT_FALSE(host.execute("MCCP(mc2, pts[0], 6, 0, 0, prof[0])", &ctl));
-  step();
-  ASSERT_TRUE(host.settled());
-  EXPECT_EQ(host.read("mc2.ER", &e).value_or(-1), 1.0) << e;
-  EXPECT_EQ(host.read("mc2.ERR", &e).value_or(-1), 29.0) << e;
+  ASSERT_TRUE(r.execute("MCCP(mc2, pts[0], 6, 0, 0, prof[0])"));
+  r.cycle();
+  ASSERT_TRUE(r.host.settled());
+  EXPECT_EQ(r.read("mc2.ER"), 1.0);
+  EXPECT_EQ(r.read("mc2.ERR"), 29.0);
 }
 
 }  // namespace

@@ -4,12 +4,12 @@
 #include <gtest/gtest.h>
 
 #include "tests/config/config_errors.hpp"
+#include "tests/config/runtime_rig.hpp"
 
 #include <string>
 
 #include "config/config.hpp"
 #include "config/runtime.hpp"
-#include "rt/controller/host.hpp"
 
 namespace canmotion::config {
 namespace {
@@ -81,7 +81,7 @@ TEST(ConfigArrays, RealElementBoundIsTheControllers) {
     return kHead + "arrays:\n  - {name: a, type: REAL, size: " + std::to_string(a) + "}\n  - {name: b, type: REAL, size: " +
            std::to_string(b) + "}\n";
   };
-  Runtime rt = build_runtime(load_string(reals(max - 1, 1), "arr.yaml"), true);
+  const Runtime rt = build_runtime(load_string(reals(max - 1, 1), "arr.yaml"), true);
   ASSERT_NE(rt.controller, nullptr);
   std::string e = errors_of(reals(max, 1));
   EXPECT_NE(e.find("arrays[1].size: REAL arrays may hold " + std::to_string(max) + " elements together; this one "
@@ -95,27 +95,21 @@ TEST(ConfigArrays, RealElementBoundIsTheControllers) {
 }
 
 TEST(ConfigArrays, RuntimeHasTheArrayTagsAndMccpRunsOnThem) {
-  Runtime rt = build_runtime(load_string(kHead + R"(arrays:
+  test::RuntimeRig r(load_string(kHead + R"(arrays:
   - {name: pts, type: CAM, size: 10, values: [[0, 0, cubic], [1, 2, cubic], [2, 0]]}
   - {name: prof, type: CAM_PROFILE, size: 10}
   - {name: ed, type: REAL, size: 2, values: [0.5, 1]}
-)", "arr.yaml"), true);
-  rt::Controller& c = *rt.controller;
-  rt::ControllerHost host(c);
-  std::int64_t now = 0;
-  auto step = [&] { c.cycle(now); now += 1'000'000; };
-  step();
-  std::string e;
-  EXPECT_EQ(host.read("pts[1].Slave", &e).value_or(-1), 2.0) << e;
-  EXPECT_EQ(host.read("ed[0]", &e).value_or(-1), 0.5) << e;
-  EXPECT_EQ(host.read("prof[0].Status", &e).value_or(-1), 0.0) << e;
-  EXPECT_EQ(host.read("ref[0].Status", &e).value_or(-1), 2.0) << e;
-  std::string ctl;
-  ASSERT_FALSE(host.execute("MCCP(mc, pts[0], 3, 0, 0, prof[0])", &ctl));
-  step();
-  ASSERT_TRUE(host.settled());
-  EXPECT_EQ(host.read("mc.DN", &e).value_or(-1), 1.0) << e;
-  EXPECT_EQ(host.read("prof[0].Status", &e).value_or(-1), 2.0) << e;
+)", "arr.yaml"));
+  r.cycle();
+  EXPECT_EQ(r.read("pts[1].Slave"), 2.0);
+  EXPECT_EQ(r.read("ed[0]"), 0.5);
+  EXPECT_EQ(r.read("prof[0].Status"), 0.0);
+  EXPECT_EQ(r.read("ref[0].Status"), 2.0);
+  ASSERT_TRUE(r.execute("MCCP(mc, pts[0], 3, 0, 0, prof[0])"));
+  r.cycle();
+  ASSERT_TRUE(r.host.settled());
+  EXPECT_EQ(r.read("mc.DN"), 1.0);
+  EXPECT_EQ(r.read("prof[0].Status"), 2.0);
 }
 
 }  // namespace

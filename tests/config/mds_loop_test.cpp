@@ -18,7 +18,7 @@
 
 #include "config/runtime.hpp"
 #include "fieldbus/can/candump_format.hpp"
-#include "rt/controller/host.hpp"
+#include "tests/config/runtime_rig.hpp"
 
 namespace canmotion::config {
 namespace {
@@ -65,23 +65,15 @@ axes:
       slat: {configuration: SLAT Max Speed/Torque, set_point: 1, time_delay_ms: 3}
 )";
 
-struct Loop {
-  Runtime rt;
-  rt::ControllerHost host;
-  std::int64_t now = 0;
+struct Loop : test::RuntimeRig {
   std::vector<std::string> trace;
 
-  Loop() : rt(build_runtime(load_string(kYaml, "mds.yaml"), true)), host(*rt.controller) {
+  Loop() : RuntimeRig(load_string(kYaml, "mds.yaml")) {
     rt.controller->set_trace(true);
     rt.sim->power_on(0);
   }
-  rt::Controller& ctl() { return *rt.controller; }
   emulator::Emulator& emu(std::size_t bus, std::uint8_t node) { return *rt.sim->find_drive(bus, node); }
-  void cycle() {
-    rt.sim->begin_cycle(now);
-    ctl().cycle(now);
-    rt.sim->end_cycle(now);
-    now += 1'000'000;
+  void after_cycle() override {
     rt::TraceRecord r;
     std::array<char, 128> line{};
     while (ctl().pop_trace(r)) {
@@ -89,16 +81,8 @@ struct Loop {
       trace.emplace_back(line.data(), n);
     }
   }
-  double read(const std::string& tag) {
-    std::string e;
-    const auto v = host.read(tag, &e);
-    EXPECT_TRUE(v) << e;
-    return v.value_or(-1.0);
-  }
   void exec(const std::string& call) {
-    std::string c;
-    const auto err = host.execute(call, &c);
-    ASSERT_FALSE(err) << *err;
+    ASSERT_TRUE(execute(call));
     cycle();  // the request is taken at the next cycle
   }
   bool until(const std::string& tag, int max) {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "config/runtime.hpp"
-#include "rt/controller/host.hpp"
+#include "tests/config/runtime_rig.hpp"
 
 namespace canmotion::config {
 namespace {
@@ -19,47 +19,28 @@ cams:
 )";
 
 TEST(ConfigRuntime, CamsAreComputedAtLoadAndRunByMatc) {
-  Runtime rt = build_runtime(load_string(kYaml, "cams.yaml"), true);
-  rt::Controller& c = *rt.controller;
-  ASSERT_EQ(c.cam_count(), 1u);
-  rt::ControllerHost host(c);
-  std::int64_t now = 0;
-  auto cycles = [&](int n) {
-    for (int i = 0; i < n; ++i) {
-      rt.sim->begin_cycle(now);
-      c.cycle(now);
-      rt.sim->end_cycle(now);
-      now += 1'000'000;
-    }
-  };
-  auto read = [&](const std::string& tag) {
-    std::string e;
-    const auto v = host.read(tag, &e);
-    EXPECT_TRUE(v) << e;
-    return v.value_or(-1.0);
-  };
-  rt.sim->power_on(0);
-  cycles(1);  // the first snapshot
-  EXPECT_EQ(read("rise[0].Status"), 2.0);  // calculated, not in use
-  std::string ctl;
-  ASSERT_EQ(host.execute("MSO(C, mso)", &ctl), std::nullopt);
-  for (int i = 0; i < 3000 && read("mso.DN") == 0.0; ++i) cycles(1);
-  ASSERT_EQ(read("mso.DN"), 1.0);
-  ASSERT_EQ(host.execute("MATC(C, matc, Same, rise, 1, 1, Once, Immediate, 0, None, TimeDrivenMode)", &ctl),
-            std::nullopt);
-  cycles(2);
-  EXPECT_EQ(read("matc.IP"), 1.0) << "ERR " << read("matc.ERR");
-  EXPECT_EQ(read("C.TimeCamStatus"), 1.0);
-  EXPECT_EQ(read("rise[0].Status"), 3.0);  // in use by one cam
-  cycles(1000);  // one second of cam time: the cubic rise is done
-  EXPECT_NEAR(read("C.CommandPosition"), 90.0, 0.5);
-  cycles(1100);  // past the end of the profile: Once completes
-  EXPECT_EQ(read("matc.PC"), 1.0);
-  EXPECT_EQ(read("C.TimeCamStatus"), 0.0);
-  EXPECT_EQ(read("rise[0].Status"), 2.0);
-  EXPECT_NEAR(read("C.ActualPosition"), 90.0, 0.05);
+  test::RuntimeRig r(load_string(kYaml, "cams.yaml"));
+  ASSERT_EQ(r.ctl().cam_count(), 1u);
+  r.rt.sim->power_on(0);
+  r.cycle();  // the first snapshot
+  EXPECT_EQ(r.read("rise[0].Status"), 2.0);  // calculated, not in use
+  ASSERT_TRUE(r.execute("MSO(C, mso)"));
+  for (int i = 0; i < 3000 && r.read("mso.DN") == 0.0; ++i) r.cycle();
+  ASSERT_EQ(r.read("mso.DN"), 1.0);
+  ASSERT_TRUE(r.execute("MATC(C, matc, Same, rise, 1, 1, Once, Immediate, 0, None, TimeDrivenMode)"));
+  r.cycles(2);
+  EXPECT_EQ(r.read("matc.IP"), 1.0) << "ERR " << r.read("matc.ERR");
+  EXPECT_EQ(r.read("C.TimeCamStatus"), 1.0);
+  EXPECT_EQ(r.read("rise[0].Status"), 3.0);  // in use by one cam
+  r.cycles(1000);  // one second of cam time: the cubic rise is done
+  EXPECT_NEAR(r.read("C.CommandPosition"), 90.0, 0.5);
+  r.cycles(1100);  // past the end of the profile: Once completes
+  EXPECT_EQ(r.read("matc.PC"), 1.0);
+  EXPECT_EQ(r.read("C.TimeCamStatus"), 0.0);
+  EXPECT_EQ(r.read("rise[0].Status"), 2.0);
+  EXPECT_NEAR(r.read("C.ActualPosition"), 90.0, 0.05);
   std::string e;
-  EXPECT_FALSE(host.read("rise[1].Status", &e));
+  EXPECT_FALSE(r.host.read("rise[1].Status", &e));
   EXPECT_NE(e.find("rise[0].Status"), std::string::npos) << e;
 }
 
