@@ -24,6 +24,7 @@
 #include "fieldbus/canopen/cob_id.hpp"
 #include "motion/planner.hpp"
 #include "rt/controller/controller.hpp"
+#include "rt/controller/tags.hpp"
 
 namespace canmotion::config {
 
@@ -641,8 +642,7 @@ class Loader {
       const ArraySettings& a = cfg.arrays[i];
       const std::string key = fmt::format("arrays[{}]", i);
       unique(a.name, a.where, key + ".name", "tag");
-      if (!a.name.empty() && (a.name.find_first_of(".[] ") != std::string::npos ||
-                              !(std::isalpha(static_cast<unsigned char>(a.name[0])) || a.name[0] == '_')))
+      if (!a.name.empty() && !rt::TagTable::is_user_tag_name(a.name))
         error_at(a.where, key + ".name",
                  fmt::format("'{}' is not a tag name (a letter or '_', then letters, digits or '_')", a.name));
       if (a.type == T::kCam && ++cams == motion::kMaxCamArrays + 1)
