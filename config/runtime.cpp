@@ -23,6 +23,16 @@ consteval cia402::SdoWrite od_write(std::uint16_t index, std::uint8_t sub) {
   return {index, sub, static_cast<std::uint8_t>(size), 0};
 }
 
+/// A `cams:` entry's points or a CAM array's values as the motion library's
+/// CAM elements (segment type 0 linear, 1 cubic).
+std::vector<motion::cam::CamPoint> motion_points(const std::vector<CamPoint>& points) {
+  std::vector<motion::cam::CamPoint> out;
+  out.reserve(points.size());
+  for (const CamPoint& p : points)
+    out.push_back({p.master, p.slave, p.cubic ? motion::cam::kSegmentCubic : motion::cam::kSegmentLinear});
+  return out;
+}
+
 }  // namespace
 
 std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
@@ -145,8 +155,7 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
     cs.name = c.name;
     cs.start_slope = c.start_slope;
     cs.end_slope = c.end_slope;
-    for (const CamPoint& p : c.points)
-      cs.points.push_back({p.master, p.slave, p.cubic ? motion::cam::kSegmentCubic : motion::cam::kSegmentLinear});
+    cs.points = motion_points(c.points);
     spec.cams.push_back(std::move(cs));
   }
   for (const ArraySettings& a : cfg.arrays) {
@@ -156,8 +165,7 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
     as.type = a.type == ArraySettings::Type::kCam          ? rt::ArraySpec::Type::kCam
               : a.type == ArraySettings::Type::kCamProfile ? rt::ArraySpec::Type::kCamProfile
                                                            : rt::ArraySpec::Type::kReal;
-    for (const CamPoint& p : a.cam_values)
-      as.cam_values.push_back({p.master, p.slave, p.cubic ? motion::cam::kSegmentCubic : motion::cam::kSegmentLinear});
+    as.cam_values = motion_points(a.cam_values);
     as.real_values = a.real_values;
     spec.arrays.push_back(std::move(as));
   }

@@ -135,6 +135,8 @@ TEST(ConfigCamPoints, MastersMustIncreaseInACamButNotInACamArray) {
   r.cycle();
   EXPECT_EQ(r.read("pts[3].Master"), 0.0);
   EXPECT_EQ(r.read("pts[4].Slave"), 2.0);
+  EXPECT_EQ(r.read("pts[4].SegmentType"), 1.0);  // cubic
+  EXPECT_EQ(r.read("pts[5].SegmentType"), 0.0);  // linear
   ASSERT_TRUE(r.execute("MCCP(mc, pts[3], 3, 0, 0, prof[0])"));
   r.cycle();
   ASSERT_TRUE(r.host.settled());
