@@ -22,6 +22,7 @@
 #include "config/config.hpp"
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/cob_id.hpp"
+#include "fieldbus/cia402/cia402.hpp"
 #include "motion/planner.hpp"
 #include "rt/controller/controller.hpp"
 #include "rt/controller/tags.hpp"
@@ -87,24 +88,13 @@ std::optional<std::string> nearest(std::string_view word, const std::vector<std:
 }
 
 std::optional<InterpolationPeriod> interpolation_period(double period_s) noexcept {
-  if (!(period_s > 0)) return std::nullopt;
-  // The first exponent (from 10^-9 up) giving an integral mantissa <= 255,
-  // then reduced so the mantissa has no factor 10: 1 ms -> 1 x 10^-3.
-  for (int e = -9; e <= 0; ++e) {
-    const double m = period_s / std::pow(10.0, e);
-    const double r = std::round(m);
-    if (r >= 1 && r <= 255 && std::abs(m - r) < 1e-6) {
-      // Reduce: a mantissa divisible by 10 moves to a larger exponent.
-      long mi = static_cast<long>(r);
-      int ei = e;
-      while (mi % 10 == 0 && mi > 0) {
-        mi /= 10;
-        ++ei;
-      }
-      return InterpolationPeriod{static_cast<std::uint8_t>(mi), static_cast<std::int8_t>(ei)};
-    }
-  }
-  return std::nullopt;
+  // The drive proxy's own encoder (cia402.hpp), on the period in ns as the
+  // runtime uses it: what is checked here is what is written. 255 s is the
+  // longest period 0x60C2 can hold (255 x 10^0).
+  if (!(period_s > 0) || period_s > 255.0) return std::nullopt;
+  const auto ip = cia402::encode_interpolation_period(static_cast<std::int64_t>(std::llround(period_s * 1e9)));
+  if (!ip) return std::nullopt;
+  return InterpolationPeriod{ip->value, ip->index};
 }
 
 namespace {
