@@ -203,6 +203,14 @@ class Loader {
     return true;
   }
 
+  /// A required key: true when present, else `missing: <what>` at the parent
+  /// (a present but bad value is reported by whoever reads it, once).
+  bool required(const YAML::Node& parent, const std::string& path, std::string_view key, std::string_view what) {
+    if (parent[std::string(key)]) return true;
+    error(parent, sub(path, key), fmt::format("missing: {}", what));
+    return false;
+  }
+
   bool string(const YAML::Node& parent, const std::string& path, std::string_view key, std::string& out) {
     const YAML::Node n = parent[std::string(key)];
     if (!n) return false;
@@ -254,7 +262,7 @@ class Loader {
     b.where = loc(n);
     if (!check_map(n, path, {"name", "interface", "bitrate", "master_node", "master_heartbeat_ms", "sync_counter_overflow"}))
       return b;
-    if (!string(n, path, "name", b.name)) error(n, path + ".name", "missing: every bus needs a name");
+    if (required(n, path, "name", "every bus needs a name")) string(n, path, "name", b.name);
     if (string(n, path, "interface", b.interface) && b.interface.size() >= 16)
       error(n["interface"], path + ".interface", "an interface name has at most 15 characters");
     scalar(n, path, "bitrate", b.bitrate, 10'000u, 1'000'000u, "bit/s");
@@ -414,14 +422,11 @@ class Loader {
                              "soft_limits", "position_error_tolerance", "homing", "exception_actions", "drive",
                              "direct_control"}))
       return a;
-    if (!string(n, path, "name", a.name)) error(n, path + ".name", "missing: every axis needs a name");
+    if (required(n, path, "name", "every axis needs a name")) string(n, path, "name", a.name);
     auto& c = a.axis;
-    if (!n["type"]) {
-      error(n, path + ".type", "missing: AXIS_VIRTUAL or AXIS_CIP_DRIVE");
-    } else {
+    if (required(n, path, "type", "AXIS_VIRTUAL or AXIS_CIP_DRIVE"))
       enumeration(n, path, "type", c.type,
                   {{"AXIS_VIRTUAL", motion::AxisType::Virtual}, {"AXIS_CIP_DRIVE", motion::AxisType::CipDrive}});
-    }
     std::string units;
     if (string(n, path, "units", units)) {
       if (units.size() >= sizeof c.units_name) error(n["units"], path + ".units", "at most 15 characters");
@@ -451,9 +456,9 @@ class Loader {
     if (n["exception_actions"]) exception_actions(n["exception_actions"], path + ".exception_actions", c);
     const bool cip = c.type == motion::AxisType::CipDrive;
     if (cip) {
-      if (!string(n, path, "bus", a.bus)) error(n, path + ".bus", "missing: an AXIS_CIP_DRIVE axis needs the bus of its drive");
-      if (!n["node"]) error(n, path + ".node", "missing: an AXIS_CIP_DRIVE axis needs its drive's node id (1 .. 127)");
-      scalar(n, path, "node", a.node, std::uint8_t{1}, std::uint8_t{127});
+      if (required(n, path, "bus", "an AXIS_CIP_DRIVE axis needs the bus of its drive")) string(n, path, "bus", a.bus);
+      if (required(n, path, "node", "an AXIS_CIP_DRIVE axis needs its drive's node id (1 .. 127)"))
+        scalar(n, path, "node", a.node, std::uint8_t{1}, std::uint8_t{127});
       if (n["drive"]) drive(n["drive"], path + ".drive", a.drive);
       if (n["direct_control"]) {
         direct_control(n["direct_control"], path + ".direct_control", a);
@@ -537,7 +542,7 @@ class Loader {
     CamSettings c;
     c.where = loc(n);
     if (!check_map(n, path, {"name", "points", "start_slope", "end_slope"})) return c;
-    if (!string(n, path, "name", c.name)) error(n, path + ".name", "missing: every cam needs a name");
+    if (required(n, path, "name", "every cam needs a name")) string(n, path, "name", c.name);
     scalar(n, path, "start_slope", c.start_slope, -1e12, 1e12);
     scalar(n, path, "end_slope", c.end_slope, -1e12, 1e12);
     const YAML::Node pts = n["points"];
@@ -553,12 +558,12 @@ class Loader {
     ArraySettings a;
     a.where = loc(n);
     if (!check_map(n, path, {"name", "type", "size", "values"})) return a;
-    if (!string(n, path, "name", a.name)) error(n, path + ".name", "missing: every array needs a name");
-    if (!n["type"]) error(n, path + ".type", "missing: CAM, CAM_PROFILE or REAL");
-    else enumeration(n, path, "type", a.type, {{"CAM", T::kCam}, {"CAM_PROFILE", T::kCamProfile}, {"REAL", T::kReal}});
+    if (required(n, path, "name", "every array needs a name")) string(n, path, "name", a.name);
+    if (required(n, path, "type", "CAM, CAM_PROFILE or REAL"))
+      enumeration(n, path, "type", a.type, {{"CAM", T::kCam}, {"CAM_PROFILE", T::kCamProfile}, {"REAL", T::kReal}});
     const std::size_t max = a.type == T::kReal ? rt::kMaxRealElements : ArraySettings::kMaxCamElements;
-    if (!n["size"]) error(n, path + ".size", fmt::format("missing: the number of elements, 1 .. {}", max));
-    else scalar(n, path, "size", a.size, std::size_t{1}, max, "elements");
+    if (required(n, path, "size", fmt::format("the number of elements, 1 .. {}", max)))
+      scalar(n, path, "size", a.size, std::size_t{1}, max, "elements");
     const YAML::Node v = n["values"];
     if (!v) return a;
     const std::string vp = path + ".values";

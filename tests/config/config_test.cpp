@@ -5,6 +5,7 @@
 #include "tests/config/config_errors.hpp"
 
 #include <string>
+#include <vector>
 
 #include "config/config.hpp"
 
@@ -180,6 +181,37 @@ TEST(Config, CrossReferencesAndCamPoints) {
   const std::string e = errors_of(y);
   EXPECT_NE(e.find("axes[1].bus: no bus named 'cna0'; did you mean 'can0'?"), std::string::npos) << e;
   EXPECT_NE(e.find("cams[0].points[1]: master values must increase: -5 follows 0"), std::string::npos) << e;
+}
+
+TEST(Config, ARequiredKeyIsReportedOnce) {
+  // Absent: `missing: ...`; present but bad: what is wrong with it, and only that.
+  struct Case {
+    std::string yaml, key, message;
+  };
+  const Case cases[] = {
+      {"axes:\n  - {type: AXIS_VIRTUAL}\n", "axes[0].name", "missing: every axis needs a name"},
+      {"axes:\n  - {name: '', type: AXIS_VIRTUAL}\n", "axes[0].name", "must be a non-empty string"},
+      {"axes:\n  - {name: [X], type: AXIS_VIRTUAL}\n", "axes[0].name", "must be a non-empty string"},
+      {"axes:\n  - {name: X}\n", "axes[0].type", "missing: AXIS_VIRTUAL or AXIS_CIP_DRIVE"},
+      {"buses:\n  - {name: ''}\naxes:\n  - {name: X, type: AXIS_VIRTUAL}\n", "buses[0].name",
+       "must be a non-empty string"},
+      {"buses:\n  - {name: c}\naxes:\n  - {name: X, type: AXIS_CIP_DRIVE, bus: '', node: 1}\n", "axes[0].bus",
+       "must be a non-empty string"},
+      {"buses:\n  - {name: c}\naxes:\n  - {name: X, type: AXIS_CIP_DRIVE, bus: c}\n", "axes[0].node",
+       "missing: an AXIS_CIP_DRIVE axis needs its drive's node id (1 .. 127)"},
+      {"axes:\n  - {name: X, type: AXIS_VIRTUAL}\ncams:\n  - {name: '', points: [[0, 0], [1, 1]]}\n", "cams[0].name",
+       "must be a non-empty string"},
+      {"axes:\n  - {name: X, type: AXIS_VIRTUAL}\narrays:\n  - {name: '', type: REAL, size: 1}\n", "arrays[0].name",
+       "must be a non-empty string"},
+      {"axes:\n  - {name: X, type: AXIS_VIRTUAL}\narrays:\n  - {name: a, type: REAL}\n", "arrays[0].size",
+       "missing: the number of elements, 1 .. 1024"},
+  };
+  for (const Case& k : cases) {
+    const std::vector<Diagnostic> d = test::diagnostics_of(k.yaml);
+    ASSERT_EQ(d.size(), 1u) << k.yaml << ConfigError(d).what();
+    EXPECT_EQ(d[0].key, k.key) << k.yaml;
+    EXPECT_EQ(d[0].message, k.message) << k.yaml;
+  }
 }
 
 TEST(Config, VirtualAxisHasNoDrive) {
