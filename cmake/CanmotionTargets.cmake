@@ -35,6 +35,34 @@ elseif(FALSE)
   message(FATAL_ERROR "CANMOTION_SANITIZE must be '', 'address' or 'thread', not '${CANMOTION_SANITIZE}'")
 endif()
 
+# ---- optimised product builds ------------------------------------------------
+# CANMOTION_LTO (default ON; GCC Release/RelWithDebInfo builds without
+# sanitizers or fuzzing): the hot path crosses many small functions in
+# different libraries (planner -> controller -> DriveProxy -> SimBus ->
+# emulator), so the product programs (canmotion_executable(... LTO)) are
+# linked with link-time optimisation and the optimised builds use -O3
+# (BENCHMARKS.md, "--sim speed": -O2 -> -O3 + LTO measured before enabling).
+# Every object is compiled "fat" (machine code and GIMPLE), so the tests and
+# benchmarks still link the ordinary way (-fno-lto): one LTO link per program
+# instead of one per test binary keeps the build time of CI.
+option(CANMOTION_LTO "Link-time optimisation and -O3 for the product programs (GCC optimised builds)" ON)
+set(CANMOTION_LTO_ACTIVE OFF)
+if(CANMOTION_LTO AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CANMOTION_SANITIZE STREQUAL ""
+   AND NOT CANMOTION_FUZZ AND CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
+  set(CANMOTION_LTO_ACTIVE ON)
+  string(REGEX REPLACE "-O[0-9s]" "-O3" CMAKE_CXX_FLAGS_RELEASE "${CMAKE_CXX_FLAGS_RELEASE}")
+  string(REGEX REPLACE "-O[0-9s]" "-O3" CMAKE_CXX_FLAGS_RELWITHDEBINFO "${CMAKE_CXX_FLAGS_RELWITHDEBINFO}")
+  add_compile_options($<$<COMPILE_LANGUAGE:CXX>:-flto=auto> $<$<COMPILE_LANGUAGE:CXX>:-ffat-lto-objects>)
+  # GCC 12 at -O3 warns falsely inside libstdc++'s std::string operator+
+  # ("memcpy ... may overlap", GCC bug 105329).
+  if(CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+    add_compile_options($<$<COMPILE_LANGUAGE:CXX>:-Wno-restrict>)
+  endif()
+  # Executables link with LTO only when they ask for it (property CANMOTION_LTO_LINK).
+  add_link_options($<IF:$<BOOL:$<TARGET_PROPERTY:CANMOTION_LTO_LINK>>,-flto=auto,-fno-lto>)
+  message(STATUS "canmotion: -O3, and link-time optimisation for the product programs (CANMOTION_LTO=ON)")
+endif()
+
 function(canmotion_library name alias)
   cmake_parse_arguments(ARG "" "" "DEPS;PRIVATE_DEPS;EXCLUDE_DIRS" ${ARGN})
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
@@ -55,10 +83,15 @@ function(canmotion_library name alias)
   add_library(${alias} ALIAS ${name})
 endfunction()
 
-# canmotion_executable(NAME SOURCES ... LIBS ...)
+# canmotion_executable(NAME [LTO] SOURCES ... LIBS ...)
+# LTO: a product program whose cycle speed matters; linked with link-time
+# optimisation when CANMOTION_LTO is active (see above).
 function(canmotion_executable name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "LTO" "" "SOURCES;LIBS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS})
   canmotion_apply_flags(${name})
+  if(ARG_LTO)
+    set_property(TARGET ${name} PROPERTY CANMOTION_LTO_LINK ON)
+  endif()
 endfunction()
