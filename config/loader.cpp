@@ -22,6 +22,7 @@
 #include "config/config.hpp"
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/cob_id.hpp"
+#include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/cia402/cia402.hpp"
 #include "motion/planner.hpp"
 #include "rt/controller/controller.hpp"
@@ -314,9 +315,41 @@ class Loader {
           }
           scalar(e, p, "index", s.index, std::uint16_t{0x1000}, std::uint16_t{0xFFFF});
           scalar(e, p, "sub", s.sub, std::uint8_t{0}, std::uint8_t{254});
-          if (scalar(e, p, "size", s.size, std::uint8_t{1}, std::uint8_t{4}) && s.size == 3)
-            error(e["size"], p + ".size", "must be 1, 2 or 4 bytes, got 3");
-          scalar(e, p, "value", s.value, std::int64_t{-2147483648LL}, std::int64_t{4294967295LL});
+          // An object of the one object table (canopen::known_objects()) has
+          // its size from there: `size:` may be left out, and must match.
+          const canopen::ObjectInfo* known = canopen::object_info(s.index, s.sub);
+          const std::size_t known_size = known != nullptr ? canopen::data_type_size(known->type) : 0;
+          if (known != nullptr && (known->access == canopen::Access::kRo || known->access == canopen::Access::kConst))
+            error(e["index"], p + ".index",
+                  fmt::format("0x{:04X}:{:02X} ({}) is read-only", s.index, s.sub, known->name));
+          if (known_size == 1 || known_size == 2 || known_size == 4) s.size = static_cast<std::uint8_t>(known_size);
+          if (const YAML::Node sz = e["size"]) {
+            std::uint8_t given = 0;
+            if (scalar(e, p, "size", given, std::uint8_t{1}, std::uint8_t{4})) {
+              if (given == 3)
+                error(sz, p + ".size", "must be 1, 2 or 4 bytes, got 3");
+              else if (known_size != 0 && given != known_size)
+                error(sz, p + ".size",
+                      fmt::format("0x{:04X}:{:02X} ({}) is {} byte{}, got {}", s.index, s.sub, known->name, known_size,
+                                  known_size == 1 ? "" : "s", given));
+              else
+                s.size = given;
+            }
+          }
+          if (scalar(e, p, "value", s.value, std::int64_t{-2147483648LL}, std::int64_t{4294967295LL})) {
+            // The object's own type when known (INTEGERn signed, UNSIGNEDn
+            // unsigned); otherwise either reading of `size` bytes.
+            const int bits = 8 * s.size;
+            const bool is_signed = known_size != 0 && (known->type == canopen::DataType::kInteger8 ||
+                                                       known->type == canopen::DataType::kInteger16 ||
+                                                       known->type == canopen::DataType::kInteger32);
+            const bool is_unsigned = known_size != 0 && !is_signed;
+            const std::int64_t lo = is_unsigned ? 0 : -(std::int64_t{1} << (bits - 1));
+            const std::int64_t hi = is_signed ? (std::int64_t{1} << (bits - 1)) - 1 : (std::int64_t{1} << bits) - 1;
+            if (s.value < lo || s.value > hi)
+              error(e["value"], p + ".value",
+                    fmt::format("{} does not fit in {} byte{} ({} .. {})", s.value, s.size, s.size == 1 ? "" : "s", lo, hi));
+          }
           d.sdo_writes.push_back(s);
         }
       }
@@ -626,6 +659,13 @@ class Loader {
   }
 
   // ---- cross-checks ---------------------------------------------------------
+  /// A `cams:` or `arrays:` name is a tag (`cam1[0].Status`, `pts[2]`): the
+  /// runtime's own tag-name rule.
+  void tag_name_check(const std::string& name, Location where, const std::string& key) {
+    if (!name.empty() && !rt::TagTable::is_user_tag_name(name))
+      error_at(where, key, fmt::format("'{}' is not a tag name (a letter or '_', then letters, digits or '_')", name));
+  }
+
   /// `arrays:` names (unique among cams, arrays and axes) and the registry
   /// capacities (motion::kMaxCamArrays, kMaxCamProfiles, kMaxRealArrays,
   /// rt::kMaxRealElements).
@@ -637,9 +677,7 @@ class Loader {
       const ArraySettings& a = cfg.arrays[i];
       const std::string key = fmt::format("arrays[{}]", i);
       unique(a.name, a.where, key + ".name", "tag");
-      if (!a.name.empty() && !rt::TagTable::is_user_tag_name(a.name))
-        error_at(a.where, key + ".name",
-                 fmt::format("'{}' is not a tag name (a letter or '_', then letters, digits or '_')", a.name));
+      tag_name_check(a.name, a.where, key + ".name");
       if (a.type == T::kCam && ++cams == motion::kMaxCamArrays + 1)
         error_at(a.where, key, fmt::format("at most {} CAM arrays", motion::kMaxCamArrays));
       if (a.type == T::kCamProfile && ++profiles == motion::kMaxCamProfiles + 1)
@@ -666,7 +704,11 @@ class Loader {
     for (std::size_t i = 0; i < cfg.buses.size(); ++i) unique(cfg.buses[i].name, cfg.buses[i].where, fmt::format("buses[{}].name", i), "bus");
     names.clear();
     for (std::size_t i = 0; i < cfg.axes.size(); ++i) unique(cfg.axes[i].name, cfg.axes[i].where, fmt::format("axes[{}].name", i), "axis");
-    for (std::size_t i = 0; i < cfg.cams.size(); ++i) unique(cfg.cams[i].name, cfg.cams[i].where, fmt::format("cams[{}].name", i), "tag");
+    for (std::size_t i = 0; i < cfg.cams.size(); ++i) {
+      const CamSettings& c = cfg.cams[i];
+      unique(c.name, c.where, fmt::format("cams[{}].name", i), "tag");
+      tag_name_check(c.name, c.where, fmt::format("cams[{}].name", i));
+    }
     array_checks(cfg, unique);
 
     const auto ip = interpolation_period(cfg.controller.period_s);

@@ -92,6 +92,56 @@ TEST(Config, TypesAndRangesNameTheKey) {
   EXPECT_NE(e.find("axes[0].max_speed: must be a real number in units/s, got 'fast'"), std::string::npos) << e;
 }
 
+// sdo_writes of objects in the one object table (canopen::known_objects())
+// take their size from it; a different size, a read-only object or a value
+// that does not fit the size is refused, naming the entry.
+TEST(Config, SdoWritesAreCheckedAgainstTheObjectTable) {
+  auto with_write = [](const std::string& w) {
+    std::string y = kGood;
+    y.replace(y.find("        - {index: 0x6065, sub: 0, size: 4, value: 20000}"), 56, "        - " + w);
+    return y;
+  };
+  // Size left out: the table's (0x6083 Profile acceleration is UNSIGNED32,
+  // 0x6060 Modes of operation INTEGER8); an unknown object keeps 4.
+  const Config c = load_string(with_write("{index: 0x6083, value: 1000}\n        - {index: 0x6060, value: -3}\n"
+                                          "        - {index: 0x2345, sub: 1, value: 7}"));
+  const auto& w = c.axes[1].drive.sdo_writes;
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_EQ(w[0].size, 4);
+  EXPECT_EQ(w[1].size, 1);
+  EXPECT_EQ(w[2].size, 4);
+
+  std::string e = errors_of(with_write("{index: 0x6083, sub: 0, size: 2, value: 1000}"));
+  EXPECT_NE(e.find("test.yaml:29:41: error: axes[1].drive.sdo_writes[0].size: 0x6083:00 (Profile acceleration) is "
+                   "4 bytes, got 2"),
+            std::string::npos)
+      << e;
+  e = errors_of(with_write("{index: 0x6041, value: 0}"));
+  EXPECT_NE(e.find("axes[1].drive.sdo_writes[0].index: 0x6041:00 (Statusword) is read-only"), std::string::npos) << e;
+  e = errors_of(with_write("{index: 0x6060, value: 200}"));
+  EXPECT_NE(e.find("axes[1].drive.sdo_writes[0].value: 200 does not fit in 1 byte (-128 .. 127)"), std::string::npos)
+      << e;
+  e = errors_of(with_write("{index: 0x6065, value: -1}"));  // UNSIGNED32
+  EXPECT_NE(e.find("axes[1].drive.sdo_writes[0].value: -1 does not fit in 4 bytes (0 .. 4294967295)"),
+            std::string::npos)
+      << e;
+  e = errors_of(with_write("{index: 0x2345, size: 2, value: 70000}"));
+  EXPECT_NE(e.find("axes[1].drive.sdo_writes[0].value: 70000 does not fit in 2 bytes (-32768 .. 65535)"),
+            std::string::npos)
+      << e;
+}
+
+// `cams:` names are tags (`cam1[0].Status`): the runtime's tag-name rule, as
+// for `arrays:`.
+TEST(Config, CamNamesAreTagNames) {
+  std::string y = kGood;
+  y.replace(y.find("- name: cam1"), 12, "- name: cam-1");
+  const std::string e = errors_of(y);
+  EXPECT_NE(e.find("cams[0].name: 'cam-1' is not a tag name (a letter or '_', then letters, digits or '_')"),
+            std::string::npos)
+      << e;
+}
+
 TEST(Config, EnumerationListsValidValues) {
   std::string y = kGood;
   y.replace(y.find("AXIS_VIRTUAL"), 12, "AXIS_VIRTUL");
