@@ -13,17 +13,6 @@ namespace canmotion::cia402 {
 
 namespace {
 
-/// Write `v` into entry `entry` of `m` in `f` (payload length m.size_bytes). Realtime-safe.
-[[gnu::always_inline]] inline void put_entry(can::Frame& f, const canopen::PdoMap& m, std::int8_t entry, std::uint64_t v) noexcept {
-  const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(entry)];
-  // Byte-aligned entries inside the payload (all CiA 402 objects): direct store.
-  if (((e.bit_offset | e.bits) % 8) == 0 && e.bit_offset / 8u + e.bits / 8u <= f.len) {
-    canopen::store_le(f.data.data() + e.bit_offset / 8, e.bits / 8u, v);
-  } else {
-    canopen::pack_bits(std::span<std::uint8_t>(f.data.data(), f.len), e.bit_offset, e.bits, v);
-  }
-}
-
 void put_u32(SdoWrite& w, std::uint16_t index, std::uint8_t sub, std::uint8_t size, std::uint32_t value) {
   w = SdoWrite{index, sub, size, value};
 }
@@ -154,6 +143,10 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
   vel_slot_ = find(false, obj::kVelocityActualValue);
   trq_slot_ = find(false, obj::kTorqueActualValue);
   mdisp_slot_ = find(false, obj::kModesOfOperationDisplay);
+  for (std::size_t p = 0; p < 4; ++p) {
+    rpdo_plan_[p] = canopen::PdoPlan::of(pdos_.rpdo[p]);
+    tpdo_plan_[p] = canopen::PdoPlan::of(pdos_.tpdo[p]);
+  }
   build_configuration();
 }
 
@@ -234,14 +227,10 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
     const canopen::PdoMap& m = pdos_.tpdo[p];
     if (f.id != (m.cob_id & 0x7FFu)) continue;
     if (f.len < m.size_bytes) return true;  // length error: ignored (the drive reports 0x8210 on its side)
-    const auto payload = f.payload();
-    auto get = [&](const Slot& s) -> std::uint64_t {
-      const canopen::PdoEntry& e = m.entries[static_cast<std::size_t>(s.entry)];
-      // Byte-aligned entries inside the received payload (all CiA 402 objects): direct load.
-      if (((e.bit_offset | e.bits) % 8) == 0 && e.bit_offset / 8u + e.bits / 8u <= f.len)
-        return canopen::load_le(f.data.data() + e.bit_offset / 8, e.bits / 8u);
-      return canopen::unpack_bits(payload, e.bit_offset, e.bits);
-    };
+    // The whole payload in one load; each mapped object is a field of it.
+    const std::uint64_t w = canopen::payload_word(f);
+    const canopen::PdoPlan& plan = tpdo_plan_[p];
+    auto get = [&](const Slot& s) { return plan.get(w, static_cast<std::size_t>(s.entry)); };
     if (sw_slot_.pdo == p) fb_.statusword = static_cast<std::uint16_t>(get(sw_slot_));
     if (pos_slot_.pdo == p) fb_.position = static_cast<std::int32_t>(canopen::sign_extend(get(pos_slot_), 32));
     if (vel_slot_.pdo == p) fb_.velocity = static_cast<std::int32_t>(canopen::sign_extend(get(vel_slot_), 32));
@@ -496,11 +485,16 @@ void DriveProxy::send_rpdos(canopen::FrameSink& out) noexcept {
     f.id = m.cob_id & 0x7FFu;
     f.len = m.size_bytes;
     const auto pi = static_cast<std::int8_t>(p);
-    if (cw_slot_.pdo == pi) put_entry(f, m, cw_slot_.entry, cw_);
-    if (tpos_slot_.pdo == pi) put_entry(f, m, tpos_slot_.entry, static_cast<std::uint32_t>(target_position_));
-    if (tvel_slot_.pdo == pi) put_entry(f, m, tvel_slot_.entry, static_cast<std::uint32_t>(target_velocity_));
-    if (ttrq_slot_.pdo == pi) put_entry(f, m, ttrq_slot_.entry, static_cast<std::uint16_t>(target_torque_));
-    if (mode_slot_.pdo == pi) put_entry(f, m, mode_slot_.entry, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_)));
+    // The payload is built as one word (the plan's fields) and stored at once.
+    const canopen::PdoPlan& plan = rpdo_plan_[p];
+    auto put = [&](std::uint64_t w, const Slot& s, std::uint64_t v) { return plan.put(w, static_cast<std::size_t>(s.entry), v); };
+    std::uint64_t w = 0;
+    if (cw_slot_.pdo == pi) w = put(w, cw_slot_, cw_);
+    if (tpos_slot_.pdo == pi) w = put(w, tpos_slot_, static_cast<std::uint32_t>(target_position_));
+    if (tvel_slot_.pdo == pi) w = put(w, tvel_slot_, static_cast<std::uint32_t>(target_velocity_));
+    if (ttrq_slot_.pdo == pi) w = put(w, ttrq_slot_, static_cast<std::uint16_t>(target_torque_));
+    if (mode_slot_.pdo == pi) w = put(w, mode_slot_, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_)));
+    canopen::set_payload_word(f, w);
     out.send(f);
   }
 }

@@ -257,6 +257,9 @@ class DriveProxy {
   };
   Slot cw_slot_, tpos_slot_, tvel_slot_, ttrq_slot_, mode_slot_;
   Slot sw_slot_, pos_slot_, vel_slot_, trq_slot_, mdisp_slot_;
+  // Packing plans of pdos_.rpdo / pdos_.tpdo (made with them at set-up).
+  std::array<canopen::PdoPlan, 4> rpdo_plan_{};
+  std::array<canopen::PdoPlan, 4> tpdo_plan_{};
 };
 
 struct NetworkConfig {

@@ -313,12 +313,10 @@ void Emulator::rebuild_pdos() noexcept {
         const canopen::PdoEntry& pe = m.entries[i];
         MappedEntry& me = cache[i];
         me.entry = find(pe.index, pe.sub);
-        me.aligned = (pe.bit_offset % 8) == 0 && (pe.bits % 8) == 0 && pe.bit_offset / 8 + pe.bits / 8 <= can::kMaxPayload;
-        me.byte_offset = static_cast<std::uint8_t>(pe.bit_offset / 8);
-        me.bytes = static_cast<std::uint8_t>(pe.bits / 8);
         me.is_statusword = pe.index == obj::kStatusword && pe.sub == 0;
         me.is_controlword = pe.index == obj::kControlword;
       }
+      (rx ? rpdo_plan_[p] : tpdo_plan_[p]) = canopen::PdoPlan::of(m);
       if (rx) {
         rpdo_[p] = m;
         rpdo_valid_[p] = valid;
@@ -795,19 +793,15 @@ void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
     can::Frame f;
     f.id = m.cob_id;
     f.len = m.size_bytes;
-    std::span<std::uint8_t> payload(f.data.data(), f.len);
     const auto& cache = tpdo_entries_[p];
+    const canopen::PdoPlan& plan = tpdo_plan_[p];
+    std::uint64_t w = 0;  // the payload, stored at once
     for (std::uint8_t i = 0; i < m.count; ++i) {
       const MappedEntry& me = cache[i];
       // handle_sync() calls this right after update_outputs() stored statusword() in 0x6041.
-      const std::uint64_t v = me.is_statusword ? val(hot_.statusword) : val(me.entry);
-      if (me.aligned) {
-        canopen::store_le(f.data.data() + me.byte_offset, me.bytes, v);
-      } else {
-        const canopen::PdoEntry& e = m.entries[i];
-        canopen::pack_bits(payload, e.bit_offset, e.bits, v);
-      }
+      w = plan.put(w, i, me.is_statusword ? val(hot_.statusword) : val(me.entry));
     }
+    canopen::set_payload_word(f, w);
     out.send(f);
     ++counters_.tpdos;
   }
@@ -823,15 +817,13 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
       if (!rpdo_pending_[p]) continue;
       rpdo_pending_[p] = false;
       const canopen::PdoMap& m = rpdo_[p];
-      const can::Frame& latch = rpdo_latch_[p];
-      const auto payload = latch.payload();
+      // The latched frame is at least m.size_bytes long (checked in on_frame).
+      const std::uint64_t w = canopen::payload_word(rpdo_latch_[p]);
+      const canopen::PdoPlan& plan = rpdo_plan_[p];
       const auto& cache = rpdo_entries_[p];
       for (std::uint8_t i = 0; i < m.count; ++i) {
         const MappedEntry& me = cache[i];
-        // The latched frame is at least m.size_bytes long (checked in on_frame).
-        const std::uint64_t v = me.aligned ? canopen::load_le(latch.data.data() + me.byte_offset, me.bytes)
-                                           : canopen::unpack_bits(payload, m.entries[i].bit_offset, m.entries[i].bits);
-        put(me.entry, v);
+        put(me.entry, plan.get(w, i));
         if (me.is_controlword) cw_written = true;
       }
     }

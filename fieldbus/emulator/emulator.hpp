@@ -217,13 +217,10 @@ class Emulator final : public canopen::SdoServerBackend {
     Entry* slat_set_point;      // 0x2021
     Entry* slat_delay;          // 0x2022
   };
-  /// Per mapped PDO entry: the dictionary entry (nullptr if absent) and
-  /// whether it is byte-aligned (all CiA 402 objects are).
+  /// Per mapped PDO entry: the dictionary entry (nullptr if absent); where
+  /// it sits in the payload is in the PDO's packing plan.
   struct MappedEntry {
     Entry* entry = nullptr;
-    std::uint8_t byte_offset = 0;
-    std::uint8_t bytes = 0;
-    bool aligned = false;
     bool is_statusword = false;
     bool is_controlword = false;
   };
@@ -290,6 +287,8 @@ class Emulator final : public canopen::SdoServerBackend {
   std::array<std::uint32_t, 4> tpdo_sync_count_{};
   std::array<std::array<MappedEntry, canopen::kMaxPdoEntries>, 4> rpdo_entries_{};
   std::array<std::array<MappedEntry, canopen::kMaxPdoEntries>, 4> tpdo_entries_{};
+  std::array<canopen::PdoPlan, 4> rpdo_plan_{};  // packing plans of rpdo_ / tpdo_ (rebuild_pdos)
+  std::array<canopen::PdoPlan, 4> tpdo_plan_{};
   Hot hot_{};
   // service()'s receive buffer (a member so that it is not re-initialised
   // on every call; 64 frames per receive() call, more are drained in a loop).
