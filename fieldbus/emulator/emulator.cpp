@@ -67,9 +67,14 @@ void Emulator::add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, c
           value,
           text,
           0,
-          false};
+          false,
+          0,
+          0};
   e.size = static_cast<std::uint8_t>(canopen::data_type_size(e.type));
   e.is_signed = canopen::data_type_signed(e.type);
+  const bool full = e.size >= 8 || e.size == 0;
+  e.mask = full ? ~std::uint64_t{0} : (std::uint64_t{1} << (8 * e.size)) - 1;
+  e.sign = e.is_signed && !full ? std::uint64_t{1} << (8 * e.size - 1) : 0;
   od_.push_back(e);
 }
 
@@ -242,13 +247,13 @@ void Emulator::resolve_hot() noexcept {
 
 std::int64_t Emulator::sval(const Entry* e) noexcept {
   if (!e) return 0;
-  return e->is_signed ? canopen::sign_extend(e->value, static_cast<unsigned>(e->size) * 8u) : static_cast<std::int64_t>(e->value);
+  // canopen::sign_extend(value, 8 * size) for a signed type, with the sign bit cached (0 otherwise).
+  return static_cast<std::int64_t>((e->value ^ e->sign) - e->sign);
 }
 
 void Emulator::put(Entry* e, std::uint64_t v) noexcept {
   if (!e) return;
-  const std::size_t n = e->size;
-  e->value = n >= 8 || n == 0 ? v : (v & ((std::uint64_t{1} << (8 * n)) - 1));
+  e->value = v & e->mask;  // the low `size` bytes (all of v for 0 or 8)
 }
 
 Emulator::Entry* Emulator::find(std::uint16_t index, std::uint8_t sub) noexcept {
