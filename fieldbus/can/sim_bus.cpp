@@ -1,11 +1,66 @@
 #include "fieldbus/can/sim_bus.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 namespace canmotion::can {
 
 SimBus::Endpoint::Endpoint(SimBus& bus, std::string name, std::size_t capacity)
-    : bus_(bus), name_(std::move(name)), rx_(capacity), ev_(kEventCapacity) {}
+    : bus_(bus), name_(std::move(name)), rx_(capacity), capacity_(capacity), ev_(kEventCapacity) {}
+
+// transmit() and deliver() are inlined into send(), the path of every frame;
+// fault injection and the delayed frames take their own out-of-line paths.
+[[gnu::always_inline]] inline SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
+  if (state_ == BusState::kBusOff) [[unlikely]] return SendResult::kBusOff;
+  if (!faults_.empty()) [[unlikely]] return transmit_with_faults(from, f);
+  ++counters_.sent;
+  deliver(&from, f, now_ns_);  // no fault injection: straight to the wire
+  return SendResult::kOk;
+}
+
+// Inlined into deliver() (once per frame and endpoint).
+[[gnu::always_inline]] inline void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns, std::size_t word,
+                                                          std::uint64_t bit) noexcept {
+  if (rx_count_ == capacity_) [[unlikely]] {
+    ++counters_.rx_dropped;
+    push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, t_ns});
+    return;
+  }
+  std::size_t tail = rx_head_ + rx_count_;  // < 2 * capacity: one wrap at most
+  if (tail >= capacity_) tail -= capacity_;
+  TimedFrame& slot = rx_[tail];
+  std::memcpy(&slot.frame, &f, sizeof f);  // one 16-byte copy, not field by field
+  slot.t_ns = t_ns;
+  ++rx_count_;
+  if (filtered_ && (openers_[word] & bit) != 0) {
+    open_ = true;
+    update_gate();
+  }
+  ++counters_.rx_frames;
+}
+
+[[gnu::always_inline]] inline void SimBus::deliver(const Endpoint* from, const Frame& frame, std::int64_t t_ns) noexcept {
+  ++counters_.delivered;
+  Frame f;
+  std::memcpy(&f, &frame, sizeof f);  // read the sender's frame once, written straight into each ring
+  if (tap_) [[unlikely]] tap_(TimedFrame{f, t_ns}, name_);
+  if ((f.flags & (kExtended | kError)) != 0 || f.id >= 2048) [[unlikely]] {
+    // Extended and error frames reach only the endpoints that take every frame now.
+    for (auto& ep : endpoints_) {
+      Endpoint& e = *ep;
+      if (&e != from && e.gate_ == Endpoint::kAllIds.data()) e.push(f, t_ns, 0, 0);
+    }
+    return;
+  }
+  // Where the id sits in the endpoints' id sets, once for all.
+  const std::size_t word = f.id >> 6;
+  const std::uint64_t bit = std::uint64_t{1} << (f.id & 63u);
+  for (auto& ep : endpoints_) {
+    Endpoint& e = *ep;
+    if (&e == from || (e.gate_[word] & bit) == 0) continue;
+    e.push(f, t_ns, word, bit);
+  }
+}
 
 SendResult SimBus::Endpoint::send(const Frame& frame) noexcept {
   const SendResult r = bus_.transmit(*this, frame);
@@ -21,7 +76,7 @@ std::size_t SimBus::Endpoint::receive(std::span<TimedFrame> out) noexcept {
   std::size_t n = 0;
   while (n < out.size() && rx_count_ > 0) {
     out[n++] = rx_[rx_head_];
-    if (++rx_head_ == rx_.size()) rx_head_ = 0;
+    if (++rx_head_ == capacity_) rx_head_ = 0;
     --rx_count_;
   }
   // An empty ring starts again at its first slot: the few slots a cycle
@@ -29,8 +84,21 @@ std::size_t SimBus::Endpoint::receive(std::span<TimedFrame> out) noexcept {
   if (rx_count_ == 0) {
     rx_head_ = 0;
     open_ = false;  // the owner has seen the opener (see set_accept)
+    update_gate();
   }
   return n;
+}
+
+void SimBus::Endpoint::consume(std::size_t n) noexcept {
+  n = std::min(n, rx_count_);
+  rx_head_ += n;
+  if (rx_head_ >= capacity_) rx_head_ -= capacity_;
+  rx_count_ -= n;
+  if (rx_count_ == 0) {  // as in receive()
+    rx_head_ = 0;
+    open_ = false;
+    update_gate();
+  }
 }
 
 std::size_t SimBus::Endpoint::poll_events(std::span<BusEvent> out) noexcept {
@@ -44,23 +112,6 @@ std::size_t SimBus::Endpoint::poll_events(std::span<BusEvent> out) noexcept {
 }
 
 BusState SimBus::Endpoint::state() const noexcept { return bus_.state_; }
-
-// Inlined into deliver(), its only caller (once per frame and endpoint).
-[[gnu::always_inline]] inline void SimBus::Endpoint::push(const Frame& f, std::int64_t t_ns, std::size_t word,
-                                                          std::uint64_t bit) noexcept {
-  if (rx_count_ == rx_.size()) [[unlikely]] {
-    ++counters_.rx_dropped;
-    push_event(BusEvent{BusEvent::Kind::kRxOverflow, bus_.state_, 1, t_ns});
-    return;
-  }
-  std::size_t tail = rx_head_ + rx_count_;  // < 2 * size: one wrap at most
-  if (tail >= rx_.size()) tail -= rx_.size();
-  rx_[tail].frame = f;
-  rx_[tail].t_ns = t_ns;
-  ++rx_count_;
-  if (filtered_ && (openers_[word] & bit) != 0) open_ = true;
-  ++counters_.rx_frames;
-}
 
 void SimBus::Endpoint::push_event(const BusEvent& e) noexcept {
   if (ev_count_ == ev_.size()) {
@@ -95,13 +146,8 @@ void SimBus::set_state(BusState s) noexcept {
   for (auto& ep : endpoints_) ep->push_event(BusEvent{BusEvent::Kind::kStateChanged, s, 0, now_ns_});
 }
 
-SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
-  if (state_ == BusState::kBusOff) return SendResult::kBusOff;
+SendResult SimBus::transmit_with_faults(const Endpoint& from, const Frame& f) noexcept {
   ++counters_.sent;
-  if (faults_.empty()) {  // no fault injection: straight to the wire
-    deliver(&from, f, now_ns_);
-    return SendResult::kOk;
-  }
   Frame frame = f;
   for (Rule& r : faults_) {
     if (r.fault.cob_id != SimFault::kAnyId && r.fault.cob_id != f.id) continue;
@@ -133,22 +179,6 @@ SendResult SimBus::transmit(const Endpoint& from, const Frame& f) noexcept {
   }
   deliver(&from, frame, now_ns_);
   return SendResult::kOk;
-}
-
-void SimBus::deliver(const Endpoint* from, const Frame& frame, std::int64_t t_ns) noexcept {
-  ++counters_.delivered;
-  const Frame f = frame;  // read the sender's frame once, written straight into each ring
-  if (tap_) tap_(TimedFrame{f, t_ns}, name_);
-  // Where the id sits in the endpoints' filter sets, once for all: an endpoint
-  // takes the frame unless it is filtered, not opened, and the id's bit is clear.
-  const bool standard = (f.flags & (kExtended | kError)) == 0 && f.id < 2048;
-  const std::size_t word = standard ? f.id >> 6 : 0;
-  const std::uint64_t bit = standard ? std::uint64_t{1} << (f.id & 63u) : 0;
-  for (auto& ep : endpoints_) {
-    Endpoint& e = *ep;
-    if (&e == from || (e.filtered_ && !e.open_ && (e.accept_[word] & bit) == 0)) continue;
-    e.push(f, t_ns, word, bit);
-  }
 }
 
 }  // namespace canmotion::can

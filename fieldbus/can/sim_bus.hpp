@@ -75,6 +75,17 @@ class SimBus {
     [[nodiscard]] std::string_view name() const noexcept override { return name_; }
     /// Frames waiting in this endpoint's receive ring.
     [[nodiscard]] std::size_t pending() const noexcept { return rx_count_; }
+    /// The oldest waiting frames in place (the ring's first contiguous run;
+    /// empty when nothing waits), for an owner that handles them one by one
+    /// without copying them out (Emulator::service); consume(n) then removes
+    /// the first n, as receive() would have returned them. The span stays
+    /// valid until consume() or the next receive(): what this endpoint sends
+    /// meanwhile never comes back to it. Realtime-safe.
+    [[nodiscard]] std::span<const TimedFrame> peek() const noexcept {
+      const std::size_t run = capacity_ - rx_head_;
+      return {rx_.data() + rx_head_, rx_count_ < run ? rx_count_ : run};
+    }
+    void consume(std::size_t n) noexcept;
     /// Acceptance filter, like a CAN controller's or a SocketCAN filter list:
     /// once set, only standard (11-bit) data frames whose id has its bit set
     /// in `ids` (bit id % 64 of word id / 64) reach this endpoint; extended
@@ -89,8 +100,12 @@ class SimBus {
       accept_ = ids;
       openers_ = openers;
       filtered_ = true;
+      update_gate();
     }
-    void clear_accept() noexcept { filtered_ = open_ = false; }
+    void clear_accept() noexcept {
+      filtered_ = open_ = false;
+      update_gate();
+    }
 
    private:
     friend class SimBus;
@@ -98,9 +113,18 @@ class SimBus {
     /// `word`/`bit`: where f's id sits in the filter sets (0 for an extended or error frame).
     void push(const Frame& f, std::int64_t t_ns, std::size_t word, std::uint64_t bit) noexcept;
     void push_event(const BusEvent& e) noexcept;
+    /// gate_: the set a standard data frame's id must be in to reach the
+    /// ring now: accept_ while filtered and not opened, else every id.
+    void update_gate() noexcept { gate_ = filtered_ && !open_ ? accept_.data() : kAllIds.data(); }
+    static constexpr IdSet kAllIds = [] {
+      IdSet a{};
+      for (auto& w : a) w = ~std::uint64_t{0};
+      return a;
+    }();
     SimBus& bus_;
     std::string name_;
     std::vector<TimedFrame> rx_;
+    std::size_t capacity_ = 0;  ///< rx_.size()
     std::size_t rx_head_ = 0;
     std::size_t rx_count_ = 0;
     std::vector<BusEvent> ev_;
@@ -111,6 +135,7 @@ class SimBus {
     bool open_ = false;  ///< an opener was pushed and the ring has not been emptied since
     IdSet accept_{};
     IdSet openers_{};
+    const std::uint64_t* gate_ = kAllIds.data();
   };
 
   /// `name` is the interface name used in traces ("sim0").
@@ -159,6 +184,7 @@ class SimBus {
     std::uint64_t acted = 0;
   };
   SendResult transmit(const Endpoint& from, const Frame& f) noexcept;
+  SendResult transmit_with_faults(const Endpoint& from, const Frame& f) noexcept;
   void deliver(const Endpoint* from, const Frame& f, std::int64_t t_ns) noexcept;
 
   std::string name_;
