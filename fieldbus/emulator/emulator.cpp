@@ -614,6 +614,30 @@ void Emulator::service(can::Transport& bus, std::int64_t now_ns) noexcept {
   step(now_ns, sink);
 }
 
+namespace {
+/// FrameSink straight to a SimBus endpoint (a direct call: Endpoint is final).
+class SimEndpointSink final : public canopen::FrameSink {
+ public:
+  explicit SimEndpointSink(can::SimBus::Endpoint& ep) noexcept : ep_(ep) {}
+  bool send(const can::Frame& f) noexcept override { return ep_.send(f) == can::SendResult::kOk; }
+
+ private:
+  can::SimBus::Endpoint& ep_;
+};
+}  // namespace
+
+void Emulator::service(can::SimBus::Endpoint& bus, std::int64_t now_ns) noexcept {
+  SimEndpointSink sink(bus);
+  now_ns_ = now_ns;
+  // What this endpoint sends never comes back to it, so the frames stay put
+  // while they are handled (see SimBus::Endpoint::peek).
+  for (std::span<const can::TimedFrame> run = bus.peek(); !run.empty(); run = bus.peek()) {
+    for (const can::TimedFrame& f : run) on_frame(f, sink);
+    bus.consume(run.size());
+  }
+  step(now_ns, sink);
+}
+
 // ============================================================================
 // CiA 402
 // ============================================================================

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "fieldbus/can/frame.hpp"
+#include "fieldbus/can/sim_bus.hpp"
 #include "fieldbus/can/transport.hpp"
 #include "fieldbus/canopen/frame_sink.hpp"
 #include "fieldbus/canopen/nmt.hpp"
@@ -110,6 +111,10 @@ class Emulator final : public canopen::SdoServerBackend {
   /// Drain `bus`, handle every frame, then step(now_ns); replies go to `bus`.
   /// This is how the emulator attaches to a SimBus endpoint or a SocketCanBus.
   void service(can::Transport& bus, std::int64_t now_ns) noexcept;
+  /// The same on a SimBus endpoint (SimWorld, SimRig): the frames are
+  /// handled where they wait in the endpoint's ring instead of being copied
+  /// out first, and replies go straight to the endpoint. Realtime-safe.
+  void service(can::SimBus::Endpoint& bus, std::int64_t now_ns) noexcept;
 
   /// The standard identifiers on_frame() acts on (NMT, SYNC, this node's SDO
   /// requests, heartbeats, the valid RPDOs), as bits (id % 64 of word

@@ -3,7 +3,7 @@
 // the mapping's size, and read back what unpack_bits reads, for any mapping
 // (byte-aligned CiA 402 objects and arbitrary bit fields). Seeded random
 // mappings; the seed is printed on failure (CANMOTION_SEED /
-// CANMOTION_PROP_COUNT override seed and count).
+// CANMOTION_COUNT override seed and count, tests/support/random_seed.hpp).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -11,19 +11,11 @@
 
 #include "fieldbus/canopen/pdo.hpp"
 #include "fieldbus/cia402/drive_pdos.hpp"
+#include "tests/support/random_seed.hpp"
 
 using namespace canmotion;
 
 namespace {
-std::uint64_t test_seed() {
-  if (const char* s = std::getenv("CANMOTION_SEED")) return std::strtoull(s, nullptr, 0);
-  return std::random_device{}();
-}
-int test_count(int dflt) {
-  if (const char* s = std::getenv("CANMOTION_PROP_COUNT")) return std::atoi(s);
-  return dflt;
-}
-
 /// A random finalized mapping of 1..8 entries, 1..64 bits in all; with
 /// `byte_aligned` only 8/16/24/32-bit entries (as the CiA 402 objects are).
 canopen::PdoMap random_map(std::mt19937_64& rng, bool byte_aligned) {
@@ -62,10 +54,10 @@ can::Frame plan_pack(const canopen::PdoPlan& plan, const std::array<std::uint64_
 }  // namespace
 
 TEST(PdoPlan, GoldenBytesAgainstPackBitsOnRandomMappings) {
-  const std::uint64_t seed = test_seed();
-  const int count = test_count(20000);
+  const std::uint64_t seed = canmotion::test::test_seed(402);
+  const std::uint64_t count = canmotion::test::test_count(20000);
   std::mt19937_64 rng(seed);
-  for (int k = 0; k < count; ++k) {
+  for (std::uint64_t k = 0; k < count; ++k) {
     const bool aligned = (k & 1) == 0;
     const canopen::PdoMap m = random_map(rng, aligned);
     const canopen::PdoPlan plan = canopen::PdoPlan::of(m);
@@ -73,9 +65,9 @@ TEST(PdoPlan, GoldenBytesAgainstPackBitsOnRandomMappings) {
     for (auto& x : v) x = rng();  // wider than the fields: both must cut them to the entry width
     const can::Frame ref = reference_pack(m, v);
     const can::Frame got = plan_pack(plan, v);
-    ASSERT_EQ(got.len, ref.len) << "seed " << seed << " k " << k;
+    ASSERT_EQ(got.len, ref.len) << canmotion::test::seed_note(seed) << " k " << k;
     // All 8 data bytes: the plan writes zeros past the payload, as the zeroed frame has.
-    ASSERT_EQ(got.data, ref.data) << "seed " << seed << " k " << k << " aligned " << aligned;
+    ASSERT_EQ(got.data, ref.data) << canmotion::test::seed_note(seed) << " k " << k << " aligned " << aligned;
     // Unpacking: the plan reads what unpack_bits reads, from a frame whose
     // bytes past the payload hold garbage (a received frame may).
     can::Frame rx = ref;
@@ -83,7 +75,7 @@ TEST(PdoPlan, GoldenBytesAgainstPackBitsOnRandomMappings) {
     const std::uint64_t w = canopen::payload_word(rx);
     for (std::uint8_t i = 0; i < m.count; ++i) {
       ASSERT_EQ(plan.get(w, i), canopen::unpack_bits(rx.payload(), m.entries[i].bit_offset, m.entries[i].bits))
-          << "seed " << seed << " k " << k << " entry " << int{i};
+          << canmotion::test::seed_note(seed) << " k " << k << " entry " << int{i};
     }
   }
 }

@@ -97,6 +97,45 @@ TEST(SimBusFilter, RingKeepsOrderWhenItRestartsAfterEmptying) {
   EXPECT_EQ(rx.counters().rx_dropped, 0u);
 }
 
+TEST(SimBusFilter, PeekAndConsumeReadTheRingInPlaceLikeReceive) {
+  // peek()/consume() (Emulator::service on a SimBus endpoint) must hand out
+  // the same frames in the same order as receive(), across wraps of the ring
+  // and partial consumes, and close an opened filter only once emptied.
+  SimBus bus("sim0");
+  auto& tx = bus.add_endpoint("tx");
+  auto& rx = bus.add_endpoint("rx", 16);
+  const std::uint64_t seed = canmotion::test::test_seed(11);
+  std::mt19937_64 rng(seed);
+  std::uint32_t next_sent = 0, next_seen = 0;
+  for (int round = 0; round < 2000; ++round) {
+    const auto burst = static_cast<std::uint32_t>(rng() % 9);
+    for (std::uint32_t k = 0; k < burst && rx.pending() < 16; ++k, ++next_sent)
+      ASSERT_EQ(tx.send(Frame(next_sent % 0x7FF, {static_cast<std::uint8_t>(next_sent)})), canmotion::can::SendResult::kOk);
+    const auto run = rx.peek();
+    ASSERT_LE(run.size(), rx.pending()) << "seed " << seed;
+    ASSERT_EQ(run.empty(), rx.pending() == 0) << "seed " << seed;
+    const std::size_t take = run.empty() ? 0 : 1 + rng() % run.size();
+    for (std::size_t i = 0; i < take; ++i, ++next_seen) {
+      ASSERT_EQ(run[i].frame.id, next_seen % 0x7FF) << "seed " << seed << " round " << round;
+      ASSERT_EQ(run[i].frame.data[0], static_cast<std::uint8_t>(next_seen)) << "seed " << seed;
+    }
+    rx.consume(take);
+  }
+  EXPECT_EQ(drain_ids(rx).size(), next_sent - next_seen);
+  EXPECT_EQ(rx.counters().rx_dropped, 0u);
+  // The opener rule, with consume() in place of receive().
+  rx.set_accept(ids_of({0x080, 0x602}), ids_of({0x602}));
+  for (std::uint32_t id : {0x081u, 0x602u, 0x081u}) ASSERT_EQ(tx.send(Frame(id, {})), canmotion::can::SendResult::kOk);
+  ASSERT_EQ(rx.peek().size(), 2u);  // 0x081 before the opener was filtered out
+  rx.consume(1);
+  ASSERT_EQ(tx.send(Frame(0x203, {})), canmotion::can::SendResult::kOk);  // still open: not emptied yet
+  EXPECT_EQ(rx.pending(), 2u);
+  rx.consume(2);
+  ASSERT_EQ(tx.send(Frame(0x203, {})), canmotion::can::SendResult::kOk);  // emptied: filtering again
+  EXPECT_EQ(rx.pending(), 0u);
+  EXPECT_TRUE(rx.peek().empty());
+}
+
 /// One emulated drive on its own bus, with or without the filter SimWorld uses.
 struct Rig {
   explicit Rig(bool filter) : bus("sim0"), master(bus.add_endpoint("master")), ep(bus.add_endpoint("node2")) {
