@@ -683,10 +683,19 @@ void Emulator::enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept
 
 void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept {
   const auto qs = static_cast<std::int16_t>(sval(hot_.quick_stop_option));
+  // The controlword of the last call again, in a state where it was seen to
+  // cause no transition without an edge: nothing below would change (no
+  // transition, no homing edge, homing_active_ already cleared if bit 4 is 0).
+  if (cw == last_cw_ && settled_cw_.valid && settled_cw_.state == state_ && settled_cw_.cw == cw &&
+      settled_cw_.qs == qs && ((cw & cia402::cw::kHomingStart) != 0 || !homing_active_))
+    return;
   std::uint16_t prev = last_cw_;
   for (int i = 0; i < 2; ++i) {
     const cia402::StepResult r = cia402::apply_controlword(state_, prev, cw, qs);
-    if (r.transition == cia402::kNoTransition) break;
+    if (r.transition == cia402::kNoTransition) {
+      if (prev == cw) settled_cw_ = SettledControlword{true, state_, cw, qs};
+      break;
+    }
     if (r.transition == 15) {
       active_fault_ = 0;
       following_error_ = false;

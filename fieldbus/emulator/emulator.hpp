@@ -304,6 +304,17 @@ class Emulator final : public canopen::SdoServerBackend {
   // CiA 402.
   cia402::State state_ = cia402::State::kNotReadyToSwitchOn;
   std::uint16_t last_cw_ = 0;
+  /// A (state, controlword, 0x605A) for which the state machine was seen to
+  /// make no transition with that controlword repeated (no edge):
+  /// apply_controlword() then skips a repetition of it (the RPDO brings the
+  /// same controlword on nearly every SYNC). A cache of a pure function.
+  struct SettledControlword {
+    bool valid = false;
+    cia402::State state = cia402::State::kNotReadyToSwitchOn;
+    std::uint16_t cw = 0;
+    std::int16_t qs = 0;
+  };
+  SettledControlword settled_cw_{};
   std::int8_t mode_display_ = 0;
   std::uint16_t pending_fault_ = 0;
   std::uint16_t active_fault_ = 0;
