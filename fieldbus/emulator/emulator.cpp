@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 
 #include "fieldbus/canopen/cob_id.hpp"
@@ -332,9 +333,11 @@ void Emulator::rebuild_pdos() noexcept {
       }
     }
   }
-  rpdo_active_count_ = 0;
-  for (std::uint8_t p = 0; p < 4; ++p)
+  rpdo_active_count_ = tpdo_active_count_ = 0;
+  for (std::uint8_t p = 0; p < 4; ++p) {
     if (rpdo_valid_[p]) rpdo_active_[rpdo_active_count_++] = p;
+    if (tpdo_valid_[p]) tpdo_active_[tpdo_active_count_++] = p;
+  }
   ++accept_gen_;
 }
 
@@ -540,8 +543,8 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
         ++counters_.rpdo_length_errors;
         send_emcy(canopen::emcy_code::kPdoLength, out);
       } else {
-        rpdo_latch_[p] = f;
-        rpdo_pending_[p] = true;
+        rpdo_latch_[p] = canopen::payload_word(f);  // all handle_sync() reads of it
+        rpdo_pending_ = static_cast<std::uint8_t>(rpdo_pending_ | (1u << p));
         ++counters_.rpdos;
       }
     }
@@ -821,8 +824,8 @@ void Emulator::update_outputs() noexcept {
 }
 
 void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
-  for (std::size_t p = 0; p < 4; ++p) {
-    if (!tpdo_valid_[p]) continue;
+  for (std::uint8_t k = 0; k < tpdo_active_count_; ++k) {  // the valid ones, ascending
+    const std::size_t p = tpdo_active_[k];
     const canopen::PdoMap& m = tpdo_[p];
     const std::uint8_t t = m.transmission_type;
     if (t >= 241 && t <= 253) continue;  // RTR-only / reserved: not sent on SYNC
@@ -851,12 +854,11 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
   // RPDOs received since the last SYNC take effect now.
   if (operational) {
     bool cw_written = false;
-    for (std::size_t p = 0; p < 4; ++p) {
-      if (!rpdo_pending_[p]) continue;
-      rpdo_pending_[p] = false;
+    for (unsigned pending = rpdo_pending_; pending != 0; pending &= pending - 1) {  // ascending
+      const auto p = static_cast<std::size_t>(std::countr_zero(pending));
       const canopen::PdoMap& m = rpdo_[p];
-      // The latched frame is at least m.size_bytes long (checked in on_frame).
-      const std::uint64_t w = canopen::payload_word(rpdo_latch_[p]);
+      // The latched frame was at least m.size_bytes long (checked in on_frame).
+      const std::uint64_t w = rpdo_latch_[p];
       const canopen::PdoPlan& plan = rpdo_plan_[p];
       const auto& cache = rpdo_entries_[p];
       for (std::uint8_t i = 0; i < m.count; ++i) {
@@ -865,6 +867,7 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
         if (me.is_controlword) cw_written = true;
       }
     }
+    rpdo_pending_ = 0;
     if (cw_written) apply_controlword(static_cast<std::uint16_t>(val(hot_.controlword)), out);
     const auto modes = static_cast<std::int8_t>(sval(hot_.modes));
     if (cfg_.refuse_mode_switch) {

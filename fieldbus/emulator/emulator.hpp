@@ -289,8 +289,10 @@ class Emulator final : public canopen::SdoServerBackend {
   std::uint8_t rpdo_active_count_ = 0;
   std::array<canopen::PdoMap, 4> tpdo_{};
   std::array<bool, 4> tpdo_valid_{};
-  std::array<can::Frame, 4> rpdo_latch_{};
-  std::array<bool, 4> rpdo_pending_{};
+  std::array<std::uint8_t, 4> tpdo_active_{};  // numbers - 1 of the valid TPDOs, ascending
+  std::uint8_t tpdo_active_count_ = 0;
+  std::array<std::uint64_t, 4> rpdo_latch_{};  // payload word (canopen::payload_word) of the latched RPDO
+  std::uint8_t rpdo_pending_ = 0;              // bit p: RPDO p + 1 latched since the last SYNC
   std::array<std::uint32_t, 4> tpdo_sync_count_{};
   std::array<std::array<MappedEntry, canopen::kMaxPdoEntries>, 4> rpdo_entries_{};
   std::array<std::array<MappedEntry, canopen::kMaxPdoEntries>, 4> tpdo_entries_{};
