@@ -686,12 +686,6 @@ void Emulator::enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept
 
 void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept {
   const auto qs = static_cast<std::int16_t>(sval(hot_.quick_stop_option));
-  // The controlword of the last call again, in a state where it was seen to
-  // cause no transition without an edge: nothing below would change (no
-  // transition, no homing edge, homing_active_ already cleared if bit 4 is 0).
-  if (cw == last_cw_ && settled_cw_.valid && settled_cw_.state == state_ && settled_cw_.cw == cw &&
-      settled_cw_.qs == qs && ((cw & cia402::cw::kHomingStart) != 0 || !homing_active_))
-    return;
   std::uint16_t prev = last_cw_;
   for (int i = 0; i < 2; ++i) {
     const cia402::StepResult r = cia402::apply_controlword(state_, prev, cw, qs);
@@ -868,7 +862,17 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
       }
     }
     rpdo_pending_ = 0;
-    if (cw_written) apply_controlword(static_cast<std::uint16_t>(val(hot_.controlword)), out);
+    if (cw_written) {
+      const auto cw = static_cast<std::uint16_t>(val(hot_.controlword));
+      // The controlword of the last call again, in a state where it was seen
+      // to cause no transition without an edge: apply_controlword() would
+      // change nothing (no transition, no homing edge, homing_active_ already
+      // cleared if bit 4 is 0), so it is not called (most SYNCs).
+      const bool settled = cw == last_cw_ && settled_cw_.valid && settled_cw_.state == state_ && settled_cw_.cw == cw &&
+                           settled_cw_.qs == static_cast<std::int16_t>(sval(hot_.quick_stop_option)) &&
+                           ((cw & cia402::cw::kHomingStart) != 0 || !homing_active_);
+      if (!settled) apply_controlword(cw, out);
+    }
     const auto modes = static_cast<std::int8_t>(sval(hot_.modes));
     if (cfg_.refuse_mode_switch) {
       // fault injection: 0x6061 keeps showing the old mode

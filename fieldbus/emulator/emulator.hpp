@@ -308,8 +308,9 @@ class Emulator final : public canopen::SdoServerBackend {
   std::uint16_t last_cw_ = 0;
   /// A (state, controlword, 0x605A) for which the state machine was seen to
   /// make no transition with that controlword repeated (no edge):
-  /// apply_controlword() then skips a repetition of it (the RPDO brings the
-  /// same controlword on nearly every SYNC). A cache of a pure function.
+  /// a repetition of it need not go through apply_controlword() (the RPDO brings the
+  /// same controlword on nearly every SYNC; handle_sync() checks it before
+  /// the call). A cache of a pure function.
   struct SettledControlword {
     bool valid = false;
     cia402::State state = cia402::State::kNotReadyToSwitchOn;
