@@ -53,6 +53,7 @@ Emulator::Emulator(const EmulatorConfig& cfg)
   build_dictionary();
   resolve_hot();
   pos_ = cfg_.initial_position;
+  torque_per_acc_ = 1000.0 / cfg_.max_acceleration;
 }
 
 // ============================================================================
@@ -726,6 +727,10 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
 }
 
 void Emulator::advance_motor(double dt) noexcept {
+  // 1 / dt, computed when 0x60C2 changes: multiplications instead of the
+  // ~15-cycle divisions of the CSP path on every SYNC (a deliberate change
+  // of the last bit of some results against dividing by dt).
+  const double inv_dt = sync_period_.inv_dt;
   const Setpoint now_sp{static_cast<std::int32_t>(sval(hot_.target_position) + sval(hot_.position_offset)),
                         static_cast<std::int32_t>(sval(hot_.target_velocity) + sval(hot_.velocity_offset)),
                         static_cast<std::int16_t>(sval(hot_.target_torque) + sval(hot_.torque_offset))};
@@ -751,8 +756,8 @@ void Emulator::advance_motor(double dt) noexcept {
         // Feed-forward of the demand's change plus a proportional correction
         // of the error left from the previous SYNC: a ramp is followed exactly
         // (the only following error is the lag), a step settles geometrically.
-        const double v_ff = (demand - prev_demand_) / dt;
-        v_des = v_ff + cfg_.position_gain * (prev_demand_ - pos_) / dt;
+        const double v_ff = (demand - prev_demand_) * inv_dt;
+        v_des = v_ff + cfg_.position_gain * (prev_demand_ - pos_) * inv_dt;
         prev_demand_ = demand;
         put(hot_.position_demand, static_cast<std::uint32_t>(sp.position));
         break;
@@ -795,11 +800,11 @@ void Emulator::advance_motor(double dt) noexcept {
   } else {
     v_des = std::clamp(v_des, -vmax, vmax);
     const double dv = std::clamp(v_des - vel_, -amax * dt, amax * dt);
-    acc_ = dv / dt;
+    acc_ = dv * inv_dt;
     vel_ += dv;
     pos_ += vel_ * dt;
   }
-  const double trq = mode == cia402::Mode::kCst && state_ == State::kOperationEnabled ? torque : acc_ / cfg_.max_acceleration * 1000.0;
+  const double trq = mode == cia402::Mode::kCst && state_ == State::kOperationEnabled ? torque : acc_ * torque_per_acc_;
   torque_ = trq;
   put(hot_.torque_actual, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(round_half_away(trq), -32768.0, 32767.0))));
   if (state_ == State::kQuickStopActive && vel_ == 0.0 && !cia402::quick_stop_stays(static_cast<std::int16_t>(sval(hot_.quick_stop_option)))) {
@@ -899,7 +904,7 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
   if (!sync_period_.valid || ip.value != sync_period_.ip.value || ip.index != sync_period_.ip.index) {
     std::int64_t ns = cia402::interpolation_period_ns(ip);
     if (ns <= 0) ns = 1'000'000;
-    sync_period_ = SyncPeriod{ip, ns, static_cast<double>(ns) / 1e9, true};
+    sync_period_ = SyncPeriod{ip, ns, static_cast<double>(ns) / 1e9, 1e9 / static_cast<double>(ns), true};
   }
   const std::int64_t period_ns = sync_period_.ns;
   advance_motor(sync_period_.dt);

@@ -334,6 +334,7 @@ class Emulator final : public canopen::SdoServerBackend {
   bool slat_speed_ = false;         // CST SLAT: in speed control
   std::int64_t slat_held_ns_ = 0;   // CST SLAT: time the torque->speed condition has held
   double torque_ = 0;               // motor torque at the last SYNC (per mille)
+  double torque_per_acc_ = 0;       // 1000 / cfg_.max_acceleration: torque (per mille) of an acceleration
   static constexpr std::size_t kMaxLag = 64;  // bound of lag_cycles
   struct Setpoint {
     std::int32_t position;
@@ -351,6 +352,7 @@ class Emulator final : public canopen::SdoServerBackend {
     cia402::InterpolationPeriod ip{};
     std::int64_t ns = 0;
     double dt = 0;
+    double inv_dt = 0;  ///< 1 / dt, as 1e9 / ns (advance_motor multiplies by it)
     bool valid = false;
   };
   SyncPeriod sync_period_{};
