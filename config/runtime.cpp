@@ -7,6 +7,7 @@
 
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/object_names.hpp"
+#include "fieldbus/canopen/receive_filters.hpp"
 
 namespace canmotion::config {
 
@@ -112,14 +113,11 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       rt.is_socket.push_back(false);
     } else {
       // Receive only what a CANopen master needs: the nodes' EMCY, TPDOs,
-      // SDO responses and heartbeats (0x080 + node .. 0x700 + node).
-      std::vector<can::Filter> filters;
-      for (const AxisSettings& a : cfg.axes) {
-        if (a.axis.type != motion::AxisType::CipDrive || a.bus != b.name) continue;
-        for (std::uint32_t base : {canopen::cob::kEmcyBase, 0x180u, 0x280u, 0x380u, 0x480u, canopen::cob::kSdoTxBase,
-                                   canopen::cob::kHeartbeatBase})
-          filters.push_back(can::Filter{base + a.node, 0x7FF, false});
-      }
+      // SDO responses and heartbeats (the list DriveNetwork::receive_filters() gives).
+      std::vector<std::uint8_t> nodes;
+      for (const AxisSettings& a : cfg.axes)
+        if (a.axis.type == motion::AxisType::CipDrive && a.bus == b.name) nodes.push_back(a.node);
+      const std::vector<can::Filter> filters = canopen::master_receive_filters(nodes);
       std::error_code ec;
       std::string why;
       auto sock = can::SocketCanBus::open(b.interface, filters, ec, &why);

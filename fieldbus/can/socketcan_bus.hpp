@@ -26,14 +26,6 @@
 
 namespace canmotion::can {
 
-/// One receive filter: a frame passes when (id & mask) == (filter.id & mask).
-/// `extended` selects 29-bit ids. Mirrors struct can_filter.
-struct Filter {
-  std::uint32_t id = 0;
-  std::uint32_t mask = 0x7FF;
-  bool extended = false;
-};
-
 class SocketCanBus final : public Transport {
  public:
   /// Largest number of filters accepted by open() (the kernel allows more;

@@ -55,6 +55,15 @@ struct BusCounters {
   std::uint64_t error_frames = 0;
 };
 
+/// One receive filter: a frame passes when (id & mask) == (filter.id & mask).
+/// `extended` selects 29-bit ids. Mirrors struct can_filter (SocketCanBus
+/// hands it to the kernel); a plain value type, no socket header.
+struct Filter {
+  std::uint32_t id = 0;
+  std::uint32_t mask = 0x7FF;
+  bool extended = false;
+};
+
 /// One endpoint on a CAN bus.
 class Transport {
  public:

@@ -7,6 +7,7 @@
 
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/emcy.hpp"
+#include "fieldbus/canopen/receive_filters.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 
 namespace canmotion::cia402 {
@@ -613,15 +614,9 @@ void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept 
 }
 
 std::vector<can::Filter> DriveNetwork::receive_filters() const {
-  std::vector<can::Filter> f;
-  for (const auto& d : drives_) {
-    const std::uint8_t n = d->node();
-    f.push_back(can::Filter{canopen::cob::emcy(n), 0x7FF, false});
-    for (std::uint8_t p = 1; p <= 4; ++p) f.push_back(can::Filter{canopen::cob::tpdo(p, n), 0x7FF, false});
-    f.push_back(can::Filter{canopen::cob::sdo_tx(n), 0x7FF, false});
-    f.push_back(can::Filter{canopen::cob::heartbeat(n), 0x7FF, false});
-  }
-  return f;
+  std::vector<std::uint8_t> nodes;
+  for (const auto& d : drives_) nodes.push_back(d->node());
+  return canopen::master_receive_filters(nodes);
 }
 
 bool DriveNetwork::poll_event(canopen::NodeEvent& out) noexcept {

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "fieldbus/can/frame.hpp"
-#include "fieldbus/can/socketcan_bus.hpp"  // can::Filter only (no socket header)
+#include "fieldbus/can/transport.hpp"  // can::Filter
 #include "fieldbus/canopen/frame_sink.hpp"
 #include "fieldbus/canopen/master.hpp"
 #include "fieldbus/canopen/pdo.hpp"

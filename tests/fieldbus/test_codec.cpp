@@ -10,6 +10,7 @@
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/master.hpp"
 #include "fieldbus/canopen/pdo.hpp"
+#include "fieldbus/canopen/receive_filters.hpp"
 #include "fieldbus/cia402/cia402.hpp"
 #include "fieldbus/cia402/drive_proxy.hpp"
 #include "fieldbus/emulator/emulator.hpp"
@@ -98,6 +99,31 @@ TEST(FieldbusGolden, MasterRpdosAndBootConfiguration) {
   EXPECT_EQ(filters[5].id, 0x582u);
   EXPECT_EQ(filters[6].id, 0x702u);
   EXPECT_EQ(filters[6].mask, 0x7FFu);
+}
+
+TEST(FieldbusGolden, MasterReceiveFiltersAreOneListForNetworkAndDaemon) {
+  // canopen::master_receive_filters() serves DriveNetwork::receive_filters()
+  // and the daemon's SocketCAN set-up (config/runtime.cpp).
+  EXPECT_EQ(canopen::master_receive_ids(5),
+            (std::array<std::uint32_t, 7>{0x085, 0x185, 0x285, 0x385, 0x485, 0x585, 0x705}));
+  cia402::DriveNetwork net;
+  const std::array<std::uint8_t, 2> nodes{2, 5};
+  for (std::uint8_t n : nodes) {
+    cia402::DriveConfig dc;
+    dc.node = n;
+    net.add_drive(dc);
+  }
+  const auto expected = canopen::master_receive_filters(nodes);
+  const auto got = net.receive_filters();
+  ASSERT_EQ(got.size(), 14u);
+  ASSERT_EQ(expected.size(), got.size());
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].id, expected[i].id) << i;
+    EXPECT_EQ(got[i].mask, 0x7FFu);
+    EXPECT_FALSE(got[i].extended);
+  }
+  EXPECT_EQ(got[7].id, 0x085u);
+  EXPECT_EQ(got[13].id, 0x705u);
 }
 
 TEST(FieldbusGolden, ProxyRpdoAndTpdoBytes) {
