@@ -364,10 +364,40 @@ void Controller::publish(std::int64_t now_ns) noexcept {
   s.bus_count = static_cast<std::uint8_t>(buses_.size());
   const bool tele = telemetry_on_.load(std::memory_order_relaxed);
   for (std::size_t a = 0; a < axes_.size(); ++a) {
+    const motion::AxisTag& tag = planner_.axis(static_cast<motion::AxisId>(a));
+    const double err = std::abs(tag.position_error);
+    if (err > max_err_[a]) max_err_[a] = err;
+    if (tele) {
+      const Sample smp{cycle_index_,       static_cast<std::uint16_t>(a), tag.command_position,
+                       tag.actual_position, tag.command_velocity,      tag.actual_velocity,
+                       tag.motion_status,   tag.axis_status};
+      if (!telemetry_.try_push(smp)) ++telemetry_dropped_;
+    }
+  }
+  // The transports can change between cycles (the simulated drives run after
+  // the controller's cycle): their part is taken now.
+  for (std::size_t b = 0; b < buses_.size(); ++b) {
+    s.buses[b].state = buses_[b].transport->state();
+    s.buses[b].counters = buses_[b].transport->counters();
+    s.buses[b].send_rejected = buses_[b].rejected;
+  }
+  s.trace_dropped = trace_dropped_;
+  s.telemetry_dropped = telemetry_dropped_;
+  s.commands_deferred = deferred_;
+  s.halted = halt_ == Halt::kHalted;
+  // Control tags handed out so far (requests can only name those).
+  publish_nctl_ = controls_in_use_.load(std::memory_order_acquire);
+  publish_pending_ = true;
+  if (!deferred_publish_) finish_publish();
+}
+
+void Controller::finish_publish() const noexcept {
+  // Everything below changes only in cycle(): with deferred publishing it is
+  // copied when read_status() is called, before the next cycle.
+  Status& s = snapshot_->write_slot();
+  for (std::size_t a = 0; a < axes_.size(); ++a) {
     AxisSnapshot& x = s.axes[a];
     x.tag = planner_.axis(static_cast<motion::AxisId>(a));
-    const double err = std::abs(x.tag.position_error);
-    if (err > max_err_[a]) max_err_[a] = err;
     x.max_abs_position_error = max_err_[a];
     if (const cia402::DriveProxy* p = axes_[a].proxy) {
       x.phase = p->phase();
@@ -381,28 +411,12 @@ void Controller::publish(std::int64_t now_ns) noexcept {
       x.tpdo_missed = p->feedback().tpdo_missed;
       x.failure = p->failure();
     }
-    if (tele) {
-      const Sample smp{cycle_index_,         static_cast<std::uint16_t>(a), x.tag.command_position,
-                       x.tag.actual_position, x.tag.command_velocity,      x.tag.actual_velocity,
-                       x.tag.motion_status,   x.tag.axis_status};
-      if (!telemetry_.try_push(smp)) ++telemetry_dropped_;
-    }
   }
-  for (std::size_t b = 0; b < buses_.size(); ++b) {
-    s.buses[b].state = buses_[b].transport->state();
-    s.buses[b].counters = buses_[b].transport->counters();
-    s.buses[b].send_rejected = buses_[b].rejected;
-  }
-  // Control tags handed out so far (requests can only name those).
-  const std::size_t nctl = controls_in_use_.load(std::memory_order_acquire);
-  for (std::size_t c = 0; c < nctl; ++c) s.controls[c] = planner_.control(static_cast<motion::ControlId>(c));
-  s.trace_dropped = trace_dropped_;
-  s.telemetry_dropped = telemetry_dropped_;
-  s.commands_deferred = deferred_;
-  s.halted = halt_ == Halt::kHalted;
+  for (std::size_t c = 0; c < publish_nctl_; ++c) s.controls[c] = planner_.control(static_cast<motion::ControlId>(c));
   for (std::size_t c = 0; c < cams_.size(); ++c) s.cam_status[c] = cams_[c]->status();
   std::copy(real_store_.begin(), real_store_.end(), s.real_values.begin());  // <= kMaxRealElements
   snapshot_->commit();
+  publish_pending_ = false;
 }
 
 }  // namespace canmotion::rt

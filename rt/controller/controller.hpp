@@ -244,9 +244,13 @@ class Controller {
   /// full. Thread-safe among producers (a producer-side mutex; the RT side
   /// never takes it).
   std::uint64_t submit(Command c);
-  /// Newest status (copy). Any non-RT thread.
+  /// Newest status (copy). Any non-RT thread (with set_deferred_publish():
+  /// the thread that runs cycle(), between cycles).
   /// Returns false before the first cycle.
-  bool read_status(Status& out) const { return snapshot_->read(out) != 0; }
+  bool read_status(Status& out) const {
+    if (deferred_publish_ && publish_pending_) finish_publish();
+    return snapshot_->read(out) != 0;
+  }
   /// Drain rings (one consumer thread each).
   bool pop_event(Event& e) noexcept { return events_.try_pop(e); }
   bool pop_trace(TraceRecord& r) noexcept { return trace_.try_pop(r); }
@@ -254,6 +258,14 @@ class Controller {
   /// Turn trace/telemetry recording on or off (before or while running).
   void set_trace(bool on) noexcept { trace_on_.store(on, std::memory_order_relaxed); }
   void set_telemetry(bool on) noexcept { telemetry_on_.store(on, std::memory_order_relaxed); }
+  /// Deferred publishing, for a caller that runs cycle() and every
+  /// read_status() on ONE thread (canmotiond --sim: the script and the socket
+  /// are served between cycles): cycle() then keeps only what may change
+  /// between cycles (bus counters, the maximum following errors, telemetry)
+  /// and read_status() copies the rest, so cycles nobody reads cost no
+  /// snapshot copy. A reader sees the same Status either way. Set before the
+  /// first cycle; never with a reader on another thread.
+  void set_deferred_publish(bool on) noexcept { deferred_publish_ = on; }
 
   /// Name lookups (not realtime).
   [[nodiscard]] std::optional<motion::AxisId> axis_id(std::string_view name) const;
@@ -311,6 +323,7 @@ class Controller {
   void feedback(std::size_t a) noexcept;
   void apply(std::size_t a, const motion::AxisOutput& out) noexcept;
   void publish(std::int64_t now_ns) noexcept;
+  void finish_publish() const noexcept;  ///< the copies of publish() that read_status() may defer
   void record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noexcept;
   void emit(const Event& e) noexcept;
   void build_arrays();                              ///< controller_arrays.cpp (constructor)
@@ -349,6 +362,9 @@ class Controller {
   std::atomic<bool> trace_on_{false};
   std::atomic<bool> telemetry_on_{false};
   std::atomic<std::size_t> controls_in_use_{0};  ///< control ids handed out; publish copies only these
+  bool deferred_publish_ = false;        ///< set_deferred_publish()
+  mutable bool publish_pending_ = false;  ///< publish() left its copies to finish_publish()
+  std::size_t publish_nctl_ = 0;          ///< control tags in use at the last publish()
 
   SpscRing<Command, kCommandCapacity> commands_;
   SpscRing<Event, kEventCapacity> events_;

@@ -394,7 +394,10 @@ int run(const Options& o) {
   if (rt.sim) rt.sim->power_on(sim ? 0 : clock.now().count());  // boot-up frames at the run's start time
   if (sim) {
     // --sim: the same cycle code on a virtual clock, with the non-RT work
-    // inline between cycles so that runs are deterministic.
+    // inline between cycles so that runs are deterministic. Every status
+    // read (script, socket, progress) runs on this thread between cycles, so
+    // the controller copies its snapshot only for cycles that are read.
+    ctl.set_deferred_publish(true);
     exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
       const auto t = static_cast<std::int64_t>(info.cycle) * period.count();
       if (rt.sim) rt.sim->begin_cycle(t);  // null when the configuration has no buses (virtual axes only)
