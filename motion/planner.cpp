@@ -5,6 +5,7 @@
 #include "motion/instructions.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace canmotion::motion {
@@ -199,6 +200,7 @@ bool Planner::configure_axis(AxisId id, const AxisConfig& cfg) noexcept {
   a.cfg = cfg;
   a.present = true;
   axis_count_ = std::max<std::size_t>(axis_count_, static_cast<std::size_t>(id) + 1);
+  order_dirty_ = true;
   update_status(a);
   return true;
 }
@@ -218,14 +220,14 @@ Kin Planner::slot_kin(const AxisRt& a, Slot s) const noexcept {
 double Planner::user_command(const AxisRt& a) const noexcept { return a.cmd.p + a.frame_offset; }
 
 bool Planner::any_scurve(const AxisRt& a) const noexcept {
-  for (const auto& g : a.gen)
-    if (auto* p = std::get_if<ProfileGen>(&g); p && p->scurve) return true;
+  for (unsigned m = a.live; m != 0; m &= m - 1)  // live slots only
+    if (auto* p = std::get_if<ProfileGen>(&a.gen[std::countr_zero(m)]); p && p->scurve) return true;
   return false;
 }
 
 bool Planner::any_stopping(const AxisRt& a) const noexcept {
-  for (const auto& g : a.gen)
-    if (auto* p = std::get_if<ProfileGen>(&g); p && p->role == GenRole::Stop) return true;
+  for (unsigned m = a.live; m != 0; m &= m - 1)  // live slots only
+    if (auto* p = std::get_if<ProfileGen>(&a.gen[std::countr_zero(m)]); p && p->role == GenRole::Stop) return true;
   return false;
 }
 
@@ -255,6 +257,9 @@ void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
       }
     }
   }
+  const unsigned bit = 1u << static_cast<unsigned>(s);
+  if (a.live & bit) order_dirty_ = true;  // a master link may have gone
+  a.live = static_cast<std::uint8_t>(a.live & ~bit);
   slot = std::monostate{};
 }
 
@@ -425,7 +430,7 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
     g.owner_gen = gen_owner;
     g.post_stop = post_stop;
     g.scurve = !std::isinf(jd);
-    a.gen[static_cast<std::size_t>(Slot::StopAll)] = g;
+    set_slot(a, Slot::StopAll, g);
     return true;
   }
   bool any = false;
@@ -445,7 +450,7 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
     st.owner_gen = gen_owner;
     st.post_stop = post_stop;
     st.scurve = !std::isinf(jd);
-    a.gen[s] = st;
+    set_slot(a, static_cast<Slot>(s), st);
     any = true;
   }
   return any;
@@ -781,7 +786,7 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
     c.set(flag::AC, true);
     if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
   }
-  a.gen[static_cast<std::size_t>(Slot::Jog)] = g;
+  set_slot(a, Slot::Jog, g);
   if (V > 0) a.last_speed = V;
   c.set(flag::DN, true);
   c.set(flag::IP, true);
@@ -924,7 +929,7 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
     if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
   }
   write_calculated_data(r, g, c);  // planner_mccp.cpp
-  a.gen[static_cast<std::size_t>(slot)] = g;
+  set_slot(a, slot, g);
   if (g.speed > 0) a.last_speed = g.speed;
   c.set(flag::DN, true);
   c.set(flag::IP, true);
@@ -1265,7 +1270,7 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
                                                 Slot::MasterOffset, Slot::PositionCam, Slot::StopAll};
   for (const Slot slot_id : kStepOrder) {
     const auto s = static_cast<std::size_t>(slot_id);
-    if (std::holds_alternative<std::monostate>(a.gen[s])) continue;  // empty slot: nothing below applies
+    if (!(a.live & (1u << s))) continue;  // empty slot (AxisRt::live): nothing below applies
     // cams may end (fold) or hand over (pending) while stepping: add what the slot holds afterwards
     const auto add_slot = [&] {
       if (const GenRef r = gen_ref(a.gen[s]); r.k) {
@@ -1313,9 +1318,7 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
     ControlTag* c = owner_tag(g->owner, g->owner_gen);
     if (done) {
       if (g->role == GenRole::Move) {
-        bool alone = true;
-        for (std::size_t o = 0; o < kSlots; ++o)
-          if (o != s && !std::holds_alternative<std::monostate>(a.gen[o])) alone = false;
+        const bool alone = (a.live & ~(1u << s)) == 0;  // no other live slot
         g->k = Kin{g->total, 0, 0};
         if (alone && g->exact_target) {
           a.base = g->target_user - a.frame_offset;  // ends exactly on the programmed target
@@ -1507,7 +1510,7 @@ Err Planner::start_mag(const Request& r, const MagParams& p, AxisRt& a, std::int
     g.offset_at_lock = 0.0;
     g.k = Kin{};
   }
-  a.gen[static_cast<std::size_t>(Slot::Gear)] = g;
+  set_slot(a, Slot::Gear, g);
   a.gear_dir = dir;
   ct.set(flag::DN, true);
   ct.set(flag::IP, true);
@@ -1681,7 +1684,7 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
     c.set(flag::AC, true);
     if (ControlTag* m = owner_tag(g.md.mdac, g.md.mdac_gen)) m->set(flag::AC, true);
   }
-  a.gen[static_cast<std::size_t>(Slot::TimeCam)] = g;
+  set_slot(a, Slot::TimeCam, g);
   a.cam_dir = dir;
   c.set(flag::DN, true);
   c.set(flag::IP, true);
@@ -1728,8 +1731,7 @@ void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
           if (ControlTag* nt = owner_tag(n.owner, n.owner_gen)) nt->set(flag::AC, true);
           if (ControlTag* m = owner_tag(n.md.mdac, n.md.mdac_gen)) m->set(flag::AC, true);
         }
-        a.gen[static_cast<std::size_t>(Slot::TimeCam)] = n;
-        auto& ng = std::get<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]);
+        CamGen& ng = set_slot(a, Slot::TimeCam, n);
         step_cam(a, ng);
       } else if (ControlTag* pt = owner_tag(pc.owner, pc.owner_gen)) {
         pt->reject(Err::CamProfileNotCalculated);
@@ -1748,14 +1750,17 @@ void Planner::compute_order() noexcept {
   // depth-first: every axis after the masters it follows (gear, master-driven
   // motion). MAG refuses gear cycles (ERR 10); a cycle through master-driven
   // motion is broken arbitrarily (the stack below bounds the walk).
+  // The order changes only with the slots (set_slot, fold) and the axes
+  // (configure_axis): otherwise last cycle's order stands.
+  if (!order_dirty_) return;
+  order_dirty_ = false;
   std::array<std::uint8_t, kMaxAxes> mark{};  // 0 new, 1 on stack, 2 emitted
   order_n_ = 0;
   auto masters_of = [this](AxisId i, std::array<AxisId, kSlots>& out) noexcept {
     std::size_t n = 0;
     out.fill(kNoAxis);  // the first n are overwritten below
-    for (const auto& s : axes_[i].gen) {
-      if (std::holds_alternative<std::monostate>(s)) continue;  // empty slot: no master
-      const AxisId m = master_of(s);
+    for (unsigned live = axes_[i].live; live != 0; live &= live - 1) {  // empty slots have no master
+      const AxisId m = master_of(axes_[i].gen[std::countr_zero(live)]);
       if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
     }
   };
@@ -1800,6 +1805,35 @@ void Planner::compute_order() noexcept {
       --sp;
     }
   }
+}
+
+bool Planner::check_incremental_state() noexcept {
+  bool ok = true;
+  for (std::size_t i = 0; i < axis_count_; ++i) {
+    unsigned live = 0;
+    for (std::size_t s = 0; s < kSlots; ++s)
+      if (!std::holds_alternative<std::monostate>(axes_[i].gen[s])) live |= 1u << s;
+    ok = ok && live == axes_[i].live;
+  }
+  // the cached order against a fresh one (an up-to-date cache is recomputed
+  // to the same order; a stale one is reported and left as it was)
+  const std::array<AxisId, kMaxAxes> cached = order_;
+  const std::size_t cached_n = order_n_;
+  const bool dirty = order_dirty_;
+  order_dirty_ = true;
+  compute_order();
+  const bool same = order_n_ == cached_n && std::equal(cached.begin(), cached.begin() + static_cast<std::ptrdiff_t>(cached_n), order_.begin());
+  if (!dirty && !same) {
+    order_ = cached;
+    order_n_ = cached_n;
+    ok = false;
+  }
+  order_dirty_ = dirty;
+  if (dirty) {  // leave a pending recomputation pending
+    order_ = cached;
+    order_n_ = cached_n;
+  }
+  return ok;
 }
 
 Result Planner::update(const Input& in, Output& out) noexcept {

@@ -343,6 +343,12 @@ class Planner {
   double period() const noexcept { return T_; }
   std::uint64_t cycle() const noexcept { return cycle_; }
 
+  /// Test hook: true when the state kept incrementally for speed agrees with
+  /// what it summarises: every axis's live-slot mask (AxisRt::live) with its
+  /// slots, and the cached step order with one computed afresh. Not realtime
+  /// critical but allocation-free.
+  bool check_incremental_state() noexcept;
+
  private:
   struct AxisRt {
     AxisConfig cfg{};
@@ -361,6 +367,10 @@ class Planner {
     bool fault_reset_pulse = false;
     std::uint32_t reset_grace = 0;  ///< cycles during which a drive fault is not re-latched after a fault reset
     std::array<Generator, kSlots> gen{};
+    /// Bit per Slot: the slot holds a generator (not std::monostate). Kept by
+    /// set_slot() and fold(), the only writers of `gen`, so that the cycle
+    /// reads no empty slot; check_incremental_state() verifies it.
+    std::uint8_t live = 0;
     double last_speed = 0.0;    ///< last non-zero programmed speed (zero-speed S-curve rule)
     // multi-cycle state instructions
     ControlId mso = kNoControl, msf = kNoControl;
@@ -448,6 +458,16 @@ class Planner {
   void handle_feedback(AxisId id, AxisRt& a, const AxisFeedback* fb) noexcept;
   void handle_exceptions(AxisRt& a) noexcept;
   void fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept;
+  /// Put generator g into slot s: every write of a slot goes through here or
+  /// fold(), keeping AxisRt::live and the step order (order_dirty_) current.
+  template <class G>
+  G& set_slot(AxisRt& a, Slot s, const G& g) noexcept {
+    const auto i = static_cast<std::size_t>(s);
+    a.gen[i] = g;
+    a.live = static_cast<std::uint8_t>(a.live | (1u << i));
+    order_dirty_ = true;
+    return *std::get_if<G>(&a.gen[i]);
+  }
   void abort_all(AxisRt& a) noexcept;  ///< cancel every generator at once (no ramp)
   bool stop_slots(AxisRt& a, std::uint32_t slot_mask, double d, double jd, ControlId owner,
                   std::uint8_t post_stop) noexcept;
@@ -472,6 +492,7 @@ class Planner {
   std::array<std::span<double>, kMaxRealArrays> real_arrays_{};
   std::array<AxisId, kMaxAxes> order_{};  ///< step order: masters before slaves
   std::size_t order_n_ = 0;
+  bool order_dirty_ = true;  ///< a slot or an axis changed since order_ was computed
 };
 
 }  // namespace canmotion::motion

@@ -186,7 +186,7 @@ Err Planner::start_mapc(const Request& r, const MapcParams& p, AxisRt& a, std::i
   g.lock_mp = mp;
   g.owner = r.control;
   g.owner_gen = c.generation;
-  a.gen[kPosCam] = g;
+  set_slot(a, Slot::PositionCam, g);
   a.pcam_dir = dir;
   c.set(flag::DN, true);
   c.set(flag::IP, true);
@@ -293,8 +293,8 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
       n.owner = pc.owner;
       n.owner_gen = pc.owner_gen;
       if (ControlTag* nc = owner_tag(n.owner, n.owner_gen)) nc->set(flag::AC, true);
-      a.gen[kPosCam] = n;  // g is gone from here on
-      step_position_cam(a, std::get<PosCamGen>(a.gen[kPosCam]));
+      PosCamGen& ng = set_slot(a, Slot::PositionCam, n);  // g is gone from here on
+      step_position_cam(a, ng);
       return;
     }
   }
