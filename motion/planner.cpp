@@ -1210,6 +1210,12 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
     if (p > a.cfg.soft_limit_pos) active |= bit(ExceptionKind::SoftOvertravelPos);
     if (p < a.cfg.soft_limit_neg) active |= bit(ExceptionKind::SoftOvertravelNeg);
   }
+  if (active == 0 && a.tag.exception_faults == 0) {  // the usual case: what the code below gives then
+    a.tag.exception_alarms = 0;
+    a.tag.motion_alarm_status = 0;
+    a.tag.axis_fault = 0;
+    return;
+  }
   std::uint32_t alarms = 0, faults = 0;
   for (unsigned k = 0; active != 0 && k < static_cast<unsigned>(ExceptionKind::Count); ++k) {  // usually none active
     if (!(active & (1u << k))) continue;
@@ -1268,9 +1274,20 @@ void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
   // and is not part of the slave's sum
   constexpr std::array<Slot, kSlots> kStepOrder{Slot::Move, Slot::Jog, Slot::Gear, Slot::TimeCam,
                                                 Slot::MasterOffset, Slot::PositionCam, Slot::StopAll};
-  for (const Slot slot_id : kStepOrder) {
+  // Visit the live slots (AxisRt::live) in step order: the next live one at
+  // or after position `from`, looked up afresh after each step (a slot may
+  // fold, or fold the others, while stepping). Step position = slot index
+  // with PositionCam and MasterOffset swapped.
+  static_assert(static_cast<unsigned>(Slot::PositionCam) == 4 && static_cast<unsigned>(Slot::MasterOffset) == 5);
+  for (unsigned from = 0;;) {
+    const unsigned x = a.live;
+    const unsigned swap = ((x >> 4) ^ (x >> 5)) & 1u;
+    const unsigned pending = (x ^ (swap << 4) ^ (swap << 5)) & (~0u << from);
+    if (pending == 0) break;
+    const auto pos = static_cast<unsigned>(std::countr_zero(pending));
+    from = pos + 1;
+    const Slot slot_id = kStepOrder[pos];
     const auto s = static_cast<std::size_t>(slot_id);
-    if (!(a.live & (1u << s))) continue;  // empty slot (AxisRt::live): nothing below applies
     // cams may end (fold) or hand over (pending) while stepping: add what the slot holds afterwards
     const auto add_slot = [&] {
       if (const GenRef r = gen_ref(a.gen[s]); r.k) {
