@@ -1405,8 +1405,8 @@ void Planner::update_status(AxisRt& a) noexcept {
   setb(JogStatus, jg && jg->role == GenRole::Jog);
   setb(MoveLockStatus, mv && mv->role == GenRole::Move && mv->master_driven && mv->locked && mv->following);
   setb(JogLockStatus, jg && jg->role == GenRole::Jog && jg->master_driven && jg->locked && jg->following);
-  bool linked = false;
-  for (const auto& l : a.mdac) linked = linked || l.valid();
+  static_assert(std::tuple_size_v<decltype(a.mdac)> == 4);
+  const bool linked = a.mdac[0].valid() || a.mdac[1].valid() || a.mdac[2].valid() || a.mdac[3].valid();
   setb(CoordinatedMotionStatus, linked);
   const auto* gr = std::get_if<GearGen>(&a.gen[static_cast<std::size_t>(Slot::Gear)]);
   setb(GearingStatus, gr != nullptr);
