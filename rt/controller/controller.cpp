@@ -175,8 +175,9 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   }
   bus.bus_off = bus.transport->state() == can::BusState::kBusOff;
   for (std::size_t n; (n = bus.transport->receive(rx_)) > 0;) {
+    const bool tracing = trace_on_.load(std::memory_order_relaxed);
     for (std::size_t i = 0; i < n; ++i) {
-      record(static_cast<std::uint8_t>(b), rx_[i], false);
+      if (tracing) record(static_cast<std::uint8_t>(b), rx_[i], false);
       bus.network->on_frame(rx_[i]);
     }
     if (n < rx_.size()) break;
@@ -266,7 +267,7 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
   std::size_t nreq = 0;
   bool deferred = false;
   for (;;) {
-    Command c;
+    Command& c = popped_;
     if (held_) {
       c = *held_;
       held_.reset();

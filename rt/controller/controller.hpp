@@ -346,6 +346,7 @@ class Controller {
   std::array<can::BusEvent, 16> bus_ev_{};  ///< receive()'s bus events (a member: not re-initialised each call)
   std::array<double, motion::kMaxAxes> max_err_{};
   std::optional<Command> held_;  ///< a command popped but deferred to the next cycle
+  Command popped_{};  ///< cycle()'s current command (a member: not re-initialised every cycle)
   /// Controlled stop of the buses (Command::kPreOperational).
   enum class Halt : std::uint8_t { kRunning, kDisarming, kHalted };
   Halt halt_ = Halt::kRunning;
