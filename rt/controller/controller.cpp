@@ -185,7 +185,8 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   (void)now_ns;
 }
 
-void Controller::feedback(std::size_t a) noexcept {
+// Called once per axis per cycle from cycle() only: inlined there (no call per axis).
+[[gnu::always_inline]] inline void Controller::feedback(std::size_t a) noexcept {
   AxisRt& ax = axes_[a];
   motion::AxisFeedback& f = fb_[a];
   if (ax.proxy == nullptr) return;  // virtual axis: the planner ignores feedback
@@ -222,7 +223,8 @@ void Controller::feedback(std::size_t a) noexcept {
   ax.failure_reported = p.failed();
 }
 
-void Controller::apply(std::size_t a, const motion::AxisOutput& out) noexcept {
+// Called once per axis per cycle from cycle() only: inlined there (no call per axis).
+[[gnu::always_inline]] inline void Controller::apply(std::size_t a, const motion::AxisOutput& out) noexcept {
   AxisRt& ax = axes_[a];
   if (ax.proxy == nullptr) return;
   cia402::DriveProxy& p = *ax.proxy;
