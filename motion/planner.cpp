@@ -1191,7 +1191,8 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
   if (a.servo && a.fb.drive != DriveState::Enabled && !a.mds_waiting) servo_off(a);
 }
 
-void Planner::handle_exceptions(AxisRt& a) noexcept {
+// Called once per axis per cycle from update() only: inlined there.
+[[gnu::always_inline]] inline void Planner::handle_exceptions(AxisRt& a) noexcept {
   std::uint32_t active = 0;
   auto bit = [](ExceptionKind k) { return 1u << static_cast<unsigned>(k); };
   if (a.cfg.type == AxisType::CipDrive) {
@@ -1268,7 +1269,8 @@ void Planner::handle_exceptions(AxisRt& a) noexcept {
   a.tag.axis_fault = af;
 }
 
-void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
+// Called once per axis per cycle from update() only: inlined there.
+[[gnu::always_inline]] inline void Planner::step_axis(AxisRt& a, AxisOutput* out) noexcept {
   double sum_p = 0, sum_v = 0, sum_a = 0;
   // the master offset move shifts the position cam's master: it steps first
   // and is not part of the slave's sum
