@@ -402,7 +402,8 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   return true;
 }
 
-void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
+// Called once per drive per cycle from step() only: inlined there.
+[[gnu::always_inline]] inline void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
   state_ = decode_state(fb_.statusword);
   const bool faulted = state_ == State::kFault || state_ == State::kFaultReactionActive;
   if (faulted && !reset_requested_) {
