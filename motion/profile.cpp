@@ -146,18 +146,7 @@ bool kin_valid(const Kin& k) noexcept {
 
 }  // namespace
 
-Kin Profile::sample(double t, int& hint) const noexcept {
-  if (n_ == 0 || (t >= duration_ && finite())) return Kin{origin_ + end_x_, 0.0, 0.0};
-  if (hint < 0 || hint >= n_ || t < seg_[static_cast<std::size_t>(hint)].t0) hint = 0;
-  while (hint + 1 < n_ && t >= seg_[static_cast<std::size_t>(hint + 1)].t0) ++hint;
-  const Segment& s = seg_[static_cast<std::size_t>(hint)];
-  const double dt = std::max(0.0, t - s.t0);
-  Kin k;
-  k.p = origin_ + s.p + s.v * dt + s.a * dt * dt / 2 + s.j * dt * dt * dt / 6;
-  k.v = s.v + s.a * dt + s.j * dt * dt / 2;
-  k.a = s.a + s.j * dt;
-  return k;
-}
+// Profile::sample: inline in profile.hpp (one call per generator per cycle).
 
 double Profile::peak_velocity() const noexcept {
   double m = 0;

@@ -11,6 +11,7 @@
 /// is closed-form and O(1) per call when time advances monotonically.
 /// All functions are noexcept, allocate nothing and are realtime-safe.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -99,5 +100,19 @@ double jerk_from_percent_of_time(double rate, double speed, double percent) noex
 
 /// Number of distance evaluations the bracketing solve may use (bounded cost).
 inline constexpr int kSolveIterations = 64;
+
+// Inline: every generator samples its profile every cycle.
+inline Kin Profile::sample(double t, int& hint) const noexcept {
+  if (n_ == 0 || (t >= duration_ && finite())) return Kin{origin_ + end_x_, 0.0, 0.0};
+  if (hint < 0 || hint >= n_ || t < seg_[static_cast<std::size_t>(hint)].t0) hint = 0;
+  while (hint + 1 < n_ && t >= seg_[static_cast<std::size_t>(hint + 1)].t0) ++hint;
+  const Segment& s = seg_[static_cast<std::size_t>(hint)];
+  const double dt = std::max(0.0, t - s.t0);
+  Kin k;
+  k.p = origin_ + s.p + s.v * dt + s.a * dt * dt / 2 + s.j * dt * dt * dt / 6;
+  k.v = s.v + s.a * dt + s.j * dt * dt / 2;
+  k.a = s.a + s.j * dt;
+  return k;
+}
 
 }  // namespace canmotion::motion
