@@ -245,7 +245,7 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   };
   p.set_target_position(sat32(out.position * ax.conv));
   p.set_target_velocity(sat32(out.velocity * ax.conv));
-  const double t = round_half_away(out.torque);
+  const double t = out.torque == 0.0 ? 0.0 : round_half_away(out.torque);  // CSP and CSV axes: 0
   p.set_target_torque(static_cast<std::int16_t>(t > 32767 ? 32767 : (t < -32768 ? -32768 : t)));
 }
 
