@@ -61,8 +61,8 @@ constexpr double master_follow_step(LockDirection lock, double lock_pos, double 
   return d > 0 ? d : 0.0;
 }
 
-/// Following state of a master-driven MATC (the same fields a master-driven
-/// ProfileGen carries inline).
+/// Following state of a master-driven generator: MATC (CamGen::md) and
+/// MAM/MAJ (ProfileGen::md).
 struct MasterFollow {
   AxisId master = kNoAxis;
   bool use_actual = false;     ///< master reference actual (CIP masters only)

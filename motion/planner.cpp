@@ -238,11 +238,8 @@ void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
     cg->profile = nullptr;
   }
   if (auto* pc = std::get_if<PosCamGen>(&slot)) end_position_cam(a, *pc);  // MAPC (planner_mapc.cpp)
-  if (auto* p = std::get_if<ProfileGen>(&slot); p && p->master_driven) {
-    if (ControlTag* m = owner_tag(p->mdac, p->mdac_gen)) m->set(flag::AC, false);
-  }
-  if (auto* cg = std::get_if<CamGen>(&slot); cg && cg->master_driven) {
-    if (ControlTag* m = owner_tag(cg->md.mdac, cg->md.mdac_gen)) m->set(flag::AC, false);
+  if (const MasterFollow* f = follow_of(slot)) {  // master-driven move/jog/offset move or time cam
+    if (ControlTag* m = owner_tag(f->mdac, f->mdac_gen)) m->set(flag::AC, false);
   }
   if (const GenRef g = gen_ref(slot); g.k) {
     if (s == Slot::MasterOffset) add_master_offset(a, g.k->p);  // shifts the cam's master, not the slave
@@ -335,8 +332,8 @@ Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, b
   const AxisRt& m = axes_[l.master];
   const double mp = l.use_actual ? m.fb_pos : m.cmd.p;
   const double mv = l.use_actual ? m.fb_vel : m.cmd.v;
-  const bool immediate = lock_immediate(g.lock);
-  const bool fwd = lock_forward(g.lock);
+  const bool immediate = lock_immediate(g.md.lock);
+  const bool fwd = lock_forward(g.md.lock);
   const double udot = immediate ? std::max(0.0, fwd ? mv : -mv) : 0.0;
   if (start.v != 0 || start.a != 0) {
     // the slave's present motion, per unit of master travel
@@ -344,15 +341,15 @@ Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, b
     start = Kin{0, start.v / udot, 0};
   }
   g.master_driven = true;
-  g.master = l.master;
-  g.use_actual = l.use_actual;
-  g.locked = immediate;
-  g.following = immediate;  // Move/JogLockStatus set at once for immediate locks
-  g.lock_pos -= m.frame_offset;  // LockPosition is a master position (user frame); mp is drive frame
-  g.prev_mp = mp;
-  g.u = 0;
-  g.mdac = l.ctl;
-  g.mdac_gen = l.gen;
+  g.md.master = l.master;
+  g.md.use_actual = l.use_actual;
+  g.md.locked = immediate;
+  g.md.following = immediate;  // Move/JogLockStatus set at once for immediate locks
+  g.md.lock_pos -= m.frame_offset;  // LockPosition is a master position (user frame); mp is drive frame
+  g.md.prev_mp = mp;
+  g.md.u = 0;
+  g.md.mdac = l.ctl;
+  g.md.mdac_gen = l.gen;
   ok = true;
   return Err::None;
 }
@@ -756,8 +753,8 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
   ProfileGen g;
   g.role = GenRole::Jog;
   if (dy.master_driven) {  // the profile runs over master travel
-    g.lock = dy.lock;
-    g.lock_pos = dy.lock_pos;
+    g.md.lock = dy.lock;
+    g.md.lock_pos = dy.lock_pos;
     bool ok_md = true;
     if (Err e = master_driven_setup(a, 1, g, start, ok_md); e != Err::None) return e;
   }
@@ -784,7 +781,7 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
   promote_pending(a, 1);
   if (g.master_driven) {
     c.set(flag::AC, true);
-    if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
+    if (ControlTag* m = owner_tag(g.md.mdac, g.md.mdac_gen)) m->set(flag::AC, true);
   }
   set_slot(a, Slot::Jog, g);
   if (V > 0) a.last_speed = V;
@@ -861,8 +858,8 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   ProfileGen g;
   g.role = GenRole::Move;
   if (dy.master_driven) {  // the profile runs over master travel
-    g.lock = dy.lock;
-    g.lock_pos = dy.lock_pos;
+    g.md.lock = dy.lock;
+    g.md.lock_pos = dy.lock_pos;
     bool ok_md = true;
     if (Err e = master_driven_setup(a, link, g, start, ok_md); e != Err::None) return e;
   }
@@ -926,7 +923,7 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   promote_pending(a, link);
   if (g.master_driven) {
     c.set(flag::AC, true);
-    if (ControlTag* m = owner_tag(g.mdac, g.mdac_gen)) m->set(flag::AC, true);
+    if (ControlTag* m = owner_tag(g.md.mdac, g.md.mdac_gen)) m->set(flag::AC, true);
   }
   write_calculated_data(r, g, c);  // planner_mccp.cpp
   set_slot(a, slot, g);
@@ -1319,16 +1316,14 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
     bool tracking = false;
     if (g->master_driven) {
       // abscissa = master travel in the lock direction [RM002H p.512]
-      const AxisRt& m = axes_[g->master];
-      const double mp = g->use_actual ? m.fb_pos : m.cmd.p;
-      const double du = master_follow_step(g->lock, g->lock_pos, mp, g->prev_mp, g->locked, g->following);
-      g->u += du;
-      const Kin ku = g->prof.sample(g->u, g->hint);
+      const AxisRt& m = axes_[g->md.master];
+      const double du = g->md.step(g->md.use_actual ? m.fb_pos : m.cmd.p);
+      const Kin ku = g->prof.sample(g->md.u, g->hint);
       const double udot = du / T_;
       g->k = Kin{ku.p, ku.v * udot, ku.a * udot * udot};
       // TrackingMaster: locked, following, and the accel transition to the programmed ratio done
-      tracking = g->locked && g->following && g->speed > 0 && std::fabs(ku.v) >= g->speed * (1 - 1e-9);
-      done = g->role != GenRole::Jog && g->prof.finite() && g->u >= g->prof.duration();
+      tracking = g->md.locked && g->md.following && g->speed > 0 && std::fabs(ku.v) >= g->speed * (1 - 1e-9);
+      done = g->role != GenRole::Jog && g->prof.finite() && g->md.u >= g->prof.duration();
     } else {
       const double t = static_cast<double>(cycle_ - g->t0_cycle) * T_;
       g->k = g->prof.sample(t, g->hint);
@@ -1405,8 +1400,8 @@ void Planner::update_status(AxisRt& a) noexcept {
   const auto* jg = std::get_if<ProfileGen>(&a.gen[static_cast<std::size_t>(Slot::Jog)]);
   setb(MoveStatus, mv && mv->role == GenRole::Move);
   setb(JogStatus, jg && jg->role == GenRole::Jog);
-  setb(MoveLockStatus, mv && mv->role == GenRole::Move && mv->master_driven && mv->locked && mv->following);
-  setb(JogLockStatus, jg && jg->role == GenRole::Jog && jg->master_driven && jg->locked && jg->following);
+  setb(MoveLockStatus, mv && mv->role == GenRole::Move && mv->master_driven && mv->md.locked && mv->md.following);
+  setb(JogLockStatus, jg && jg->role == GenRole::Jog && jg->master_driven && jg->md.locked && jg->md.following);
   static_assert(std::tuple_size_v<decltype(a.mdac)> == 4);
   const bool linked = a.mdac[0].valid() || a.mdac[1].valid() || a.mdac[2].valid() || a.mdac[3].valid();
   setb(CoordinatedMotionStatus, linked);

@@ -136,18 +136,10 @@ struct ProfileGen {
   ControlId owner = kNoControl;
   std::uint32_t owner_gen = 0;
   std::uint8_t post_stop = 0;  ///< stop ramps of MGS: 0 none, 1 disable, 2 shutdown
-  // master driven (MDSC): the profile's abscissa is master travel, not time
+  // master driven (MDSC): the profile's abscissa is master travel md.u, not
+  // time; md as for a master-driven MATC (motion/master_follow.hpp)
   bool master_driven = false;
-  AxisId master = kNoAxis;
-  bool use_actual = false;
-  LockDirection lock = LockDirection::None;
-  double lock_pos = 0.0;
-  bool locked = false;         ///< lock condition met (position locks: master crossed LockPosition)
-  bool following = false;      ///< master moved in the lock direction this cycle (Move/JogLockStatus)
-  double u = 0.0;              ///< master travel counted so far (profile abscissa)
-  double prev_mp = 0.0;        ///< master position last cycle
-  ControlId mdac = kNoControl; ///< the MDAC whose AC bit this motion sets
-  std::uint32_t mdac_gen = 0;
+  MasterFollow md{};
 };
 
 /// One MDAC link of a slave (per motion type).
@@ -265,13 +257,20 @@ inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
 /// The closed set of generator states. Issue 5 adds cam and direct states here.
 using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen, PosCamGen>;
 
+/// The master-driven following state of a generator (master-driven
+/// move/jog/master offset move or time cam), or null. Realtime-safe.
+inline const MasterFollow* follow_of(const Generator& s) noexcept {
+  if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) return &p->md;
+  if (auto* cg = std::get_if<CamGen>(&s); cg && cg->master_driven) return &cg->md;
+  return nullptr;
+}
+
 /// The master a generator follows (gear, master-driven move/jog/time cam,
 /// position cam), or kNoAxis. Realtime-safe.
 inline AxisId master_of(const Generator& s) noexcept {
   if (auto* g = std::get_if<GearGen>(&s)) return g->master;
-  if (auto* p = std::get_if<ProfileGen>(&s); p && p->master_driven) return p->master;
   if (auto* pc = std::get_if<PosCamGen>(&s)) return pc->master;
-  if (auto* cg = std::get_if<CamGen>(&s); cg && cg->master_driven) return cg->md.master;
+  if (const MasterFollow* f = follow_of(s)) return f->master;
   return kNoAxis;
 }
 

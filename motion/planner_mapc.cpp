@@ -99,7 +99,7 @@ void Planner::position_cam_status(const AxisRt& a, std::uint32_t& ms) const noex
   setb(PositionCamPendingStatus, a.pending_pcam.valid());
   const auto* o = std::get_if<ProfileGen>(&a.gen[kOffset]);
   setb(MasterOffsetMoveStatus, o != nullptr);
-  setb(MasterOffsetMoveLockStatus, o && o->master_driven && o->locked && o->following);
+  setb(MasterOffsetMoveLockStatus, o && o->master_driven && o->md.locked && o->md.following);
 }
 
 // -------------------------------------------------------------------- MAPC
