@@ -105,50 +105,6 @@ constexpr void pack_bits(std::span<std::uint8_t> payload, unsigned bit_offset, u
   }
 }
 
-/// Byte-aligned fast path of pack_bits (offset and width multiples of 8).
-constexpr void pack_bytes(std::span<std::uint8_t> payload, unsigned byte_offset, unsigned bytes, std::uint64_t value) noexcept {
-  for (unsigned i = 0; i < bytes && byte_offset + i < payload.size(); ++i)
-    payload[byte_offset + i] = static_cast<std::uint8_t>(value >> (8 * i));
-}
-
-/// Store the low `bytes` (0..8) bytes of `value` little-endian at `p`. The
-/// caller guarantees `p[0..bytes)` is inside the payload (byte-aligned PDO
-/// entries checked once when the mapping is built). Realtime-safe.
-constexpr void store_le(std::uint8_t* p, unsigned bytes, std::uint64_t value) noexcept {
-  switch (bytes) {
-    case 4:
-      p[3] = static_cast<std::uint8_t>(value >> 24);
-      [[fallthrough]];
-    case 3:
-      p[2] = static_cast<std::uint8_t>(value >> 16);
-      [[fallthrough]];
-    case 2:
-      p[1] = static_cast<std::uint8_t>(value >> 8);
-      [[fallthrough]];
-    case 1: p[0] = static_cast<std::uint8_t>(value); return;
-    default:
-      for (unsigned i = 0; i < bytes && i < 8; ++i) p[i] = static_cast<std::uint8_t>(value >> (8 * i));
-      return;
-  }
-}
-
-/// Load `bytes` (0..8) little-endian bytes at `p`, zero-extended; same
-/// precondition as store_le. Realtime-safe.
-[[nodiscard]] constexpr std::uint64_t load_le(const std::uint8_t* p, unsigned bytes) noexcept {
-  switch (bytes) {
-    case 1: return p[0];
-    case 2: return static_cast<std::uint64_t>(p[0]) | (static_cast<std::uint64_t>(p[1]) << 8);
-    case 4:
-      return static_cast<std::uint64_t>(p[0]) | (static_cast<std::uint64_t>(p[1]) << 8) |
-             (static_cast<std::uint64_t>(p[2]) << 16) | (static_cast<std::uint64_t>(p[3]) << 24);
-    default: {
-      std::uint64_t v = 0;
-      for (unsigned i = 0; i < bytes && i < 8; ++i) v |= static_cast<std::uint64_t>(p[i]) << (8 * i);
-      return v;
-    }
-  }
-}
-
 /// Read `bits` little-endian at `bit_offset`, zero-extended. Realtime-safe.
 [[nodiscard]] constexpr std::uint64_t unpack_bits(std::span<const std::uint8_t> payload, unsigned bit_offset,
                                                   unsigned bits) noexcept {
