@@ -2,6 +2,7 @@
 // Seeded randomness for property tests: seed and count come from the
 // environment (CANMOTION_SEED, CANMOTION_PROP_COUNT) and are printed on failure.
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <random>
 #include <string>
@@ -31,5 +32,13 @@ struct Rng {
   bool coin(double p = 0.5) { return uni(0, 1) < p; }
   int pick(int n) { return static_cast<int>(std::uniform_int_distribution<int>(0, n - 1)(g)); }
 };
+
+/// `v` as an ST literal with `precision` significant digits (17: the exact
+/// double; std::to_string keeps 6 decimals only).
+inline std::string num(double v, int precision = 17) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.*g", precision, v);
+  return b;
+}
 
 }  // namespace canmotion::motion::test

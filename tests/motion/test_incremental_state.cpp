@@ -18,16 +18,11 @@
 
 using namespace canmotion::motion;
 using canmotion::motion::test::Rig;
+using canmotion::motion::test::num;
 using canmotion::motion::test::Rng;
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 struct StateRig {
   Rig r;

@@ -17,6 +17,7 @@ using canmotion::motion::test::maj;
 using canmotion::motion::test::prop_count;
 using canmotion::motion::test::prop_seed;
 using canmotion::motion::test::Rig;
+using canmotion::motion::test::num;
 using canmotion::motion::test::Rng;
 
 namespace {
@@ -72,12 +73,6 @@ struct PropRig {
   }
 };
 
-/// Full precision (std::to_string keeps 6 decimals only).
-std::string num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
 
 std::string matc(const std::string& ax, const std::string& c, const std::string& prof, double ds, double ts,
                  const std::string& mode, const std::string& sched, bool md, const std::string& lock,

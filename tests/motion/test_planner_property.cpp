@@ -11,16 +11,11 @@
 #include "rig.hpp"
 
 using namespace canmotion::motion;
+using canmotion::motion::test::num;
 using canmotion::motion::test::Rng;
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
 
 }  // namespace
 
