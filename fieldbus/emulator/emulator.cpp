@@ -69,14 +69,11 @@ void Emulator::add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, c
           value,
           text,
           0,
-          false,
-          0,
           0};
-  e.size = static_cast<std::uint8_t>(canopen::data_type_size(e.type));
-  e.is_signed = canopen::data_type_signed(e.type);
-  const bool full = e.size >= 8 || e.size == 0;
-  e.mask = full ? ~std::uint64_t{0} : (std::uint64_t{1} << (8 * e.size)) - 1;
-  e.sign = e.is_signed && !full ? std::uint64_t{1} << (8 * e.size - 1) : 0;
+  const std::size_t size = canopen::data_type_size(e.type);
+  const bool full = size >= 8 || size == 0;
+  e.mask = full ? ~std::uint64_t{0} : (std::uint64_t{1} << (8 * size)) - 1;
+  e.sign = canopen::data_type_signed(e.type) && !full ? std::uint64_t{1} << (8 * size - 1) : 0;
   od_.push_back(e);
 }
 

@@ -172,10 +172,8 @@ class Emulator final : public canopen::SdoServerBackend {
     std::uint64_t value;      // raw little-endian bits
     std::uint64_t default_value;
     const std::string* text;  // strings (0x1008...)
-    std::uint8_t size;        // data_type_size(type), cached
-    bool is_signed;           // data_type_signed(type), cached
-    std::uint64_t mask;       // the value bits of `size` bytes (put)
-    std::uint64_t sign;       // the sign bit of a signed value shorter than 8 bytes, else 0 (sval)
+    std::uint64_t mask;       // the value bits of the type's size (put; all bits for 0 or 8 bytes)
+    std::uint64_t sign;       // the sign bit of a signed type shorter than 8 bytes, else 0 (sval)
   };
   /// Entries the SYNC / frame path touches, resolved once after the
   /// dictionary is built (od_ never grows or reallocates afterwards, so the
