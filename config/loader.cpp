@@ -340,9 +340,7 @@ class Loader {
             // The object's own type when known (INTEGERn signed, UNSIGNEDn
             // unsigned); otherwise either reading of `size` bytes.
             const int bits = 8 * s.size;
-            const bool is_signed = known_size != 0 && (known->type == canopen::DataType::kInteger8 ||
-                                                       known->type == canopen::DataType::kInteger16 ||
-                                                       known->type == canopen::DataType::kInteger32);
+            const bool is_signed = known_size != 0 && canopen::data_type_signed(known->type);
             const bool is_unsigned = known_size != 0 && !is_signed;
             const std::int64_t lo = is_unsigned ? 0 : -(std::int64_t{1} << (bits - 1));
             const std::int64_t hi = is_signed ? (std::int64_t{1} << (bits - 1)) - 1 : (std::int64_t{1} << bits) - 1;

@@ -1778,7 +1778,7 @@ void Planner::compute_order() noexcept {
       if (m < kMaxAxes && axes_[m].present && m != i) out[n++] = m;
     }
   };
-  // The masters of every axis, once per cycle (the walk below visits an axis
+  // The masters of every axis, once per recomputation (the walk below visits an axis
   // several times). Usually no axis follows another: then the order is the
   // axis order, which is what the walk would give.
   std::array<std::array<AxisId, kSlots>, kMaxAxes> masters;  // [i] set for present axes

@@ -14,10 +14,6 @@ using namespace canmotion::motion;
 using canmotion::motion::test::num;
 using canmotion::motion::test::Rng;
 
-namespace {
-
-
-}  // namespace
 
 TEST(PlannerProperty, RandomSequencesStayContinuousAndWithinLimits) {
   const std::uint64_t seed = canmotion::motion::test::prop_seed() + 10;
