@@ -9,12 +9,15 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string_view>
 
 namespace canmotion::canopen {
 
-/// CiA 301 static data types (the numbers are the spec's data type indices).
+/// CiA 301 static data types (the numbers are the spec's data type indices,
+/// CiA 301 table 44; 0x000E and 0x0017 are reserved). Every basic type is
+/// here: the EDS reader (fieldbus/eds) takes its data types from this enum.
 enum class DataType : std::uint16_t {
   kBoolean = 0x0001,
   kInteger8 = 0x0002,
@@ -32,18 +35,48 @@ enum class DataType : std::uint16_t {
   kDomain = 0x000F,
   kInteger24 = 0x0010,
   kReal64 = 0x0011,
+  kInteger40 = 0x0012,
+  kInteger48 = 0x0013,
+  kInteger56 = 0x0014,
   kInteger64 = 0x0015,
+  kUnsigned24 = 0x0016,
+  kUnsigned40 = 0x0018,
+  kUnsigned48 = 0x0019,
+  kUnsigned56 = 0x001A,
   kUnsigned64 = 0x001B,
 };
+
+/// Every DataType above, in the order of their numbers.
+inline constexpr DataType kAllDataTypes[] = {
+    DataType::kBoolean,    DataType::kInteger8,      DataType::kInteger16,       DataType::kInteger32,
+    DataType::kUnsigned8,  DataType::kUnsigned16,    DataType::kUnsigned32,      DataType::kReal32,
+    DataType::kVisibleString, DataType::kOctetString, DataType::kUnicodeString,  DataType::kTimeOfDay,
+    DataType::kTimeDifference, DataType::kDomain,    DataType::kInteger24,       DataType::kReal64,
+    DataType::kInteger40,  DataType::kInteger48,     DataType::kInteger56,       DataType::kInteger64,
+    DataType::kUnsigned24, DataType::kUnsigned40,    DataType::kUnsigned48,      DataType::kUnsigned56,
+    DataType::kUnsigned64,
+};
+
+/// The DataType with CiA 301 number `code`, or nullopt (reserved, a
+/// complex type such as 0x0020 PDO_COMMUNICATION_PARAMETER, or
+/// manufacturer-specific). Realtime-safe.
+[[nodiscard]] constexpr std::optional<DataType> data_type_of(std::uint16_t code) noexcept {
+  for (DataType t : kAllDataTypes)
+    if (static_cast<std::uint16_t>(t) == code) return t;
+  return std::nullopt;
+}
 
 /// Size in bytes of a fixed-size data type; 0 for strings and domains.
 [[nodiscard]] constexpr std::size_t data_type_size(DataType t) noexcept {
   switch (t) {
     case DataType::kBoolean: case DataType::kInteger8: case DataType::kUnsigned8: return 1;
     case DataType::kInteger16: case DataType::kUnsigned16: return 2;
-    case DataType::kInteger24: return 3;
+    case DataType::kInteger24: case DataType::kUnsigned24: return 3;
     case DataType::kInteger32: case DataType::kUnsigned32: case DataType::kReal32: return 4;
+    case DataType::kInteger40: case DataType::kUnsigned40: return 5;
     case DataType::kTimeOfDay: case DataType::kTimeDifference: return 6;
+    case DataType::kInteger48: case DataType::kUnsigned48: return 6;
+    case DataType::kInteger56: case DataType::kUnsigned56: return 7;
     case DataType::kReal64: case DataType::kInteger64: case DataType::kUnsigned64: return 8;
     default: return 0;
   }
@@ -52,7 +85,8 @@ enum class DataType : std::uint16_t {
 /// True for the signed integer types.
 [[nodiscard]] constexpr bool data_type_signed(DataType t) noexcept {
   return t == DataType::kInteger8 || t == DataType::kInteger16 || t == DataType::kInteger24 ||
-         t == DataType::kInteger32 || t == DataType::kInteger64;
+         t == DataType::kInteger32 || t == DataType::kInteger40 || t == DataType::kInteger48 ||
+         t == DataType::kInteger56 || t == DataType::kInteger64;
 }
 
 [[nodiscard]] constexpr std::string_view data_type_name(DataType t) noexcept {
@@ -73,7 +107,14 @@ enum class DataType : std::uint16_t {
     case DataType::kDomain: return "DOMAIN";
     case DataType::kInteger24: return "INTEGER24";
     case DataType::kReal64: return "REAL64";
+    case DataType::kInteger40: return "INTEGER40";
+    case DataType::kInteger48: return "INTEGER48";
+    case DataType::kInteger56: return "INTEGER56";
     case DataType::kInteger64: return "INTEGER64";
+    case DataType::kUnsigned24: return "UNSIGNED24";
+    case DataType::kUnsigned40: return "UNSIGNED40";
+    case DataType::kUnsigned48: return "UNSIGNED48";
+    case DataType::kUnsigned56: return "UNSIGNED56";
     case DataType::kUnsigned64: return "UNSIGNED64";
   }
   return "?";
