@@ -196,6 +196,17 @@ void Emulator::build_dictionary() {
   rebuild_pdos();
 }
 
+std::vector<Emulator::ObjectDescription> Emulator::dictionary() const {
+  std::vector<ObjectDescription> d;
+  d.reserve(od_.size());
+  for (const Entry& e : od_) {
+    d.push_back(ObjectDescription{static_cast<std::uint16_t>(e.key >> 8), static_cast<std::uint8_t>(e.key & 0xFF), e.type,
+                                  e.access, e.pdo, e.default_value,
+                                  e.text != nullptr ? std::string_view(*e.text) : std::string_view{}});
+  }
+  return d;
+}
+
 void Emulator::resolve_hot() noexcept {
   // Every object below is added unconditionally by build_dictionary(), so
   // none of these is nullptr; val()/sval()/put() still accept nullptr.

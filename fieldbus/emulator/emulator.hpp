@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fieldbus/can/frame.hpp"
@@ -157,6 +158,20 @@ class Emulator final : public canopen::SdoServerBackend {
   [[nodiscard]] const EmulatorConfig& config() const noexcept { return cfg_; }
   /// Read an integer object (testing aid); 0 if absent.
   [[nodiscard]] std::int64_t read_int(std::uint16_t index, std::uint8_t sub = 0) const noexcept;
+
+  /// One entry of the object dictionary the emulator serves.
+  struct ObjectDescription {
+    std::uint16_t index = 0;
+    std::uint8_t sub = 0;
+    canopen::DataType type = canopen::DataType::kUnsigned8;
+    canopen::Access access = canopen::Access::kRo;
+    canopen::PdoMappable pdo = canopen::PdoMappable::kNo;
+    std::uint64_t default_value = 0;  ///< raw bits, as after power-on
+    std::string_view text;            ///< strings (0x1008 ...): the text
+  };
+  /// The whole dictionary, ascending index and sub-index (set-up / tests:
+  /// allocates). tests/eds checks config/examples/cia402-emu.eds against it.
+  [[nodiscard]] std::vector<ObjectDescription> dictionary() const;
 
   // ---- SdoServerBackend -----------------------------------------------------
   canopen::SdoAbort sdo_read(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> out,
