@@ -72,11 +72,13 @@ function(canmotion_benchmark name)
   canmotion_apply_flags(${name})
 endfunction()
 
-# canmotion_fuzz(NAME SOURCES ... LIBS ... [SECONDS n])
+# canmotion_fuzz(NAME SOURCES ... LIBS ... [SECONDS n] [SEEDS dir ...])
 # libFuzzer target (clang only, CANMOTION_FUZZ=ON). Runs as a ctest test
-# (label fuzz) for a bounded time.
+# (label fuzz) for a bounded time. SEEDS: seed corpus folders, read only
+# (libFuzzer writes new inputs to the first folder it is given, which is
+# ${CMAKE_CURRENT_BINARY_DIR}/NAME-corpus).
 function(canmotion_fuzz name)
-  cmake_parse_arguments(ARG "" "SECONDS" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "" "SECONDS" "SOURCES;LIBS;SEEDS" ${ARGN})
   if(NOT CANMOTION_FUZZ)
     return()
   endif()
@@ -87,6 +89,12 @@ function(canmotion_fuzz name)
   target_compile_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
   target_link_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
   target_link_libraries(${name} PRIVATE ${ARG_LIBS})
-  add_test(NAME ${name} COMMAND ${name} -max_total_time=${ARG_SECONDS} -rss_limit_mb=2048 -print_final_stats=1)
+  set(corpus)
+  if(ARG_SEEDS)
+    set(corpus ${CMAKE_CURRENT_BINARY_DIR}/${name}-corpus)
+    file(MAKE_DIRECTORY ${corpus})
+    list(APPEND corpus ${ARG_SEEDS})
+  endif()
+  add_test(NAME ${name} COMMAND ${name} -max_total_time=${ARG_SECONDS} -rss_limit_mb=2048 -print_final_stats=1 ${corpus})
   set_tests_properties(${name} PROPERTIES LABELS fuzz TIMEOUT ${ARG_SECONDS}0)
 endfunction()

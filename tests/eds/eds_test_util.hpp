@@ -1,0 +1,98 @@
+#pragma once
+// Shared by the EDS tests: a valid EDS around a few object sections, the
+// line of a text in it, and the errors of a file that must be refused.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "fieldbus/eds/eds.hpp"
+
+namespace canmotion::eds::test {
+
+/// A valid EDS: [DeviceInfo] (2 RPDOs, 2 TPDOs), [MandatoryObjects] with
+/// 0x1000 (and its section), then `body`; `optional` and `manufacturer`
+/// are the other lists (each given only when not empty).
+inline std::string eds_text(std::string_view body, const std::vector<std::uint16_t>& manufacturer = {},
+                            const std::vector<std::uint16_t>& optional = {}) {
+  std::string s =
+      "[FileInfo]\n"
+      "FileName=test.eds\n"
+      "EDSVersion=4.0\n"
+      "\n"
+      "[DeviceInfo]\n"
+      "VendorName=test\n"
+      "VendorNumber=0x12345678\n"
+      "ProductName=test drive\n"
+      "ProductNumber=0x402\n"
+      "RevisionNumber=0x00020001\n"
+      "BaudRate_500=1\n"
+      "BaudRate_1000=1\n"
+      "Granularity=8\n"
+      "NrOfRXPDO=2\n"
+      "NrOfTXPDO=2\n"
+      "\n"
+      "[MandatoryObjects]\n"
+      "SupportedObjects=1\n"
+      "1=0x1000\n"
+      "\n";
+  const auto list = [&](const char* name, const std::vector<std::uint16_t>& l) {
+    if (l.empty()) return;
+    s += fmt::format("[{}]\nSupportedObjects={}\n", name, l.size());
+    for (std::size_t i = 0; i < l.size(); ++i) s += fmt::format("{}=0x{:04X}\n", i + 1, l[i]);
+    s += "\n";
+  };
+  list("OptionalObjects", optional);
+  list("ManufacturerObjects", manufacturer);
+  s +=
+      "[1000]\n"
+      "ParameterName=Device type\n"
+      "ObjectType=0x7\n"
+      "DataType=0x0007\n"
+      "AccessType=ro\n"
+      "DefaultValue=0x00020192\n"
+      "PDOMapping=0\n"
+      "\n";
+  s += body;
+  return s;
+}
+
+/// 1-based line of the first occurrence of `what` in `text` (a test
+/// failure and 0 when absent); `nth` > 1 for later occurrences.
+inline int line_of(std::string_view text, std::string_view what, int nth = 1) {
+  std::size_t pos = 0;
+  for (int i = 0; i < nth; ++i) {
+    pos = text.find(what, i == 0 ? 0 : pos + 1);
+    if (pos == std::string_view::npos) {
+      ADD_FAILURE() << "'" << what << "' not in the text";
+      return 0;
+    }
+  }
+  int line = 1;
+  for (std::size_t i = 0; i < pos; ++i)
+    if (text[i] == '\n') ++line;
+  return line;
+}
+
+/// The errors of parsing `text` as `file` (a test failure if it parses).
+inline std::vector<Diagnostic> errors_of(const std::string& text, const std::string& file = "bad.eds") {
+  try {
+    (void)parse(text, file);
+  } catch (const ParseError& e) {
+    return e.errors();
+  }
+  ADD_FAILURE() << "the file was accepted:\n" << text;
+  return {};
+}
+
+/// ParseError::what() of `text`: every error as "file:line: message".
+inline std::string error_text(const std::string& text, const std::string& file = "bad.eds") {
+  const auto e = errors_of(text, file);
+  return e.empty() ? std::string() : ParseError(e).what();
+}
+
+}  // namespace canmotion::eds::test
