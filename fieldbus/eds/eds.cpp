@@ -633,7 +633,6 @@ class Builder {
     }
     if (const RawKey* k = m.get("ParameterName")) o.name = k->value;
     if (const RawKey* k = m.get("Denotation")) o.denotation = k->value;
-    if (const RawKey* k = m.get("ObjFlags")) number(m, *k, o.obj_flags, 0xFFFFFFFFu);
     if (const RawKey* k = m.get("ObjectType")) {
       unsigned c = 0;
       if (!number(m, *k, c, 0xFF)) return;
@@ -663,11 +662,17 @@ class Builder {
         error(compact_key->line, fmt::format("[{}] CompactSubObj={}: only an ARRAY has compact sub-indices", m.name,
                                              compact_key->value));
       SubObject v;
-      if (variable(m, o.code, v)) o.subs.push_back(std::move(v));
+      if (variable(m, o.code, v)) {
+        o.obj_flags = v.obj_flags;  // one section: the object's flags are its sub-index 0's
+        o.subs.push_back(std::move(v));
+      }
     } else if (o.compact_sub_obj != 0) {
       compact(o, secs);
     } else {
       subs(o, secs, subnum_key);
+    }
+    if (structured && o.compact_sub_obj == 0) {  // (a compact array's main section was read by variable())
+      if (const RawKey* k = m.get("ObjFlags")) number(m, *k, o.obj_flags, 0xFFFFFFFFu);
     }
     eds_.objects.push_back(std::move(o));
   }
@@ -682,6 +687,7 @@ class Builder {
                         secs.subs.begin()->second->name, o.index, o.compact_sub_obj));
     SubObject proto;
     if (!variable(m, ObjectCode::kVar, proto)) return;
+    o.obj_flags = proto.obj_flags;
     SubObject s0;
     s0.sub = 0;
     s0.name = "Highest sub-index supported";

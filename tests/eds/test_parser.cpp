@@ -235,7 +235,7 @@ TEST(EdsParse, DeviceInfoAndFileInfo) {
 
 TEST(EdsParse, RecordWithSubNumberAndArrayWithCompactSubObj) {
   const std::string body =
-      "[1018]\nParameterName=Identity object\nObjectType=0x9\nSubNumber=3\n\n"
+      "[1018]\nParameterName=Identity object\nObjectType=0x9\nSubNumber=3\nObjFlags=1\n\n"
       "[1018sub0]\nParameterName=Highest sub-index supported\nDataType=0x0005\nAccessType=ro\nDefaultValue=2\n\n"
       "[1018Sub1]\nParameterName=Vendor-ID\nDataType=0x0007\nAccessType=ro\nDefaultValue=0x12345678\n\n"
       "[1018SUB2]\nParameterName=Product code\nDataType=0x0007\nAccessType=ro\nDefaultValue=0x402\n\n"
@@ -249,6 +249,7 @@ TEST(EdsParse, RecordWithSubNumberAndArrayWithCompactSubObj) {
   const eds::Object& id = *e.find(0x1018);
   EXPECT_EQ(id.code, eds::ObjectCode::kRecord);
   EXPECT_EQ(id.sub_number, 3);
+  EXPECT_EQ(id.obj_flags, 1u);
   ASSERT_EQ(id.subs.size(), 3u);
   EXPECT_EQ(id.subs[1].name, "Vendor-ID");
   EXPECT_EQ(id.subs[1].default_value->bits, 0x12345678u);
@@ -289,6 +290,7 @@ TEST(EdsParse, LimitsObjFlagsAndDcfData) {
   EXPECT_EQ(canopen::sign_extend(s.low_limit->bits, 16), -10);
   EXPECT_EQ(s.high_limit->bits, 100u);
   EXPECT_EQ(s.obj_flags, 3u);
+  EXPECT_EQ(e.find(0x2000)->obj_flags, 3u);  // a VAR: the object's flags are its sub-index 0's
   ASSERT_TRUE(s.parameter_value);
   EXPECT_EQ(s.parameter_value->bits, 42u);
   EXPECT_EQ(s.denotation, "Axis X offset");
@@ -426,7 +428,7 @@ TEST(EdsErrors, ValueDoesNotFitItsTypeOrLimits) {
 
 TEST(EdsErrors, SubIndexListedButMissing) {
   const std::string text = eds_text(
-      "[1018]\nParameterName=Identity object\nObjectType=0x9\nSubNumber=3\n\n"
+      "[1018]\nParameterName=Identity object\nObjectType=0x9\nSubNumber=3\nObjFlags=1\n\n"
       "[1018sub0]\nParameterName=n\nDataType=0x0005\nAccessType=ro\nDefaultValue=2\n\n"
       "[1018sub2]\nParameterName=Product code\nDataType=0x0007\nAccessType=ro\n\n",
       {}, {0x1018});
