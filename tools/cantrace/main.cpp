@@ -58,6 +58,7 @@ Options:
                              applied N SYNCs earlier (default 0; 1 for drives that sample
                              their position at SYNC before applying the new target)
          -n, --count N       stop after N frames
+             --check-args    check the options and exit (0 = valid); reads no input
          -h, --help          show this help
 
 Exit status: 0 on success, 1 on errors (bad options, unreadable input, no frames).
@@ -90,6 +91,7 @@ struct Options {
   std::int64_t window_ns = 100'000'000;
   std::uint32_t lag = 0;
   std::uint64_t count = 0;
+  bool check_args = false;
 };
 
 [[noreturn]] void usage_error(const std::string& msg) {
@@ -129,6 +131,8 @@ Options parse_args(int argc, char** argv) {
       o.json = true;
     } else if (a == "--delta") {
       o.delta = true;
+    } else if (a == "--check-args") {
+      o.check_args = true;
     } else if (a == "--csv") {
       o.csv_dir = value();
     } else if (a == "--plot") {
@@ -528,6 +532,11 @@ int App::run() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  App app(parse_args(argc, argv));
+  Options o = parse_args(argc, argv);
+  if (o.check_args) {
+    std::puts("cantrace: arguments OK; nothing was read");
+    return 0;
+  }
+  App app(std::move(o));
   return app.run();
 }

@@ -72,10 +72,16 @@ int main(int argc, char** argv) {
                "do not hold /dev/cpu_dma_latency at 0 (cyclictest holds it by default)");
   app.add_flag("-q,--quiet", quiet, "print only the final summary");
   app.add_option("--histogram", histogram_file, "write the latency histogram (lower_ns upper_ns count per line) to FILE");
+  bool check_args = false;
+  app.add_flag("--check-args", check_args, "parse and check the arguments, then exit (0 = valid) without measuring");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 1;  // can-utils convention: exit 1 on error
+  }
+  if (check_args) {
+    std::printf("rt-latency: arguments OK; nothing was run\n");
+    return 0;
   }
 
   const Nanos period{interval_us * 1000};
