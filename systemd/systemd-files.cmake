@@ -38,8 +38,12 @@ endfunction()
 # directories as they are (/lib/systemd/system on Debian 12); another prefix
 # the same path below it (/usr/local/lib/systemd/system, also searched by systemd).
 function(canmotion_systemd_dir out kind)
-  if(CANMOTION_SYSTEMD_${kind}DIR)  # set by the user: -DCANMOTION_SYSTEMD_UNITDIR=...
-    set(${out} "${CANMOTION_SYSTEMD_${kind}DIR}" PARENT_SCOPE)
+  if(CANMOTION_SYSTEMD_${kind}DIR)  # set by the user: -DCANMOTION_SYSTEMD_UNITDIR=... (relative: below the prefix)
+    set(dir "${CANMOTION_SYSTEMD_${kind}DIR}")
+    if(NOT IS_ABSOLUTE "${dir}")
+      set(dir "${CMAKE_INSTALL_PREFIX}/${dir}")
+    endif()
+    set(${out} "${dir}" PARENT_SCOPE)
   elseif(CMAKE_INSTALL_PREFIX STREQUAL CANMOTION_SYSTEMD_PC_PREFIX)
     set(${out} "${CANMOTION_SYSTEMD_PC_${kind}}" PARENT_SCOPE)
   else()

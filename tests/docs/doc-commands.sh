@@ -105,9 +105,9 @@ tokenize() {
   flush
 }
 
-program_of() {  # program_of WORD: the program's name if WORD runs one of ours
+program_of() {  # program_of WORD: true if WORD runs one of ours; its name in PROG (no subshell: called often)
   local b=${1##*/} p
-  for p in "${programs[@]}"; do [[ $b == "$p" ]] && { echo "$p"; return 0; }; done
+  for p in "${programs[@]}"; do [[ $b == "$p" ]] && { PROG=$p; return 0; }; done
   return 1
 }
 
@@ -159,7 +159,8 @@ run_check() {  # run_check ORIGIN PROG ARGS...: run the program in its check mod
 
 check_command() {  # check_command ORIGIN WORD...: a command as written; synopsis or runnable
   local origin=$1; shift
-  local prog; prog=$(program_of "$1") || return 0
+  program_of "$1" || return 0
+  local prog=$PROG
   shift
   local a
   for a in "$@"; do
@@ -218,7 +219,7 @@ check_markdown() {  # check_markdown FILE: fenced code lines (run) and inline sp
     [[ $line == *' ['* ]] && line=${line//|/ }  # a synopsis: [a | b] are alternatives, not a pipe
     check_line "$rel:$start" "$line"
     if [[ $line == *' ['* ]]; then
-      tokenize "$line"; synopsis_prog=$(program_of "${WORDS[0]:-}") || synopsis_prog=""
+      tokenize "$line"; synopsis_prog=""; program_of "${WORDS[0]:-}" && synopsis_prog=$PROG
     fi
   done <"$file"
   check_spans "$rel" < <(awk '/^[[:space:]]*```/ { f = !f; next } !f { print }' "$file")
@@ -230,10 +231,10 @@ check_spans() {  # check_spans ORIGIN < TEXT: `program --option ...` spans (may 
   while [[ $text =~ \`([^\`]*)\` ]]; do
     span=${BASH_REMATCH[1]}
     text=${text#*"${BASH_REMATCH[0]}"}
+    [[ $span == *-* ]] || continue  # no option named: nothing to check
     tokenize "$span"
-    local prog
-    prog=$(program_of "${WORDS[0]:-}") || continue
-    [[ ${WORDS[0]} == "$prog" || ${WORDS[0]} == */"$prog" ]] || continue
+    program_of "${WORDS[0]:-}" || continue
+    local prog=$PROG
     [[ " ${WORDS[*]:1}" == *' -'* ]] || continue  # no option named: nothing to check
     check_options "$origin (inline)" "$prog" "${WORDS[@]:1}"
   done

@@ -63,9 +63,14 @@ sysusersdir=$(pkg-config --variable=sysusersdir systemd 2>/dev/null || echo /usr
 networkdir=$(pkg-config --variable=systemdutildir systemd 2>/dev/null || echo /usr/lib/systemd)/network
 required+=("$unitdir/canmotiond.service" "$unitdir/cia402-emu@.service" "$unitdir/canmotion-vcan@.service"
            "$sysusersdir/canmotion.conf" "$networkdir/80-vcan0.netdev" "$networkdir/80-vcan0.network")
-# Every example of the source tree (EDS files included) is in the package.
-while IFS= read -r f; do required+=("/usr/share/canmotion/examples/${f##*/}"); done < <(
+# Every example of the source tree (EDS files included, wherever they are kept) is in the package.
+while IFS= read -r f; do required+=("/usr/share/canmotion/examples/${f#"$src"/config/examples/}"); done < <(
   find "$src/config/examples" -type f \( -name '*.yaml' -o -name '*.script' -o -iname '*.eds' \))
+for d in config/eds fieldbus/eds; do
+  [[ -d $src/$d ]] || continue
+  while IFS= read -r f; do required+=("/usr/share/canmotion/examples/${f#"$src/$d"/}"); done < <(
+    find "$src/$d" -type f -iname '*.eds')
+done
 for f in "${required[@]}"; do grep -qxF "$f" "$work/files.txt" || fail "$f missing from the package"; done
 if grep -nE '^/usr/local|/tests?/|fieldbus-demo|vcan-vm|\.a$|/include/|_test$|_bench$' "$work/files.txt"; then
   fail "files that do not belong in the package (above)"
