@@ -54,6 +54,9 @@ struct ControllerSettings {
   int priority = 80;        ///< SCHED_FIFO priority 1..99; 0 = run without real-time scheduling
   int cpu = -1;             ///< CPU to pin the cyclic thread to; -1 = no affinity
   bool lock_memory = true;  ///< mlockall + stack prefault
+  /// PM QoS request held on /dev/cpu_dma_latency while the cycle runs, in
+  /// microseconds (0 = shallowest CPU idle state only); -1 = do not ask.
+  std::int32_t cpu_dma_latency_us = 0;
   Location where;
 };
 

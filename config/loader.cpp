@@ -249,12 +249,14 @@ class Loader {
   ControllerSettings controller(const YAML::Node& n) {
     ControllerSettings c;
     c.where = loc(n);
-    if (!check_map(n, "controller", {"period_ms", "priority", "cpu", "lock_memory"})) return c;
+    if (!check_map(n, "controller", {"period_ms", "priority", "cpu", "lock_memory", "cpu_dma_latency_us"})) return c;
     double ms = c.period_s * 1e3;
     if (scalar(n, "controller", "period_ms", ms, 0.25, 100.0, "ms")) c.period_s = ms / 1e3;
     scalar(n, "controller", "priority", c.priority, 0, 99);
     scalar(n, "controller", "cpu", c.cpu, -1, 1023);
     scalar(n, "controller", "lock_memory", c.lock_memory, false, true);
+    // -1 = leave the CPU idle states alone; the top is the kernel's "no constraint" (rt/pm_qos.hpp).
+    scalar(n, "controller", "cpu_dma_latency_us", c.cpu_dma_latency_us, std::int32_t{-1}, std::int32_t{2'000'000'000}, "us");
     return c;
   }
 

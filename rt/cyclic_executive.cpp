@@ -62,7 +62,18 @@ std::error_code CyclicExecutive::setup_on_this_thread() {
     pthread_setname_np(pthread_self(), name.c_str());
   }
   report_ = apply_rt_settings(config_.rt, config_.syscalls);
+  // The loop owns the PM QoS request from here (report_ is read by other
+  // threads while the loop runs, so the loop closes its own copy).
+  cpu_latency_fd_ = report_.cpu_latency_fd;
+  report_.cpu_latency_fd = -1;
   return report_.hard_error();
+}
+
+void CyclicExecutive::release_cpu_latency() noexcept {
+  if (cpu_latency_fd_ >= 0 && config_.syscalls.release_cpu_latency != nullptr) {
+    config_.syscalls.release_cpu_latency(cpu_latency_fd_);
+  }
+  cpu_latency_fd_ = -1;
 }
 
 void CyclicExecutive::emit_warning() const {
@@ -87,6 +98,9 @@ std::error_code CyclicExecutive::start() {
   try {
     thread_ = std::thread([this, promise = std::move(ready)]() mutable {
       const std::error_code ec = setup_on_this_thread();
+      if (ec) {
+        release_cpu_latency();
+      }
       promise.set_value(ec);
       if (ec) {
         running_.store(false, std::memory_order_release);
@@ -116,6 +130,7 @@ std::error_code CyclicExecutive::run(std::uint64_t max_cycles) {
   }
   running_.store(true, std::memory_order_release);
   if (auto ec = setup_on_this_thread()) {
+    release_cpu_latency();
     running_.store(false, std::memory_order_release);
     return ec;
   }
@@ -186,6 +201,8 @@ void CyclicExecutive::loop(std::uint64_t max_cycles) noexcept {
     }
   }
 
+  // After the last cycle: drop the PM QoS request (the CPUs may sleep deeply again).
+  release_cpu_latency();
   stop_requested_.store(false, std::memory_order_release);
   stop_reason_.store(reason, std::memory_order_release);
   running_.store(false, std::memory_order_release);

@@ -136,7 +136,9 @@ class CyclicExecutive {
   const CycleStatistics& statistics() const noexcept { return stats_; }
   /// Statistics copy with percentiles. Not realtime-safe.
   CycleStats stats() const noexcept { return stats_.snapshot(); }
-  /// Result of the RT set-up of the last start()/run().
+  /// Result of the RT set-up of the last start()/run(). The PM QoS request it
+  /// opened is held by the executive (cpu_latency_fd reads -1) and dropped
+  /// when the loop ends.
   const RtSetupReport& setup_report() const noexcept { return report_; }
   /// The configured period.
   Nanos period() const noexcept { return config_.period; }
@@ -162,6 +164,7 @@ class CyclicExecutive {
 
   std::error_code check_startable() const;
   std::error_code setup_on_this_thread();
+  void release_cpu_latency() noexcept;
   void emit_warning() const;
   void loop(std::uint64_t max_cycles) noexcept;
 
@@ -170,6 +173,7 @@ class CyclicExecutive {
   std::unique_ptr<BodyBase> body_;
   CycleStatistics stats_;
   RtSetupReport report_;
+  int cpu_latency_fd_ = -1;  ///< PM QoS request held while the loop runs (loop thread only)
   std::thread thread_;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};

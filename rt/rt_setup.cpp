@@ -1,5 +1,7 @@
 #include "rt/rt_setup.hpp"
 
+#include "rt/pm_qos.hpp"
+
 #include <alloca.h>
 #include <fmt/format.h>
 #include <sys/mman.h>
@@ -33,7 +35,17 @@ int real_get_rlimit(int resource, rlimit* out) {
   return ::getrlimit(static_cast<__rlimit_resource_t>(resource), out) == 0 ? 0 : errno;
 }
 
+int real_hold_cpu_latency(std::int32_t us) { return open_cpu_latency_request(us); }
+
+void real_release_cpu_latency(int fd) { close_cpu_latency_request(fd); }
+
 std::error_code errc(int e) { return {e, std::generic_category()}; }
+
+/// The device is missing (as opposed to present but refused).
+bool device_missing(const std::error_code& e) {
+  const int v = e.value();
+  return v == ENOENT || v == ENODEV || v == ENXIO || v == ENOSYS;
+}
 
 /// Touch `bytes` of stack below the caller so the pages are mapped (and, after
 /// mlockall(MCL_FUTURE), locked). noinline: the alloca'd area is released on
@@ -102,6 +114,8 @@ RtSyscalls RtSyscalls::real() noexcept {
   s.set_affinity = &real_set_affinity;
   s.get_affinity = &real_get_affinity;
   s.get_rlimit = &real_get_rlimit;
+  s.hold_cpu_latency = &real_hold_cpu_latency;
+  s.release_cpu_latency = &real_release_cpu_latency;
   return s;
 }
 
@@ -111,6 +125,7 @@ std::string_view to_string(RtStep step) noexcept {
     case RtStep::prefault_stack: return "stack prefault";
     case RtStep::scheduler: return "SCHED_FIFO";
     case RtStep::affinity: return "CPU affinity";
+    case RtStep::cpu_latency: return "cpu_dma_latency";
   }
   return "?";
 }
@@ -120,6 +135,11 @@ bool RtStepOutcome::not_permitted() const noexcept {
     return false;
   }
   const int e = error.value();
+  if (step == RtStep::cpu_latency) {
+    // A latency optimisation, not a guarantee: only a value out of range
+    // (EINVAL, a configuration error) stops the engine.
+    return e != EINVAL;
+  }
   if (e == EPERM || e == EACCES) {
     return true;
   }
@@ -162,6 +182,7 @@ std::string RtSetupReport::warning() const {
   const bool sched = outcome(RtStep::scheduler).not_permitted();
   const bool lock = outcome(RtStep::lock_memory).not_permitted();
   const bool aff = outcome(RtStep::affinity).not_permitted();
+  const bool qos = outcome(RtStep::cpu_latency).not_permitted();
   std::string lost;
   std::string grant;
   auto add = [](std::string& s, std::string_view part) {
@@ -184,6 +205,19 @@ std::string RtSetupReport::warning() const {
   if (aff) {
     add(lost, fmt::format("pinning to CPU {} not permitted ({}): the cycle may migrate between CPUs",
                           settings.cpu, outcome(RtStep::affinity).error.message()));
+  }
+  const std::error_code& qos_error = outcome(RtStep::cpu_latency).error;
+  if (qos) {
+    add(lost, fmt::format("{} ({}{}): the CPUs may sleep in deep idle states between cycles, which adds tens "
+                          "to hundreds of microseconds to a wake-up",
+                          device_missing(qos_error)
+                              ? std::string("no PM QoS device /dev/cpu_dma_latency")
+                              : fmt::format("holding /dev/cpu_dma_latency at {} us not permitted",
+                                            settings.cpu_dma_latency_us),
+                          qos_error.message(),
+                          device_missing(qos_error) ? ": a kernel without CPU idle PM QoS, or a container that "
+                                                      "does not pass the device in"
+                                                    : ""));
   }
   if (sched || aff) {
     add(grant, "CAP_SYS_NICE");
@@ -211,12 +245,31 @@ std::string RtSetupReport::warning() const {
   if (lock) {
     conf += "'@canmotion - memlock unlimited' ";
   }
-  return fmt::format(
-      "real-time set-up incomplete, the engine runs WITHOUT real-time guarantees: {}. "
-      "To grant it: run as root, or give the program {} (e.g. setcap "
-      "cap_sys_nice,cap_ipc_lock+ep {}), or under systemd set {}"
-      "(see systemd/canmotiond.service), or add {}to /etc/security/limits.conf and log in again.",
-      lost, caps, self_path(), limits, conf);
+  std::string how;
+  if (sched || lock || aff) {
+    how = fmt::format(
+        "run as root, or give the program {} (e.g. setcap "
+        "cap_sys_nice,cap_ipc_lock+ep {}), or under systemd set {}"
+        "(see systemd/canmotiond.service), or add {}to /etc/security/limits.conf and log in again",
+        caps, self_path(), limits, conf);
+  }
+  if (qos) {
+    if (!how.empty()) {
+      how += "; for /dev/cpu_dma_latency: ";
+    }
+    how += device_missing(qos_error)
+               ? "use a kernel with CPU idle PM QoS, or pass the device into the container (e.g. docker run "
+                 "--device /dev/cpu_dma_latency)"
+               : "run as root, or let the service's group write the device with a udev rule "
+                 "(systemd/60-canmotion-cpu-dma-latency.rules) and, under systemd, keep "
+                 "BindPaths=-/dev/cpu_dma_latency and DeviceAllow=/dev/cpu_dma_latency rw "
+                 "(see systemd/canmotiond.service)";
+    how += " (canmotiond: controller.cpu_dma_latency_us: -1 stops asking)";
+  }
+  return fmt::format("real-time set-up incomplete, {}: {}. To grant it: {}.",
+                     sched || lock || aff ? "the engine runs WITHOUT real-time guarantees"
+                                          : "wake-up latency will be higher",
+                     lost, how);
 }
 
 std::string RtSetupReport::describe() const {
@@ -232,6 +285,8 @@ std::string RtSetupReport::describe() const {
       what += fmt::format(" cpu {}", settings.cpu);
     } else if (s.step == RtStep::prefault_stack) {
       what += fmt::format(" {} KiB", settings.prefault_stack_bytes / 1024);
+    } else if (s.step == RtStep::cpu_latency) {
+      what += fmt::format(" {} us", settings.cpu_dma_latency_us);
     }
     out += fmt::format("{}: {}{}\n", what, s.error ? s.error.message() : "ok",
                        s.not_permitted() ? " (not permitted)" : "");
@@ -259,6 +314,10 @@ std::string RtSetupReport::error_message() const {
       case RtStep::affinity:
         return fmt::format("cannot pin the real-time thread to CPU {}: {} (allowed CPUs: {})", settings.cpu,
                            s.error.message(), allowed_cpus.empty() ? "unknown" : allowed_cpus);
+      case RtStep::cpu_latency:
+        return fmt::format("cpu_dma_latency request of {} us refused: {} (valid: 0 .. {} us, -1 = leave the CPU "
+                           "idle states alone)",
+                           settings.cpu_dma_latency_us, s.error.message(), kMaxCpuLatencyUs);
     }
   }
   return {};
@@ -320,6 +379,21 @@ RtSetupReport apply_rt_settings(const RtSettings& settings, const RtSyscalls& sy
     }
   }
 
+  auto& qos = r.steps[static_cast<std::size_t>(RtStep::cpu_latency)];
+  qos.requested = settings.cpu_dma_latency_us != -1;
+  if (qos.requested) {
+    if (settings.cpu_dma_latency_us < 0 || settings.cpu_dma_latency_us > kMaxCpuLatencyUs) {
+      qos.error = errc(EINVAL);
+    } else {
+      const int fd = sys.hold_cpu_latency ? sys.hold_cpu_latency(settings.cpu_dma_latency_us) : -ENOSYS;
+      if (fd >= 0) {
+        r.cpu_latency_fd = fd;
+      } else {
+        qos.error = errc(-fd);
+      }
+    }
+  }
+
   if (sch.error) {
     r.rlimit_rtprio = soft_limit(sys, RLIMIT_RTPRIO);
   }
@@ -327,6 +401,13 @@ RtSetupReport apply_rt_settings(const RtSettings& settings, const RtSyscalls& sy
     r.rlimit_memlock = soft_limit(sys, RLIMIT_MEMLOCK);
   }
   return r;
+}
+
+void release_rt_settings(RtSetupReport& report, const RtSyscalls& sys) noexcept {
+  if (report.cpu_latency_fd >= 0 && sys.release_cpu_latency != nullptr) {
+    sys.release_cpu_latency(report.cpu_latency_fd);
+  }
+  report.cpu_latency_fd = -1;
 }
 
 }  // namespace canmotion::rt

@@ -92,6 +92,27 @@ TEST(Config, TypesAndRangesNameTheKey) {
   EXPECT_NE(e.find("axes[0].max_speed: must be a real number in units/s, got 'fast'"), std::string::npos) << e;
 }
 
+// controller.cpu_dma_latency_us: the PM QoS request (rt/pm_qos.hpp); 0 by
+// default, -1 = do not ask, range checked with file:line:key.
+TEST(Config, CpuDmaLatencyDefaultRangeAndPosition) {
+  EXPECT_EQ(load_string(kGood, "good.yaml").controller.cpu_dma_latency_us, 0);
+  std::string y = kGood;
+  y.replace(y.find("  cpu: 1\n"), 9, "  cpu: 1\n  cpu_dma_latency_us: -1\n");
+  EXPECT_EQ(load_string(y, "off.yaml").controller.cpu_dma_latency_us, -1);
+  y = kGood;
+  y.replace(y.find("  cpu: 1\n"), 9, "  cpu: 1\n  cpu_dma_latency_us: 20\n");
+  EXPECT_EQ(load_string(y, "twenty.yaml").controller.cpu_dma_latency_us, 20);
+  for (const char* bad : {"-2", "3000000000", "fast", "1.5"}) {
+    y = kGood;
+    y.replace(y.find("  cpu: 1\n"), 9, std::string("  cpu: 1\n  cpu_dma_latency_us: ") + bad + "\n");
+    const std::string e = errors_of(y);
+    EXPECT_NE(e.find("test.yaml:5:23: error: controller.cpu_dma_latency_us: must be"), std::string::npos) << e;
+  }
+  y = kGood;
+  y.replace(y.find("  cpu: 1\n"), 9, "  cpu: 1\n  cpu_dma_latency: 0\n");
+  EXPECT_NE(errors_of(y).find("cpu_dma_latency_us"), std::string::npos) << "the nearest key is suggested";
+}
+
 // sdo_writes of objects in the one object table (canopen::known_objects())
 // take their size from it; a different size, a read-only object or a value
 // that does not fit the size is refused, naming the entry.

@@ -25,6 +25,14 @@ if [[ $(id -u) -eq 0 ]] && command -v setpriv >/dev/null; then
   grep -q 'CAP_SYS_NICE' "$err" || fail "the warning does not say how to grant SCHED_FIFO: $(cat "$err")"
   grep -q 'LimitRTPRIO=80' "$err" || fail "the warning does not name LimitRTPRIO: $(cat "$err")"
   echo "unprivileged warning: $(cat "$err")"
+  # With the PM QoS request (root's /dev/cpu_dma_latency is 0600): still ONE warning, naming it.
+  if [[ -e /dev/cpu_dma_latency ]]; then
+    out=$(setpriv --reuid=nobody --regid=nogroup --clear-groups -- "$bin" -i 500 -l 50 -p 80 -q 2>"$err") \
+      || fail "unprivileged run with the PM QoS request failed: $(cat "$err")"
+    n=$(grep -c 'warning' "$err" || true)
+    [[ $n -eq 1 ]] || fail "expected exactly one warning with cpu_dma_latency refused, got $n: $(cat "$err")"
+    grep -q '/dev/cpu_dma_latency' "$err" || fail "the warning does not name /dev/cpu_dma_latency: $(cat "$err")"
+  fi
 else
   echo "not root: unprivileged part skipped"
 fi

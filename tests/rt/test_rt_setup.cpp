@@ -15,6 +15,7 @@
 
 #include "rt/clock.hpp"
 #include "rt/cyclic_executive.hpp"
+#include "rt/pm_qos.hpp"
 #include "rt/rt_setup.hpp"
 
 using namespace canmotion::rt;
@@ -34,12 +35,23 @@ struct Script {
   static inline int mlock_order = 0;
   static inline int fifo_order = 0;
   static inline int affinity_order = 0;
+  // PM QoS: the "device" is held while qos_fd is open.
+  static inline int qos_err = 0;
+  static inline int qos_calls = 0;
+  static inline int qos_order = 0;
+  static inline std::int32_t last_qos_us = -100;
+  static inline bool qos_open = false;
+  static inline int qos_closed = 0;
+  static constexpr int kQosFd = 42;
 
   static void reset() {
     mlock_err = fifo_err = affinity_err = 0;
     mlock_calls = fifo_calls = 0;
     last_priority = last_cpu = -1;
     order = mlock_order = fifo_order = affinity_order = 0;
+    qos_err = qos_calls = qos_order = qos_closed = 0;
+    last_qos_us = -100;
+    qos_open = false;
   }
   static RtSyscalls syscalls() {
     RtSyscalls s;
@@ -76,6 +88,20 @@ struct Script {
       out->rlim_max = out->rlim_cur;
       return 0;
     };
+    s.hold_cpu_latency = [](std::int32_t us) {
+      ++qos_calls;
+      qos_order = ++order;
+      last_qos_us = us;
+      if (qos_err != 0) return -qos_err;
+      qos_open = true;
+      return kQosFd;
+    };
+    s.release_cpu_latency = [](int fd) {
+      EXPECT_EQ(fd, kQosFd);
+      EXPECT_TRUE(qos_open) << "closed twice";
+      qos_open = false;
+      ++qos_closed;
+    };
     return s;
   }
 };
@@ -102,10 +128,22 @@ TEST(RtSetup, AllStepsSucceedInOrder) {
   EXPECT_EQ(Script::last_cpu, 1);
   EXPECT_LT(Script::mlock_order, Script::fifo_order);
   EXPECT_LT(Script::fifo_order, Script::affinity_order);
+  EXPECT_LT(Script::affinity_order, Script::qos_order);
   for (const auto& s : r.steps) {
     EXPECT_TRUE(s.done()) << to_string(s.step);
   }
   EXPECT_NE(r.describe().find("SCHED_FIFO 80: ok"), std::string::npos) << r.describe();
+  EXPECT_NE(r.describe().find("cpu_dma_latency 0 us: ok"), std::string::npos) << r.describe();
+  // The PM QoS request stays open until released.
+  EXPECT_EQ(Script::last_qos_us, 0);
+  EXPECT_EQ(r.cpu_latency_fd, Script::kQosFd);
+  EXPECT_TRUE(Script::qos_open);
+  auto copy = r;
+  release_rt_settings(copy, Script::syscalls());
+  EXPECT_FALSE(Script::qos_open);
+  EXPECT_EQ(copy.cpu_latency_fd, -1);
+  release_rt_settings(copy, Script::syscalls());  // twice: nothing more
+  EXPECT_EQ(Script::qos_closed, 1);
 }
 
 TEST(RtSetup, NothingRequestedMakesNoCalls) {
@@ -113,6 +151,8 @@ TEST(RtSetup, NothingRequestedMakesNoCalls) {
   const auto r = apply_rt_settings(RtSettings::none(), Script::syscalls());
   EXPECT_EQ(Script::mlock_calls, 0);
   EXPECT_EQ(Script::fifo_calls, 0);
+  EXPECT_EQ(Script::qos_calls, 0) << "RtSettings::none() leaves /dev/cpu_dma_latency alone";
+  EXPECT_EQ(r.cpu_latency_fd, -1);
   EXPECT_TRUE(r.realtime());
   EXPECT_TRUE(r.describe().empty());
 }
@@ -199,6 +239,139 @@ TEST(RtSetup, InvalidSettingsAreHardErrorsWithoutSyscalls) {
   EXPECT_EQ(r.outcome(RtStep::affinity).error, std::errc::invalid_argument);
 }
 
+// PM QoS (/dev/cpu_dma_latency): a missing device or a refusal degrades with
+// the one warning, which says what it costs and how to get it.
+TEST(RtSetup, CpuLatencyUnavailableDegradesWithOneExplainingWarning) {
+  for (int e : {ENOENT, ENODEV, EACCES, EPERM, EROFS}) {
+    Script::reset();
+    Script::qos_err = e;
+    const auto r = apply_rt_settings(full(80, -1), Script::syscalls());
+    EXPECT_TRUE(r.outcome(RtStep::cpu_latency).not_permitted()) << e;
+    EXPECT_EQ(r.outcome(RtStep::cpu_latency).error.value(), e);
+    EXPECT_TRUE(r.degraded()) << e;
+    EXPECT_FALSE(r.realtime()) << e;
+    EXPECT_FALSE(r.hard_error()) << "the engine runs without it: " << e;
+    EXPECT_EQ(r.cpu_latency_fd, -1);
+    EXPECT_TRUE(r.outcome(RtStep::scheduler).done()) << "the other steps still ran";
+    const std::string w = r.warning();
+    EXPECT_NE(w.find("/dev/cpu_dma_latency"), std::string::npos) << w;
+    EXPECT_NE(w.find("deep idle states"), std::string::npos) << w;
+    EXPECT_NE(w.find("controller.cpu_dma_latency_us: -1"), std::string::npos) << w;
+    // Only the PM QoS request failed: the cycle still has its real-time priority.
+    EXPECT_EQ(w.find("WITHOUT real-time guarantees"), std::string::npos) << w;
+    EXPECT_EQ(w.find("CAP_SYS_NICE"), std::string::npos) << w;
+    EXPECT_EQ(w.find('\n'), std::string::npos) << "one message, one line";
+    if (e == ENOENT || e == ENODEV) {
+      EXPECT_NE(w.find("no PM QoS device"), std::string::npos) << w;
+      EXPECT_NE(w.find("--device /dev/cpu_dma_latency"), std::string::npos) << w;
+    } else {
+      EXPECT_NE(w.find("holding /dev/cpu_dma_latency at 0 us not permitted"), std::string::npos) << w;
+      EXPECT_NE(w.find("60-canmotion-cpu-dma-latency.rules"), std::string::npos) << w;
+      EXPECT_NE(w.find("DeviceAllow=/dev/cpu_dma_latency rw"), std::string::npos) << w;
+    }
+    EXPECT_NE(r.describe().find("cpu_dma_latency 0 us: "), std::string::npos) << r.describe();
+  }
+}
+
+TEST(RtSetup, CpuLatencyJoinsTheOtherRefusalsInTheOneWarning) {
+  Script::reset();
+  Script::fifo_err = EPERM;
+  Script::qos_err = EACCES;
+  const auto r = apply_rt_settings(full(80, -1), Script::syscalls());
+  const std::string w = r.warning();
+  EXPECT_NE(w.find("WITHOUT real-time guarantees"), std::string::npos) << w;
+  EXPECT_NE(w.find("SCHED_FIFO priority 80 not permitted"), std::string::npos) << w;
+  EXPECT_NE(w.find("holding /dev/cpu_dma_latency at 0 us not permitted"), std::string::npos) << w;
+  EXPECT_NE(w.find("LimitRTPRIO=80"), std::string::npos) << w;
+  EXPECT_NE(w.find("for /dev/cpu_dma_latency:"), std::string::npos) << w;
+  EXPECT_EQ(w.find('\n'), std::string::npos) << w;
+}
+
+TEST(RtSetup, CpuLatencyValueIsCheckedAndMinusOneMeansLeaveIt) {
+  Script::reset();
+  auto s = full(80, -1);
+  s.cpu_dma_latency_us = 75;
+  auto r = apply_rt_settings(s, Script::syscalls());
+  EXPECT_EQ(Script::last_qos_us, 75);
+  EXPECT_NE(r.describe().find("cpu_dma_latency 75 us: ok"), std::string::npos) << r.describe();
+  release_rt_settings(r, Script::syscalls());
+
+  Script::reset();
+  s.cpu_dma_latency_us = -1;
+  r = apply_rt_settings(s, Script::syscalls());
+  EXPECT_EQ(Script::qos_calls, 0);
+  EXPECT_FALSE(r.outcome(RtStep::cpu_latency).requested);
+  EXPECT_TRUE(r.realtime());
+
+  for (std::int32_t bad : {-2, -1000}) {
+    Script::reset();
+    s.cpu_dma_latency_us = bad;
+    r = apply_rt_settings(s, Script::syscalls());
+    EXPECT_EQ(Script::qos_calls, 0) << bad;
+    EXPECT_EQ(r.hard_error(), std::errc::invalid_argument) << "a configuration error: " << bad;
+    EXPECT_NE(r.error_message().find("valid: 0 .. 2000000000 us, -1 = leave"), std::string::npos)
+        << r.error_message();
+  }
+}
+
+// The executive holds the request exactly while its loop runs.
+TEST(RtSetup, ExecutiveHoldsCpuLatencyWhileTheLoopRuns) {
+  Script::reset();
+  VirtualClock clock;
+  ExecutiveConfig cfg;
+  cfg.rt = full(80, -1);
+  cfg.syscalls = Script::syscalls();
+  int warnings = 0;
+  cfg.warn = [&](std::string_view) { ++warnings; };
+  CyclicExecutive exec(cfg, clock);
+  int held_cycles = 0;
+  exec.set_cycle([&held_cycles](const CycleInfo&) noexcept { held_cycles += Script::qos_open ? 1 : 0; });
+  ASSERT_FALSE(exec.run(7));
+  EXPECT_EQ(held_cycles, 7);
+  EXPECT_FALSE(Script::qos_open) << "released when the loop ended";
+  EXPECT_EQ(Script::qos_closed, 1);
+  EXPECT_EQ(warnings, 0);
+  EXPECT_TRUE(exec.setup_report().outcome(RtStep::cpu_latency).done());
+
+  // On a thread, and when a hard error stops the start: released at once.
+  Script::reset();
+  Script::affinity_err = EINVAL;
+  cfg.rt = full(80, 3);
+  cfg.syscalls = Script::syscalls();
+  CyclicExecutive refused(cfg, clock);
+  refused.set_cycle([](const CycleInfo&) noexcept {});
+  EXPECT_EQ(refused.start(), std::errc::invalid_argument);
+  EXPECT_EQ(Script::qos_calls, 1);
+  EXPECT_FALSE(Script::qos_open);
+}
+
+#if !defined(__SANITIZE_THREAD__) && !defined(__SANITIZE_ADDRESS__)
+// The real device, when this process may open it (root): the kernel's
+// aggregate constraint reads our value while the loop runs and goes back
+// afterwards. Skipped without the device, or when another process (say a
+// cyclictest) already holds a constraint at or below ours.
+TEST(RtSetup, RealCpuDmaLatencyIsHeldAndReleased) {
+  const auto before = read_cpu_latency();
+  if (!before) GTEST_SKIP() << "cannot read " << kCpuDmaLatencyPath << " (not root, or no device)";
+  constexpr std::int32_t kOurs = 1234;
+  if (*before <= kOurs) GTEST_SKIP() << "another process holds " << *before << " us";
+  RtSettings s = RtSettings::none();
+  s.cpu_dma_latency_us = kOurs;
+  VirtualClock clock;
+  ExecutiveConfig cfg;
+  cfg.rt = s;
+  CyclicExecutive exec(cfg, clock);
+  std::int32_t during = -1;
+  exec.set_cycle([&during](const CycleInfo&) noexcept { during = read_cpu_latency().value_or(-1); });
+  ASSERT_FALSE(exec.run(1));
+  ASSERT_TRUE(exec.setup_report().outcome(RtStep::cpu_latency).done()) << exec.setup_report().describe();
+  EXPECT_EQ(during, kOurs);
+  const auto after = read_cpu_latency();
+  ASSERT_TRUE(after);
+  EXPECT_GT(*after, kOurs) << "closing the file dropped the request";
+}
+#endif
+
 // The executive runs anyway when a step is not permitted, and says so ONCE.
 TEST(RtSetup, ExecutiveRunsDegradedWithExactlyOneWarning) {
   Script::reset();
@@ -269,6 +442,7 @@ TEST(RtSetup, RealSyscallsOnAThread) {
     sched_getparam(0, &param);
   });
   t.join();
+  release_rt_settings(r);
   EXPECT_FALSE(r.hard_error()) << r.describe();
   if (r.outcome(RtStep::scheduler).done()) {
     EXPECT_EQ(policy, SCHED_FIFO);
@@ -319,6 +493,11 @@ TEST(RtSetup, UnprivilegedProcessRunsDegradedWithOneWarning) {
     if (!r.outcome(RtStep::lock_memory).not_permitted()) _exit(23);
     if (text.find("LimitMEMLOCK") == std::string::npos) _exit(26);
 #endif
+    // /dev/cpu_dma_latency is root's (0600): refused, and part of the one warning.
+    if (access(kCpuDmaLatencyPath, F_OK) == 0) {
+      if (!r.outcome(RtStep::cpu_latency).not_permitted()) _exit(27);
+      if (text.find("/dev/cpu_dma_latency") == std::string::npos) _exit(28);
+    }
     if (warnings != 1) _exit(24);
     if (text.find("CAP_SYS_NICE") == std::string::npos) _exit(25);
     _exit(0);

@@ -323,7 +323,7 @@ int run(const Options& o) {
   ec.period = period;
   ec.rt = sim ? rt::RtSettings::none()
               : rt::RtSettings{cfg.controller.lock_memory, cfg.controller.lock_memory ? 256u * 1024u : 0u,
-                               cfg.controller.priority, cfg.controller.cpu};
+                               cfg.controller.priority, cfg.controller.cpu, cfg.controller.cpu_dma_latency_us};
   ec.warn = [](std::string_view w) { fmt::print(stderr, "canmotiond: WARNING: {}\n", w); };
   rt::VirtualClock vclock;
   rt::MonotonicClock mclock;

@@ -4,9 +4,6 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -92,24 +89,15 @@ int main(int argc, char** argv) {
     }
   }
 
-  // Like cyclictest: keep CPUs out of deep idle states while we measure, by
-  // holding /dev/cpu_dma_latency open with 0 us (PM QoS). Best effort.
-  int dma_fd = -1;
-  if (!no_dma_latency) {
-    dma_fd = ::open("/dev/cpu_dma_latency", O_RDWR | O_CLOEXEC);
-    const std::int32_t zero = 0;
-    if (dma_fd >= 0 && ::write(dma_fd, &zero, sizeof(zero)) != sizeof(zero)) {
-      ::close(dma_fd);
-      dma_fd = -1;
-    }
-  }
-
   MonotonicClock clock;
   ExecutiveConfig cfg;
   cfg.period = period;
   cfg.rt.lock_memory = !no_mlock;
   cfg.rt.priority = priority;
   cfg.rt.cpu = cpu;
+  // Like cyclictest: keep the CPUs out of deep idle states while we measure
+  // (PM QoS, /dev/cpu_dma_latency held at 0 us; one of the RT set-up steps).
+  cfg.rt.cpu_dma_latency_us = no_dma_latency ? -1 : 0;
   cfg.thread_name = "rt-latency";
   cfg.warn = [](std::string_view w) { fmt::print(stderr, "rt-latency: warning: {}\n", w); };
   CyclicExecutive exec(cfg, clock);
@@ -136,7 +124,7 @@ int main(int argc, char** argv) {
   if (!quiet) {
     fmt::print("# period {} us, priority {}, cpu {}, {} cycles, cost {} us, mlockall {}, cpu_dma_latency {}\n",
                interval_us, priority, cpu, loops, cost_us, no_mlock ? "off" : "on",
-               dma_fd >= 0 ? "0 us" : "not set");
+               exec.setup_report().outcome(RtStep::cpu_latency).done() ? "0 us" : "not set");
     std::string setup = exec.setup_report().describe();
     for (std::size_t pos = 0; (pos = setup.find('\n', pos)) != std::string::npos && pos + 1 < setup.size();) {
       setup.replace(pos, 1, "\n# ");
@@ -181,9 +169,6 @@ int main(int argc, char** argv) {
         out << Histogram::bucket_lower(i) << ' ' << Histogram::bucket_upper(i) << ' ' << n << '\n';
       }
     }
-  }
-  if (dma_fd >= 0) {
-    ::close(dma_fd);
   }
   return 0;
 }
