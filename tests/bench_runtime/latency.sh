@@ -2,25 +2,108 @@
 # latency.sh [CANMOTIOND] [LOOPS] [REPEATS]
 # Wake-up latency of the canmotiond cycle (1 ms, 16 AXIS_CIP_DRIVE axes on 8
 # `interface: sim` buses, SCHED_FIFO 80, drives enabled and jogging: see
-# gen-config.sh) against cyclictest -m -p 80 -i 1000 -l LOOPS -q, one after
-# the other (tools/rt-latency/compare-cyclictest.sh -m sequential -x), REPEATS
-# times. canmotiond's percentiles come from its --stats summary
-# (rt::format_summary). Run as root (or with CAP_SYS_NICE + CAP_IPC_LOCK).
+# gen-config.sh) against cyclictest -m -p 80 -i 1000 -l LOOPS -q
+# (tools/rt-latency/compare-cyclictest.sh -x), REPEATS times in each of
+# four cases:
+#   idle-seq   no load added; one after the other (the acceptance case:
+#              cyclictest and canmotiond alternate which runs first)
+#   idle-par   no load added; side by side
+#   load-seq   under LATENCY_LOAD; one after the other
+#   load-par   under LATENCY_LOAD; side by side
+# canmotiond's percentiles come from its --stats summary (rt::format_summary).
+# "idle" means only that this script adds no load: the 1-minute load average
+# is recorded before and after every run and the summary says how idle the
+# machine was. Side by side, cyclictest's PM QoS request (/dev/cpu_dma_latency
+# = 0, system-wide) also serves canmotiond, so only the sequential cases show
+# what canmotiond gets by itself.
+#
+# Environment:
+#   LATENCY_CASES  which cases, default "idle-seq idle-par load-seq load-par"
+#   LATENCY_LOAD   the load command, run in the background for the load-*
+#                  cases and killed after each run; default: hackbench
+#                  (rt-tests) with 2 groups of 4 sender/receiver pairs,
+#                  scheduler and IPC stress
+#   LATENCY_DMA    controller.cpu_dma_latency_us written to the configuration
+#                  (default: not written, i.e. the daemon's default 0; -1 =
+#                  do not hold the PM QoS request, to see what it is worth;
+#                  leave unset for builds that predate the key)
+#   LATENCY_OUT    folder for the raw outputs (default: a temporary folder)
+# Run as root (or with CAP_SYS_NICE + CAP_IPC_LOCK and write access to
+# /dev/cpu_dma_latency). Prints one line per run and a summary with the
+# median ratios per case.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)"
 repo="$(cd "$here/../.." && pwd -P)"
-daemon="${1:-$repo/build-verify/tools/canmotiond/canmotiond}"
+daemon="${1:-$repo/build/tools/canmotiond/canmotiond}"
 loops="${2:-30000}" repeats="${3:-3}"
+cases="${LATENCY_CASES:-idle-seq idle-par load-seq load-par}"
+load_cmd="${LATENCY_LOAD:-hackbench -g 2 -f 4 -l 1000000000}"
 [[ -x "$daemon" ]] || { echo "latency: canmotiond not found: $daemon" >&2; exit 1; }
 out="${LATENCY_OUT:-$(mktemp -d)}"
 mkdir -p "$out"
 "$here/gen-config.sh" 16 1 8 "$out/bench16"
+if [[ -n ${LATENCY_DMA:-} ]]; then
+  sed -i "s/^  cpu: -1$/  cpu: -1\n  cpu_dma_latency_us: $LATENCY_DMA/" "$out/bench16.yaml"
+fi
 # --duration in controller seconds; the controlled stop adds a few cycles.
 secs=$(awk -v l="$loops" 'BEGIN { printf "%.3f", l / 1000 }')
-for ((r = 1; r <= repeats; r++)); do
-  echo "## run $r of $repeats, load $(cut -d' ' -f1-3 /proc/loadavg)"
-  "$repo/tools/rt-latency/compare-cyclictest.sh" -m sequential -i 1000 -p 80 -l "$loops" -o "$out/run$r" \
-    -x "$daemon --config $out/bench16.yaml --script $out/bench16.script --duration $secs --stats --quiet"
-  grep -E '^(summary: wake-up|cycles |exec )' "$out/run$r/rt-latency.txt" || true
+cmd="$daemon --config $out/bench16.yaml --script $out/bench16.script --duration $secs --stats --quiet"
+
+load_pid=""
+stop_load() {
+  if [[ -n $load_pid ]]; then
+    kill -- -"$load_pid" 2>/dev/null || kill "$load_pid" 2>/dev/null || true
+    wait "$load_pid" 2>/dev/null || true
+    load_pid=""
+  fi
+}
+trap stop_load EXIT
+
+echo "# $(date -u +%FT%TZ) $(uname -r), $(nproc) CPUs, load $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "# daemon: $cmd"
+echo "# cases: $cases; $repeats runs each of $loops cycles; load command: $load_cmd"
+[[ -n ${LATENCY_DMA:-} ]] && echo "# controller.cpu_dma_latency_us: $LATENCY_DMA"
+: >"$out/results.txt"
+for c in $cases; do
+  case $c in
+    idle-seq | load-seq) mode=sequential ;;
+    idle-par | load-par) mode=parallel ;;
+    *) echo "latency: unknown case $c" >&2; exit 1 ;;
+  esac
+  for ((r = 1; r <= repeats; r++)); do
+    if [[ $c == load-* ]]; then
+      set -m
+      $load_cmd >/dev/null 2>&1 &
+      load_pid=$!
+      set +m
+      sleep 2  # let the load build up
+    fi
+    rev=()
+    # One after the other: alternate which program runs first.
+    [[ $mode == sequential && $((r % 2)) == 0 ]] && rev=(-r)
+    "$repo/tools/rt-latency/compare-cyclictest.sh" -m "$mode" "${rev[@]}" -i 1000 -p 80 -l "$loops" \
+      -o "$out/$c-run$r" -x "$cmd" >"$out/$c-run$r.txt" 2>&1 || { cat "$out/$c-run$r.txt" >&2; exit 1; }
+    stop_load
+    res=$(grep '^RESULT ' "$out/$c-run$r.txt")
+    echo "case=$c run=$r ${res#RESULT }" | tee -a "$out/results.txt"
+    grep -E '^(exec |canmotiond: real-time set-up)' "$out/$c-run$r/rt-latency.txt" | sed 's/^/#   /' || true
+  done
 done
-echo "# outputs kept in $out"
+
+echo
+echo "# summary: medians over the runs of each case (ratio = canmotiond / cyclictest; load = 1-minute load average)"
+printf '%-9s %5s %16s %16s %16s %9s %9s %13s\n' case runs "ct p50/p99 us" "cm p50/p99 us" "p99.9 ct/cm" "p50 ratio" "p99 ratio" "load min-max"
+for c in $cases; do
+  awk -v c="$c" '
+    function med(a, n,   i, j, t) { for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
+                                    return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
+    { for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] } }
+    v["case"] != c { next }
+    { n++; cp50[n] = v["ct_p50"]; cp99[n] = v["ct_p99"]; mp50[n] = v["rl_p50"]; mp99[n] = v["rl_p99"]
+      cp999[n] = v["ct_p999"]; mp999[n] = v["rl_p999"]; r50[n] = v["ratio_p50"]; r99[n] = v["ratio_p99"]
+      for (k in v) if (k ~ /^load_/) { if (lo == "" || v[k] < lo) lo = v[k]; if (hi == "" || v[k] > hi) hi = v[k] } }
+    END { if (!n) exit
+          printf "%-9s %5d %16s %16s %16s %9.2f %9.2f %13s\n", c, n, med(cp50, n) "/" med(cp99, n), med(mp50, n) "/" med(mp99, n),
+                 med(cp999, n) "/" med(mp999, n), med(r50, n), med(r99, n), lo "-" hi }' "$out/results.txt"
+done
+echo "# raw outputs kept in $out"

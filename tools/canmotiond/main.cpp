@@ -432,6 +432,11 @@ int run(const Options& o) {
       fmt::print(stderr, "canmotiond: cannot start the cyclic thread: {}\n", exec.setup_report().error_message());
       return 1;
     }
+    if (o.stats) {  // what the RT set-up got (mlockall, SCHED_FIFO, cpu_dma_latency, ...), one line
+      std::string steps = exec.setup_report().describe();
+      for (std::size_t p; (p = steps.find('\n')) != std::string::npos;) steps.replace(p, 1, p + 1 < steps.size() ? "; " : "");
+      fmt::print("canmotiond: real-time set-up: {}\n", steps);
+    }
     rt::SdNotifier::ready();
     std::unique_ptr<rt::WatchdogThread> wd;
     if (auto iv = rt::SdNotifier::watchdog_interval()) {

@@ -19,6 +19,8 @@ Options:
   -p PRIO        SCHED_FIFO priority (default 80)
   -l LOOPS       cycles per program (default 20000)
   -m MODE        parallel (both at once, same load; default) or sequential
+                 (one after the other: cyclictest first)
+  -r             sequential: run the measured program first, then cyclictest
   -b PATH        rt-latency binary (default: build*/tools/rt-latency/rt-latency)
   -x 'COMMAND'   measure COMMAND instead of rt-latency: any program that prints
                  canmotion's statistics summary (rt::format_summary), e.g.
@@ -32,13 +34,22 @@ Example:
 
 cyclictest reports whole microseconds (truncated); rt-latency reports the
 upper edge of its log-linear bucket (at most 1/64 above the exact value).
+
+Note: cyclictest holds /dev/cpu_dma_latency at 0 while it runs, and the PM
+QoS request is system-wide: side by side (parallel) the other program gets
+the shallow idle states too, whether it asks for them or not. Only the
+sequential mode shows what a program gets by itself.
+
+The last line is machine-readable:
+  RESULT mode=M ct_p50=.. ct_p99=.. ct_p999=.. ct_max=.. rl_p50=.. ... ratio_p50=.. ratio_p99=..
+  load_before=L1 load_after=L1 (1-minute load averages)
 USAGE
 }
 
-interval=1000 prio=80 loops=20000 mode=parallel bin="" outdir="" cmd=""
-while getopts "i:p:l:m:b:o:x:h" opt; do
+interval=1000 prio=80 loops=20000 mode=parallel bin="" outdir="" cmd="" reverse=0
+while getopts "i:p:l:m:b:o:x:rh" opt; do
   case $opt in
-    i) interval=$OPTARG ;; p) prio=$OPTARG ;; l) loops=$OPTARG ;; m) mode=$OPTARG ;;
+    i) interval=$OPTARG ;; p) prio=$OPTARG ;; l) loops=$OPTARG ;; m) mode=$OPTARG ;; r) reverse=1 ;;
     b) bin=$OPTARG ;; o) outdir=$OPTARG ;; x) cmd=$OPTARG ;; h) usage; exit 0 ;; *) usage >&2; exit 1 ;;
   esac
 done
@@ -63,18 +74,26 @@ else
   rl_cmd=("$bin" -q -p "$prio" -i "$interval" -l "$loops" --histogram "$outdir/rt-latency.hist")
   name=rt-latency
 fi
-echo "# $(date -u +%FT%TZ) $(uname -r), $(nproc) CPUs, mode $mode"
+load1() { cut -d' ' -f1 /proc/loadavg; }
+order=""
+[[ $mode == sequential ]] && order=$([[ $reverse == 1 ]] && echo ", $name first" || echo ", cyclictest first")
+load_before=$(load1)
+echo "# $(date -u +%FT%TZ) $(uname -r), $(nproc) CPUs, mode $mode$order, load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "# cyclictest: ${ct_cmd[*]}"
 echo "# $name: ${rl_cmd[*]}"
 if [[ $mode == parallel ]]; then
   "${ct_cmd[@]}" >"$outdir/cyclictest.txt" 2>&1 &
   ct_pid=$!
-  "${rl_cmd[@]}" >"$outdir/rt-latency.txt" 2>&1
+  "${rl_cmd[@]}" >"$outdir/rt-latency.txt" 2>&1 || true
   wait "$ct_pid"
+elif [[ $reverse == 1 ]]; then
+  "${rl_cmd[@]}" >"$outdir/rt-latency.txt" 2>&1 || true
+  "${ct_cmd[@]}" >"$outdir/cyclictest.txt" 2>&1
 else
   "${ct_cmd[@]}" >"$outdir/cyclictest.txt" 2>&1
-  "${rl_cmd[@]}" >"$outdir/rt-latency.txt" 2>&1
+  "${rl_cmd[@]}" >"$outdir/rt-latency.txt" 2>&1 || true
 fi
+load_after=$(load1)
 
 # cyclictest: percentiles from its 1 us histogram ("us count" lines); the
 # overflow count sits above the histogram range (reported as >histmax).
@@ -110,3 +129,8 @@ printf '%-12s %10s %10s %10s %10s %8s\n' "$name" "$rl_p50" "$rl_p99" "$rl_p999" 
 printf '%-12s %10s %10s %10s %10s\n' "ratio" "$(ratio "$rl_p50" "$ct_p50")" "$(ratio "$rl_p99" "$ct_p99")" \
   "$(ratio "$rl_p999" "$ct_p999")" "$(ratio "$rl_max" "$ct_max")"
 echo "# raw outputs: $outdir"
+echo "RESULT mode=$mode$([[ $mode == sequential && $reverse == 1 ]] && echo -reversed) ct_p50=$ct_p50 ct_p99=$ct_p99" \
+  "ct_p999=$ct_p999 ct_max=$ct_max rl_p50=$rl_p50 rl_p99=$rl_p99 rl_p999=$rl_p999 rl_max=$rl_max" \
+  "ratio_p50=$(ratio "$rl_p50" "$ct_p50") ratio_p99=$(ratio "$rl_p99" "$ct_p99")" \
+  "ratio_p999=$(ratio "$rl_p999" "$ct_p999") ratio_max=$(ratio "$rl_max" "$ct_max")" \
+  "load_before=$load_before load_after=$load_after"
