@@ -1,42 +1,51 @@
 #include "fieldbus/can/candump_format.hpp"
 
 #include <array>
+#include <cstring>
 
 namespace canmotion::can {
 namespace {
 
 constexpr char kHexUpper[] = "0123456789ABCDEF";
 
-// Fixed-capacity writer into a caller buffer; records overflow instead of writing past the end.
-struct Writer {
-  std::span<char> out;
-  std::size_t n = 0;
-  bool overflow = false;
+// "00" "01" ... "99" and "00" "01" ... "FF": two characters per table lookup.
+constexpr std::array<char, 200> kDecPairs = [] {
+  std::array<char, 200> t{};
+  for (int i = 0; i < 100; ++i) {
+    t[static_cast<std::size_t>(2 * i)] = static_cast<char>('0' + i / 10);
+    t[static_cast<std::size_t>(2 * i + 1)] = static_cast<char>('0' + i % 10);
+  }
+  return t;
+}();
+constexpr std::array<char, 512> kHexPairs = [] {
+  std::array<char, 512> t{};
+  for (int i = 0; i < 256; ++i) {
+    t[static_cast<std::size_t>(2 * i)] = kHexUpper[i >> 4];
+    t[static_cast<std::size_t>(2 * i + 1)] = kHexUpper[i & 0xF];
+  }
+  return t;
+}();
 
-  void put(char c) noexcept {
-    if (n < out.size()) {
-      out[n++] = c;
-    } else {
-      overflow = true;
-    }
+// Exactly `digits` (even) decimal digits of v (v < 10^digits), two at a time.
+inline char* put_dec_fixed(char* p, std::uint64_t v, int digits) noexcept {
+  for (int i = digits - 2; i >= 0; i -= 2) {
+    const auto pair = static_cast<std::size_t>(v % 100U);
+    v /= 100U;
+    p[i] = kDecPairs[2 * pair];
+    p[i + 1] = kDecPairs[2 * pair + 1];
   }
-  void put(std::string_view s) noexcept {
-    for (char c : s) put(c);
-  }
-  void hex(std::uint32_t v, int digits) noexcept {
-    for (int i = digits - 1; i >= 0; --i) put(kHexUpper[(v >> (4 * i)) & 0xFU]);
-  }
-  void dec(std::uint64_t v, int min_digits) noexcept {
-    std::array<char, 24> tmp{};
-    int len = 0;
-    do {
-      tmp[static_cast<std::size_t>(len++)] = static_cast<char>('0' + v % 10);
-      v /= 10;
-    } while (v != 0 && len < 24);
-    while (len < min_digits && len < 24) tmp[static_cast<std::size_t>(len++)] = '0';
-    while (len > 0) put(tmp[static_cast<std::size_t>(--len)]);
-  }
-};
+  return p + digits;
+}
+
+inline char* put_hex(char* p, std::uint32_t v, int digits) noexcept {
+  for (int i = digits - 1; i >= 0; --i) *p++ = kHexUpper[(v >> (4 * i)) & 0xFU];
+  return p;
+}
+
+// Longest line: "(" + 10 digits (INT64_MAX ns is 9223372036 s) + "." + 9 +
+// ") " + 15 + " " + 8 + "#" + 16 = 64 characters.
+constexpr std::size_t kLongestLine = 64;
+static_assert(kLongestLine <= kCandumpLineMax);
 
 constexpr int hex_value(char c) noexcept {
   if (c >= '0' && c <= '9') return c - '0';
@@ -291,41 +300,56 @@ CandumpParse parse_frame_token(std::string_view tok, CandumpLine& out) noexcept 
 
 std::size_t format_candump_line(std::span<char> out, const Frame& frame, std::int64_t t_ns, std::string_view iface,
                                 int frac_digits) noexcept {
-  Writer w{out};
+  // Written straight into `out` when it surely has room, else into a local
+  // line that is copied only if it fits (no partial line is ever left).
+  std::array<char, kLongestLine> local;
+  char* const start = out.size() > kLongestLine ? out.data() : local.data();
+  char* p = start;
   if (t_ns < 0) t_ns = 0;
   const auto t = static_cast<std::uint64_t>(t_ns);
-  w.put('(');
-  w.dec(t / 1'000'000'000ULL, 10);
-  w.put('.');
+  const std::uint64_t sec = t / 1'000'000'000ULL;  // < 10^10
+  const std::uint64_t ns = t % 1'000'000'000ULL;
+  *p++ = '(';
+  p = put_dec_fixed(p, sec, 10);
+  *p++ = '.';
   if (frac_digits == 9) {
-    w.dec(t % 1'000'000'000ULL, 9);
+    p = put_dec_fixed(p, ns / 10U, 8);
+    *p++ = static_cast<char>('0' + ns % 10U);
   } else {
-    w.dec((t % 1'000'000'000ULL) / 1000U, 6);
+    p = put_dec_fixed(p, ns / 1000U, 6);
   }
-  w.put(") ");
-  w.put(iface.substr(0, 15));
-  w.put(' ');
+  *p++ = ')';
+  *p++ = ' ';
+  const std::string_view name = iface.substr(0, 15);
+  if (!name.empty()) std::memcpy(p, name.data(), name.size());
+  p += name.size();
+  *p++ = ' ';
   if (frame.error()) {
-    w.hex((frame.id & 0x1FFFFFFFU) | kCandumpErrorFlag, 8);
+    p = put_hex(p, (frame.id & 0x1FFFFFFFU) | kCandumpErrorFlag, 8);
   } else if (frame.extended()) {
-    w.hex(frame.id & 0x1FFFFFFFU, 8);
+    p = put_hex(p, frame.id & 0x1FFFFFFFU, 8);
   } else {
-    w.hex(frame.id & 0x7FFU, 3);
+    p = put_hex(p, frame.id & 0x7FFU, 3);
   }
-  w.put('#');
+  *p++ = '#';
   const std::size_t len = frame.len <= kMaxPayload ? frame.len : kMaxPayload;
   if (frame.remote() && !frame.error()) {
-    w.put('R');
-    if (len != 0) w.put(static_cast<char>('0' + len));
+    *p++ = 'R';
+    if (len != 0) *p++ = static_cast<char>('0' + len);
   } else {
-    for (std::size_t i = 0; i < len; ++i) w.hex(frame.data[i], 2);
+    for (std::size_t i = 0; i < len; ++i) {
+      std::memcpy(p, &kHexPairs[2 * static_cast<std::size_t>(frame.data[i])], 2);
+      p += 2;
+    }
   }
-  if (w.overflow || w.n >= out.size()) {
+  const auto n = static_cast<std::size_t>(p - start);
+  if (n >= out.size()) {  // no room for the line and its NUL
     if (!out.empty()) out[0] = '\0';
     return 0;
   }
-  out[w.n] = '\0';
-  return w.n;
+  if (start == local.data()) std::memcpy(out.data(), local.data(), n);
+  out[n] = '\0';
+  return n;
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace can = canmotion::can;
 
@@ -216,5 +217,61 @@ TEST(CandumpFormat, RoundTripRandomFrames) {
     ASSERT_EQ(out.frame, f) << "seed " << seed << " line " << line;
     const std::int64_t expect_t = digits == 9 ? t : (t / 1000) * 1000;
     ASSERT_EQ(out.t_ns, expect_t) << "seed " << seed << " line " << line;
+  }
+}
+
+// Property: the formatter (written straight into the caller's buffer since
+// issue 18) gives the bytes of an snprintf oracle built from the candump -L
+// definition, for random frames, times (negative ones clamp to 0), both
+// fraction widths and interface names of every length (cut at 15), in a
+// buffer that is large enough and one of the exact size the line needs.
+TEST(CandumpFormat, MatchesAnSnprintfOracle) {
+  unsigned seed = 4242;
+  int count = 20000;
+  if (const char* s = std::getenv("CANMOTION_SEED")) seed = static_cast<unsigned>(std::strtoul(s, nullptr, 10));
+  if (const char* s = std::getenv("CANMOTION_COUNT")) count = std::atoi(s);
+  std::mt19937_64 rng(seed);
+  const std::string names = "abcdefghijklmnopqrstuvwxyz_0123456789";
+  for (int i = 0; i < count; ++i) {
+    can::Frame f;
+    f.id = static_cast<std::uint32_t>(rng());
+    f.flags = static_cast<std::uint8_t>(rng() % 8);  // any mix of extended, remote, error
+    f.len = static_cast<std::uint8_t>(rng() % 12);   // beyond 8 too: clamped
+    for (auto& b : f.data) b = static_cast<std::uint8_t>(rng());
+    std::int64_t t = static_cast<std::int64_t>(rng() >> (rng() % 64));
+    if (rng() % 10 == 0) t = -t;
+    const int digits = (rng() % 2) ? 9 : 6;
+    const std::string iface = names.substr(rng() % names.size(), rng() % 20);
+
+    const std::uint64_t tt = t < 0 ? 0 : static_cast<std::uint64_t>(t);
+    char want[256];
+    int n = digits == 9 ? std::snprintf(want, sizeof(want), "(%010llu.%09llu) %.15s ",
+                                        static_cast<unsigned long long>(tt / 1'000'000'000ULL),
+                                        static_cast<unsigned long long>(tt % 1'000'000'000ULL), iface.c_str())
+                        : std::snprintf(want, sizeof(want), "(%010llu.%06llu) %.15s ",
+                                        static_cast<unsigned long long>(tt / 1'000'000'000ULL),
+                                        static_cast<unsigned long long>(tt % 1'000'000'000ULL / 1000), iface.c_str());
+    if (f.flags & can::kError) {
+      n += std::snprintf(want + n, sizeof(want) - n, "%08X#", (f.id & 0x1FFFFFFFU) | 0x20000000U);
+    } else if (f.flags & can::kExtended) {
+      n += std::snprintf(want + n, sizeof(want) - n, "%08X#", f.id & 0x1FFFFFFFU);
+    } else {
+      n += std::snprintf(want + n, sizeof(want) - n, "%03X#", f.id & 0x7FFU);
+    }
+    const unsigned len = f.len > 8 ? 8 : f.len;
+    if ((f.flags & can::kRemote) && !(f.flags & can::kError)) {
+      n += len ? std::snprintf(want + n, sizeof(want) - n, "R%u", len) : std::snprintf(want + n, sizeof(want) - n, "R");
+    } else {
+      for (unsigned k = 0; k < len; ++k) n += std::snprintf(want + n, sizeof(want) - n, "%02X", f.data[k]);
+    }
+    const std::string expect(want, static_cast<std::size_t>(n));
+    ASSERT_EQ(fmt_line(f, t, iface, digits), expect) << "seed " << seed;
+    // A buffer of exactly the line plus its NUL works; one byte less gives 0 and an empty string.
+    std::vector<char> exact(expect.size() + 1, 'x');
+    ASSERT_EQ(can::format_candump_line(exact, f, t, iface, digits), expect.size()) << "seed " << seed;
+    ASSERT_EQ(std::string(exact.data()), expect) << "seed " << seed;
+    std::vector<char> short_by_one(expect.size(), 'x');
+    ASSERT_EQ(can::format_candump_line(short_by_one, f, t, iface, digits), 0U) << "seed " << seed;
+    ASSERT_EQ(short_by_one[0], '\0') << "seed " << seed;
   }
 }

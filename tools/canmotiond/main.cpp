@@ -25,6 +25,7 @@
 #include "rt/clock.hpp"
 #include "rt/controller/command_server.hpp"
 #include "rt/controller/host.hpp"
+#include "rt/controller/output_writer.hpp"
 #include "rt/controller/script.hpp"
 #include "rt/cyclic_executive.hpp"
 #include "rt/systemd_notify.hpp"
@@ -56,17 +57,21 @@ struct Options {
 class Outputs {
  public:
   Outputs(const Options& o, config::Runtime& rt, const config::Config& cfg) : rt_(rt), cfg_(cfg) {
-    if (!o.trace.empty()) {
-      trace_ = std::fopen(o.trace.c_str(), "w");
-      if (!trace_) throw std::runtime_error(fmt::format("cannot write trace file '{}'", o.trace));
-      rt.controller->set_trace(true);
-    }
-    if (!o.csv.empty()) {
-      csv_ = std::fopen(o.csv.c_str(), "w");
-      if (!csv_) throw std::runtime_error(fmt::format("cannot write CSV file '{}'", o.csv));
-      std::fputs("cycle,time,axis,cmd_pos,act_pos,cmd_vel,act_vel,motion_status,axis_status\n", csv_);
-      rt.controller->set_telemetry(true);
-    }
+    rt::OutputWriterConfig wc;
+    wc.trace_path = o.trace;
+    wc.csv_path = o.csv;
+    wc.trace_names = rt.trace_names;
+    for (std::size_t a = 0; a < rt.controller->axis_count(); ++a)
+      wc.axis_names.push_back(rt.controller->axis_name(static_cast<motion::AxisId>(a)));
+    wc.period_s = rt.controller->period_s();
+    // --sim: format and write on a writer thread (the text of hundreds of
+    // simulated seconds per second), 1 MiB write(2) blocks. Real time: on
+    // the draining (housekeeping) thread, 64 KiB blocks of locked memory.
+    wc.threaded = o.sim;
+    wc.buffer_bytes = o.sim ? rt::OutputFile::kDefaultBuffer : std::size_t{64} << 10;
+    writer_.emplace(std::move(wc));
+    rt.controller->set_trace(writer_->tracing());
+    rt.controller->set_telemetry(writer_->recording_csv());
     // Real time: transmit records and simulated buses carry CLOCK_MONOTONIC,
     // SocketCAN receive stamps CLOCK_REALTIME; put all on the realtime scale
     // like candump. In --sim every stamp is virtual time.
@@ -77,32 +82,19 @@ class Outputs {
       mono_to_real_ = (r.tv_sec - m.tv_sec) * 1'000'000'000LL + (r.tv_nsec - m.tv_nsec);
     }
   }
-  ~Outputs() {
-    if (trace_) std::fclose(trace_);
-    if (csv_) std::fclose(csv_);
-  }
+  /// Writes what is left and closes both files; returns what went wrong ("" if nothing).
+  std::string close() { return writer_->close(); }
   void drain(bool quiet) {
     rt::Controller& c = *rt_.controller;
+    // The RT thread only pushed records; the writer formats them (no stdio).
     rt::TraceRecord tr;
-    char line[can::kCandumpLineMax + 2];
     while (c.pop_trace(tr)) {
-      if (!trace_) continue;
       std::int64_t t = tr.frame.t_ns;
       if (tr.tx || !rt_.is_socket[tr.bus]) t += mono_to_real_;  // 0 in --sim
-      const std::size_t n = can::format_candump_line(line, tr.frame.frame, t, rt_.trace_names[tr.bus]);
-      if (n > 0) {
-        line[n] = '\n';
-        std::fwrite(line, 1, n + 1, trace_);
-      }
+      writer_->trace(tr.frame.frame, t, tr.bus);
     }
     rt::Sample s;
-    const double T = c.period_s();
-    while (c.pop_sample(s)) {
-      if (!csv_) continue;
-      std::fprintf(csv_, "%llu,%.6f,%s,%.6f,%.6f,%.6f,%.6f,%u,%u\n", static_cast<unsigned long long>(s.cycle),
-                   static_cast<double>(s.cycle) * T, c.axis_name(s.axis).c_str(), s.cmd_pos, s.act_pos, s.cmd_vel,
-                   s.act_vel, s.motion_status, s.axis_status);
-    }
+    while (c.pop_sample(s)) writer_->sample(s);
     rt::Event e;
     while (c.pop_event(e)) {
       if (e.kind == rt::Event::Kind::kDriveFailed) {
@@ -122,8 +114,7 @@ class Outputs {
  private:
   config::Runtime& rt_;
   const config::Config& cfg_;
-  std::FILE* trace_ = nullptr;
-  std::FILE* csv_ = nullptr;
+  std::optional<rt::OutputWriter> writer_;
   std::int64_t mono_to_real_ = 0;
 };
 
@@ -452,6 +443,10 @@ int run(const Options& o) {
     exec.stop();
   }
   out->drain(true);
+  if (const std::string err = out->close(); !err.empty()) {
+    fmt::print(stderr, "canmotiond: {}\n", err);
+    status = 1;
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   if (!o.quiet || o.stats) print_summary(o, rt, host, exec.statistics().snapshot(), wall, !sim);
   if (o.stats) fmt::print("{}\n", rt::format_summary(exec.statistics().snapshot()));
