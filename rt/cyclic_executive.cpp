@@ -3,7 +3,9 @@
 #include <pthread.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <future>
+#include <memory>
 #include <system_error>
 
 namespace canmotion::rt {
@@ -93,25 +95,27 @@ std::error_code CyclicExecutive::start() {
     return ec;
   }
   running_.store(true, std::memory_order_release);
-  std::promise<std::error_code> ready;
-  std::future<std::error_code> result = ready.get_future();
-  try {
-    thread_ = std::thread([this, promise = std::move(ready)]() mutable {
-      const std::error_code ec = setup_on_this_thread();
-      if (ec) {
-        release_cpu_latency();
-      }
-      promise.set_value(ec);
-      if (ec) {
-        running_.store(false, std::memory_order_release);
-        return;
-      }
-      if (config_.on_loop_start) {
-        config_.on_loop_start();
-      }
-      loop(0);
-    });
-  } catch (const std::system_error&) {
+  auto ready = std::make_shared<std::promise<std::error_code>>();
+  std::future<std::error_code> result = ready->get_future();
+  // A small stack of our own (std::thread's 8 MiB would all be locked by
+  // mlockall); never smaller than twice the prefault, which must fit in it.
+  const std::size_t stack = std::max(config_.stack_bytes, 2 * std::min(config_.rt.prefault_stack_bytes, RtSettings::kMaxPrefaultBytes));
+  const std::error_code started = thread_.start(stack, [this, ready] {
+    const std::error_code ec = setup_on_this_thread();
+    if (ec) {
+      release_cpu_latency();
+    }
+    ready->set_value(ec);
+    if (ec) {
+      running_.store(false, std::memory_order_release);
+      return;
+    }
+    if (config_.on_loop_start) {
+      config_.on_loop_start();
+    }
+    loop(0);
+  });
+  if (started) {
     running_.store(false, std::memory_order_release);
     return ExecutiveError::thread_failed;
   }

@@ -18,6 +18,7 @@
 #include "rt/clock.hpp"
 #include "rt/cycle_stats.hpp"
 #include "rt/rt_setup.hpp"
+#include "rt/sized_thread.hpp"
 
 namespace canmotion::rt {
 
@@ -53,6 +54,10 @@ struct ExecutiveConfig {
   RtSettings rt{};
   /// The system calls used by the RT set-up (tests inject failures).
   RtSyscalls syscalls = RtSyscalls::real();
+  /// Stack of the thread start() creates (run() uses the caller's). All of
+  /// it is locked by mlockall; the cycle of 16 axes uses about 12 KiB. At
+  /// least 2 x rt.prefault_stack_bytes is used, so that the prefault fits.
+  std::size_t stack_bytes = 512 * 1024;
   /// Name of the RT thread (max 15 characters, pthread_setname_np).
   std::string thread_name = "canmotion-rt";
   /// Receives the ONE warning when the RT set-up was not permitted. Called on
@@ -174,7 +179,7 @@ class CyclicExecutive {
   CycleStatistics stats_;
   RtSetupReport report_;
   int cpu_latency_fd_ = -1;  ///< PM QoS request held while the loop runs (loop thread only)
-  std::thread thread_;
+  SizedThread thread_;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};
   std::atomic<std::uint64_t> cycles_{0};
@@ -186,7 +191,7 @@ enum class ExecutiveError {
   no_callable = 1,      ///< set_cycle() was not called
   already_running = 2,  ///< start()/run() while the loop runs
   bad_period = 3,       ///< period <= 0
-  thread_failed = 4,    ///< std::thread could not be created
+  thread_failed = 4,    ///< the thread could not be created (pthread_create)
 };
 /// Category of ExecutiveError ("canmotion.rt").
 const std::error_category& executive_category() noexcept;

@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// systemd readiness (Type=notify) and watchdog (WatchdogSec) through
-/// libsystemd's sd_notify. Optional: without libsystemd at build time every
-/// call is a no-op returning -ENOSYS and compiled_in() is false. Nothing here
+/// systemd readiness (Type=notify) and watchdog (WatchdogSec): the sd_notify
+/// protocol implemented here (a datagram to $NOTIFY_SOCKET), not linked from
+/// libsystemd, whose dependencies cost 3.4 MB of locked memory. Nothing here
 /// runs on the RT thread: the watchdog is a non-RT thread that pings only
 /// while the RT cycle counter advances.
 
@@ -17,24 +17,25 @@
 #include <thread>
 
 #include "rt/clock.hpp"
+#include "rt/sized_thread.hpp"
 
 namespace canmotion::rt {
 
-/// Thin wrapper over sd_notify(3). Not realtime-safe.
+/// The sd_notify(3) protocol. Not realtime-safe.
 class SdNotifier {
  public:
-  /// True when built with libsystemd.
-  static bool compiled_in() noexcept;
-  /// sd_notify(0, state): > 0 sent, 0 not run by systemd (no $NOTIFY_SOCKET),
-  /// < 0 -errno (-ENOSYS when compiled out).
+  /// Like sd_notify(0, state): > 0 sent, 0 not run by systemd (no
+  /// $NOTIFY_SOCKET), < 0 -errno (-EAFNOSUPPORT for a socket address that is
+  /// neither a path nor '@abstract').
   static int notify(std::string_view state);
   static int ready() { return notify("READY=1"); }
   static int stopping() { return notify("STOPPING=1"); }
   static int watchdog() { return notify("WATCHDOG=1"); }
   /// "STATUS=<text>" (shown by systemctl status).
   static int status(std::string_view text);
-  /// The watchdog interval systemd expects pings within (WatchdogSec), from
-  /// sd_watchdog_enabled(); nullopt when no watchdog is configured.
+  /// The watchdog interval systemd expects pings within (WatchdogSec), read
+  /// like sd_watchdog_enabled(): $WATCHDOG_USEC, when $WATCHDOG_PID is unset
+  /// or this process; nullopt when no watchdog is configured.
   static std::optional<Nanos> watchdog_interval();
 };
 
@@ -66,12 +67,16 @@ class WatchdogThread {
   using Progress = std::function<std::uint64_t()>;
   using Send = std::function<int(std::string_view)>;
 
+  /// Stack of the watchdog thread: it formats one STATUS line and sends a
+  /// datagram (a std::thread's 8 MiB would all be locked by mlockall).
+  static constexpr std::size_t kStackBytes = 128 * 1024;
+
   WatchdogThread(Progress progress, Nanos check_every, Send send = {});
   ~WatchdogThread();
   WatchdogThread(const WatchdogThread&) = delete;
   WatchdogThread& operator=(const WatchdogThread&) = delete;
 
-  /// Start the thread (once).
+  /// Start the thread (once). Throws std::system_error if it cannot be created.
   void start();
   /// Stop and join it.
   void stop();
@@ -87,7 +92,7 @@ class WatchdogThread {
   Nanos check_every_;
   Send send_;
   CycleWatchdog logic_;
-  std::thread thread_;
+  SizedThread thread_;
   std::mutex mutex_;
   std::condition_variable wake_;
   bool stop_ = false;

@@ -84,7 +84,7 @@ field() { dpkg-deb -f "$deb" "$1"; }
 [[ $(field Architecture) == "$(dpkg --print-architecture)" ]] || fail "Architecture: $(field Architecture)"
 depends=$(field Depends)
 echo "Depends: $depends"
-for lib in libc6 libstdc++6 libyaml-cpp libfmt libspdlog libsystemd0; do
+for lib in libc6 libstdc++6 libyaml-cpp libfmt libspdlog; do
   [[ $depends == *"$lib"* ]] || fail "Depends lacks $lib (dpkg-shlibdeps did not run?)"
 done
 for f in Maintainer Description Section Priority Installed-Size Homepage; do

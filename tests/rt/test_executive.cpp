@@ -7,6 +7,9 @@
 #include <atomic>
 #include <chrono>
 #include <thread>
+#include <tuple>
+
+#include <pthread.h>
 
 #include "rt/clock.hpp"
 #include "rt/cyclic_executive.hpp"
@@ -196,4 +199,46 @@ TEST(RtExecutive, SimRunAllocatesNothingEither) {
   EXPECT_EQ(w.handled, 200u);
   EXPECT_EQ(counted_allocations(), 0u);
   EXPECT_EQ(clock.now(), Nanos{100'000LL * 1'000'000 + 10'000});
+}
+
+namespace {
+// Size of the calling thread's stack (pthread_getattr_np).
+std::size_t own_stack_size() {
+  pthread_attr_t attr;
+  std::size_t size = 0;
+  if (pthread_getattr_np(pthread_self(), &attr) == 0) {
+    pthread_attr_getstacksize(&attr, &size);
+    pthread_attr_destroy(&attr);
+  }
+  return size;
+}
+}  // namespace
+
+// The RT thread gets the configured stack, not std::thread's 8 MiB (which
+// mlockall would lock in full), and never less than twice the prefault.
+// (glibc may hand a new thread a cached stack up to 4x the size asked for:
+// the earlier tests' threads leave 512 KiB ones.)
+TEST(RtExecutive, RtThreadHasTheConfiguredStack) {
+  MonotonicClock clock;
+  for (const auto& [stack, prefault, expect] :
+       {std::tuple<std::size_t, std::size_t, std::size_t>{256 * 1024, 64 * 1024, 256 * 1024},
+        {512 * 1024, 256 * 1024, 512 * 1024},
+        {128 * 1024, 1024 * 1024, 2048 * 1024}}) {
+    ExecutiveConfig cfg = real_config(Nanos{200'000});
+    cfg.on_loop_start = {};
+    cfg.stack_bytes = stack;
+    cfg.rt.prefault_stack_bytes = prefault;
+    CyclicExecutive exec(cfg, clock);
+    std::atomic<std::size_t> seen{0};
+    exec.set_cycle([&seen](const CycleInfo& c) noexcept {
+      seen = own_stack_size();
+      return c.cycle >= 2 ? CycleResult::stop : CycleResult::run_on;
+    });
+    ASSERT_FALSE(exec.start());
+    exec.join();
+    EXPECT_GE(seen.load(), expect) << "stack_bytes " << stack << ", prefault " << prefault;
+    EXPECT_LE(seen.load(), 4 * expect) << "stack_bytes " << stack << ", prefault " << prefault;
+    EXPECT_TRUE(exec.setup_report().outcome(RtStep::prefault_stack).done()) << "the prefault fits";
+  }
+  EXPECT_EQ(ExecutiveConfig{}.stack_bytes, 512u * 1024u);
 }

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <sys/un.h>
+#include <pthread.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstdlib>
 #include <mutex>
 #include <string>
@@ -107,10 +109,6 @@ class FakeSystemd {
 }  // namespace
 
 TEST(RtSdNotify, SendsReadyWatchdogAndStatusToNotifySocket) {
-  if (!SdNotifier::compiled_in()) {
-    EXPECT_EQ(SdNotifier::ready(), -ENOSYS);
-    GTEST_SKIP() << "built without libsystemd: sd_notify is compiled out";
-  }
   FakeSystemd systemd;
   ASSERT_TRUE(systemd.ok());
   EXPECT_GT(SdNotifier::ready(), 0);
@@ -124,9 +122,6 @@ TEST(RtSdNotify, SendsReadyWatchdogAndStatusToNotifySocket) {
 }
 
 TEST(RtSdNotify, WatchdogIntervalComesFromTheEnvironment) {
-  if (!SdNotifier::compiled_in()) {
-    GTEST_SKIP() << "built without libsystemd";
-  }
   ::unsetenv("WATCHDOG_USEC");
   EXPECT_FALSE(SdNotifier::watchdog_interval().has_value());
   ::setenv("WATCHDOG_USEC", "2000000", 1);
@@ -140,18 +135,10 @@ TEST(RtSdNotify, WatchdogIntervalComesFromTheEnvironment) {
 
 TEST(RtSdNotify, NotRunBySystemdIsANoOp) {
   ::unsetenv("NOTIFY_SOCKET");
-  const int r = SdNotifier::ready();
-  if (SdNotifier::compiled_in()) {
-    EXPECT_EQ(r, 0);
-  } else {
-    EXPECT_EQ(r, -ENOSYS);
-  }
+  EXPECT_EQ(SdNotifier::ready(), 0);
 }
 
 TEST(RtWatchdog, ThreadRealSdNotifyPings) {
-  if (!SdNotifier::compiled_in()) {
-    GTEST_SKIP() << "built without libsystemd";
-  }
   FakeSystemd systemd;
   ASSERT_TRUE(systemd.ok());
   std::atomic<std::uint64_t> counter{1};
@@ -160,4 +147,63 @@ TEST(RtWatchdog, ThreadRealSdNotifyPings) {
   EXPECT_EQ(systemd.receive(), "WATCHDOG=1");
   EXPECT_EQ(systemd.receive(), "WATCHDOG=1");
   wd.stop();
+}
+
+// The protocol details libsystemd handled before issue 18: an abstract
+// socket ('@name'), a watchdog meant for another process, bad addresses.
+TEST(RtSdNotify, AbstractSocketAndAddressChecks) {
+  const std::string name = "canmotion-notify-abstract-" + std::to_string(getpid());
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  name.copy(addr.sun_path + 1, sizeof(addr.sun_path) - 2);  // sun_path[0] = 0: abstract
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr),
+                   static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + name.size())),
+            0);
+  timeval tv{2, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+  ::setenv("NOTIFY_SOCKET", ("@" + name).c_str(), 1);
+  EXPECT_GT(SdNotifier::ready(), 0);
+  char buf[64];
+  const ssize_t n = ::recv(fd, buf, sizeof(buf), 0);
+  EXPECT_EQ(std::string(buf, n > 0 ? static_cast<std::size_t>(n) : 0), "READY=1");
+  ::close(fd);
+
+  ::setenv("NOTIFY_SOCKET", "vsock:2:1234", 1);
+  EXPECT_EQ(SdNotifier::ready(), -EAFNOSUPPORT);
+  ::setenv("NOTIFY_SOCKET", "/nonexistent/notify.sock", 1);
+  EXPECT_EQ(SdNotifier::ready(), -ENOENT);
+  ::unsetenv("NOTIFY_SOCKET");
+
+  ::setenv("WATCHDOG_USEC", "500000", 1);
+  ::setenv("WATCHDOG_PID", std::to_string(getpid() + 1).c_str(), 1);
+  EXPECT_FALSE(SdNotifier::watchdog_interval().has_value()) << "meant for another process";
+  ::unsetenv("WATCHDOG_PID");
+  EXPECT_EQ(SdNotifier::watchdog_interval(), Nanos{500'000'000}) << "no WATCHDOG_PID: ours";
+  ::setenv("WATCHDOG_USEC", "2s", 1);
+  EXPECT_FALSE(SdNotifier::watchdog_interval().has_value()) << "not a number";
+  ::unsetenv("WATCHDOG_USEC");
+}
+
+// The watchdog thread runs on a small stack of its own (mlockall would lock
+// all of a std::thread's 8 MiB).
+TEST(RtWatchdog, ThreadHasASmallStack) {
+  std::atomic<std::size_t> size{0};
+  WatchdogThread wd(
+      [&size] {
+        pthread_attr_t attr;
+        std::size_t s = 0;
+        if (pthread_getattr_np(pthread_self(), &attr) == 0) {
+          pthread_attr_getstacksize(&attr, &s);
+          pthread_attr_destroy(&attr);
+        }
+        size = s;
+        return std::uint64_t{1};
+      },
+      Nanos{1'000'000}, [](std::string_view) { return 1; });
+  wd.start();
+  while (size.load() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  wd.stop();
+  EXPECT_EQ(size.load(), WatchdogThread::kStackBytes);
 }
