@@ -1,5 +1,6 @@
 // Codec tests for the candump text formats: golden strings both ways.
 #include "fieldbus/can/candump_format.hpp"
+#include "tests/support/random_seed.hpp"
 
 #include <gtest/gtest.h>
 
@@ -226,13 +227,11 @@ TEST(CandumpFormat, RoundTripRandomFrames) {
 // fraction widths and interface names of every length (cut at 15), in a
 // buffer that is large enough and one of the exact size the line needs.
 TEST(CandumpFormat, MatchesAnSnprintfOracle) {
-  unsigned seed = 4242;
-  int count = 20000;
-  if (const char* s = std::getenv("CANMOTION_SEED")) seed = static_cast<unsigned>(std::strtoul(s, nullptr, 10));
-  if (const char* s = std::getenv("CANMOTION_COUNT")) count = std::atoi(s);
+  const std::uint64_t seed = canmotion::test::test_seed(4242);
+  const std::uint64_t count = canmotion::test::test_count(20000);
   std::mt19937_64 rng(seed);
   const std::string names = "abcdefghijklmnopqrstuvwxyz_0123456789";
-  for (int i = 0; i < count; ++i) {
+  for (std::uint64_t i = 0; i < count; ++i) {
     can::Frame f;
     f.id = static_cast<std::uint32_t>(rng());
     f.flags = static_cast<std::uint8_t>(rng() % 8);  // any mix of extended, remote, error
@@ -265,13 +264,13 @@ TEST(CandumpFormat, MatchesAnSnprintfOracle) {
       for (unsigned k = 0; k < len; ++k) n += std::snprintf(want + n, sizeof(want) - n, "%02X", f.data[k]);
     }
     const std::string expect(want, static_cast<std::size_t>(n));
-    ASSERT_EQ(fmt_line(f, t, iface, digits), expect) << "seed " << seed;
+    ASSERT_EQ(fmt_line(f, t, iface, digits), expect) << canmotion::test::seed_note(seed);
     // A buffer of exactly the line plus its NUL works; one byte less gives 0 and an empty string.
     std::vector<char> exact(expect.size() + 1, 'x');
-    ASSERT_EQ(can::format_candump_line(exact, f, t, iface, digits), expect.size()) << "seed " << seed;
-    ASSERT_EQ(std::string(exact.data()), expect) << "seed " << seed;
+    ASSERT_EQ(can::format_candump_line(exact, f, t, iface, digits), expect.size()) << canmotion::test::seed_note(seed);
+    ASSERT_EQ(std::string(exact.data()), expect) << canmotion::test::seed_note(seed);
     std::vector<char> short_by_one(expect.size(), 'x');
-    ASSERT_EQ(can::format_candump_line(short_by_one, f, t, iface, digits), 0U) << "seed " << seed;
-    ASSERT_EQ(short_by_one[0], '\0') << "seed " << seed;
+    ASSERT_EQ(can::format_candump_line(short_by_one, f, t, iface, digits), 0U) << canmotion::test::seed_note(seed);
+    ASSERT_EQ(short_by_one[0], '\0') << canmotion::test::seed_note(seed);
   }
 }

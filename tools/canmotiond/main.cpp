@@ -65,10 +65,10 @@ class Outputs {
       wc.axis_names.push_back(rt.controller->axis_name(static_cast<motion::AxisId>(a)));
     wc.period_s = rt.controller->period_s();
     // --sim: format and write on a writer thread (the text of hundreds of
-    // simulated seconds per second), 1 MiB write(2) blocks. Real time: on
+    // simulated seconds per second), 256 KiB write(2) blocks. Real time: on
     // the draining (housekeeping) thread, 64 KiB blocks of locked memory.
     wc.threaded = o.sim;
-    wc.buffer_bytes = o.sim ? rt::OutputFile::kDefaultBuffer : std::size_t{64} << 10;
+    wc.buffer_bytes = std::size_t{o.sim ? 256u : 64u} << 10;
     writer_.emplace(std::move(wc));
     rt.controller->set_trace(writer_->tracing());
     rt.controller->set_telemetry(writer_->recording_csv());
