@@ -3,8 +3,12 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <charconv>
 #include <cstdint>
+#include <cstdio>
+#include <random>
 #include <thread>
+#include <vector>
 
 #include "rt/clock.hpp"
 #include "rt/cycle_stats.hpp"
@@ -12,6 +16,7 @@
 #include "rt/histogram.hpp"
 #include "rt/snapshot.hpp"
 #include "rt/spsc_ring.hpp"
+#include "rt/text_output.hpp"
 
 using namespace canmotion::rt;
 
@@ -108,5 +113,44 @@ static void BM_VirtualLoopEmptyCycle(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kCycles));
 }
 BENCHMARK(BM_VirtualLoopEmptyCycle)->Unit(benchmark::kMillisecond);
+
+// The CSV's "%.6f" three ways (issue 18): format_fixed6, std::to_chars alone,
+// snprintf (what canmotiond used before). Positions of +-5000 mm.
+namespace {
+std::vector<double> positions() {
+  std::vector<double> v(4096);
+  std::mt19937_64 rng(18);
+  std::uniform_real_distribution<double> d(-5000.0, 5000.0);
+  for (auto& x : v) x = d(rng);
+  return v;
+}
+}  // namespace
+
+static void BM_Fixed6(benchmark::State& state) {
+  const auto v = positions();
+  std::array<char, canmotion::rt::kFixed6Max> buf{};
+  std::size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(canmotion::rt::format_fixed6(buf.data(), v[i++ & 4095]));
+}
+BENCHMARK(BM_Fixed6);
+
+static void BM_Fixed6ToChars(benchmark::State& state) {
+  const auto v = positions();
+  std::array<char, canmotion::rt::kFixed6Max> buf{};
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        std::to_chars(buf.data(), buf.data() + buf.size(), v[i++ & 4095], std::chars_format::fixed, 6).ptr);
+  }
+}
+BENCHMARK(BM_Fixed6ToChars);
+
+static void BM_Fixed6Snprintf(benchmark::State& state) {
+  const auto v = positions();
+  std::array<char, canmotion::rt::kFixed6Max + 1> buf{};
+  std::size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(std::snprintf(buf.data(), buf.size(), "%.6f", v[i++ & 4095]));
+}
+BENCHMARK(BM_Fixed6Snprintf);
 
 BENCHMARK_MAIN();
