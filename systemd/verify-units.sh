@@ -94,14 +94,15 @@ check_networkd "$dir/80-vcan0.network" Match:Name Link:RequiredForOnline Link:Ac
 
 echo "== canmotiond.service reaches /dev/cpu_dma_latency (PM QoS) without giving up PrivateDevices="
 unit="$dir/canmotiond.service"
+rules="$(cd "$(dirname "$0")" && pwd)/60-canmotion-cpu-dma-latency.rules"  # the source's (not installed yet)
 if grep -qx 'PrivateDevices=yes' "$unit" && grep -qx 'DevicePolicy=closed' "$unit" \
    && grep -qx 'BindPaths=-/dev/cpu_dma_latency' "$unit" && grep -qx 'DeviceAllow=/dev/cpu_dma_latency rw' "$unit" \
-   && grep -q 'KERNEL=="cpu_dma_latency", GROUP="canmotion", MODE="0660"' "$dir/60-canmotion-cpu-dma-latency.rules"; then
+   && grep -q 'KERNEL=="cpu_dma_latency", GROUP="canmotion", MODE="0660"' "$rules"; then
   echo "ok: PrivateDevices=yes, DevicePolicy=closed, BindPaths=-/dev/cpu_dma_latency, DeviceAllow rw, udev rule"
 else
   echo "FAIL: canmotiond.service must keep PrivateDevices=yes + DevicePolicy=closed and bind and allow"
   echo "      /dev/cpu_dma_latency (BindPaths=-/dev/cpu_dma_latency, DeviceAllow=/dev/cpu_dma_latency rw),"
-  echo "      and 60-canmotion-cpu-dma-latency.rules must give the group canmotion write access"; fail=1
+  echo "      and $rules must give the group canmotion write access"; fail=1
 fi
 
 echo "== systemd-analyze security --offline (exposure 0 = best, 10 = worst)"
