@@ -99,7 +99,8 @@ std::error_code CyclicExecutive::start() {
   std::future<std::error_code> result = ready->get_future();
   // A small stack of our own (std::thread's 8 MiB would all be locked by
   // mlockall); never smaller than twice the prefault, which must fit in it.
-  const std::size_t stack = std::max(config_.stack_bytes, 2 * std::min(config_.rt.prefault_stack_bytes, RtSettings::kMaxPrefaultBytes));
+  const std::size_t prefault = std::min(config_.rt.prefault_stack_bytes, RtSettings::kMaxPrefaultBytes);
+  const std::size_t stack = std::max(config_.stack_bytes, 2 * prefault);
   const std::error_code started = thread_.start(stack, [this, ready] {
     const std::error_code ec = setup_on_this_thread();
     if (ec) {

@@ -425,7 +425,8 @@ int run(const Options& o) {
     }
     if (o.stats) {  // what the RT set-up got (mlockall, SCHED_FIFO, cpu_dma_latency, ...), one line
       std::string steps = exec.setup_report().describe();
-      for (std::size_t p; (p = steps.find('\n')) != std::string::npos;) steps.replace(p, 1, p + 1 < steps.size() ? "; " : "");
+      for (std::size_t p; (p = steps.find('\n')) != std::string::npos;)
+        steps.replace(p, 1, p + 1 < steps.size() ? "; " : "");
       fmt::print("canmotiond: real-time set-up: {}\n", steps);
     }
     rt::SdNotifier::ready();
