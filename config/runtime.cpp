@@ -115,7 +115,6 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       if (!rt.sim) rt.sim = std::make_unique<rt::SimWorld>();
       bs.transport = &rt.sim->add_bus(b.name);
       rt.trace_names.push_back(b.name);
-      rt.is_socket.push_back(false);
     } else {
       // Receive only what a CANopen master needs: the nodes' EMCY, TPDOs,
       // SDO responses and heartbeats (the list DriveNetwork::receive_filters() gives).
@@ -130,7 +129,6 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       bs.transport = sock.get();
       rt.sockets.push_back(std::move(sock));
       rt.trace_names.push_back(b.interface);
-      rt.is_socket.push_back(true);
     }
     spec.buses.push_back(bs);
   }

@@ -22,9 +22,6 @@ struct Runtime {
   std::unique_ptr<rt::Controller> controller;
   /// Name used for each bus in traces: the SocketCAN interface, or the bus name for simulated buses.
   std::vector<std::string> trace_names;
-  /// Per bus: true for a SocketCAN interface (frames carry kernel CLOCK_REALTIME
-  /// receive stamps), false for a simulated bus (stamped with the cycle's time).
-  std::vector<bool> is_socket;
 };
 
 /// Build the runtime. With `force_sim` every bus is simulated (`--sim`);

@@ -52,8 +52,10 @@ struct Frame {
   }
 };
 
-/// A received frame with the time it was received (kernel timestamp on
-/// SocketCAN, virtual time on the SimBus), in nanoseconds.
+/// A received frame with the time it was received, in nanoseconds, on the
+/// clock the cycle runs on: the kernel's stamp converted to CLOCK_MONOTONIC on
+/// SocketCAN (SocketCanBus::RxClock), the virtual time on the SimBus. Sent
+/// frames recorded for traces carry the cycle's time.
 struct TimedFrame {
   Frame frame;
   std::int64_t t_ns = 0;

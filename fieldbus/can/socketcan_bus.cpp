@@ -7,6 +7,7 @@
 #include <net/if.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -121,8 +122,33 @@ SendResult SocketCanBus::send(const Frame& frame) noexcept {
   return SendResult::kError;
 }
 
+namespace {
+std::int64_t clock_ns(clockid_t id) noexcept {
+  timespec ts{};
+  ::clock_gettime(id, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+}  // namespace
+
 std::size_t SocketCanBus::receive(std::span<TimedFrame> out) noexcept {
   std::size_t got = 0;
+  // Kernel stamps are CLOCK_REALTIME. For the monotonic scale, the offset
+  // between the clocks is read once per call (two vDSO reads, only when a
+  // frame came): a frame waits at most a cycle in the socket, so a clock step
+  // or slew between its arrival and this call is all the error there is.
+  bool have_offset = false;
+  std::int64_t real_minus_mono = 0;
+  auto to_rx_clock = [&](std::int64_t real_ns) noexcept {
+    if (rx_clock_ == RxClock::kRealtime) return real_ns;
+    if (!have_offset) {
+      const std::int64_t m0 = clock_ns(CLOCK_MONOTONIC);
+      const std::int64_t r = clock_ns(CLOCK_REALTIME);
+      const std::int64_t m1 = clock_ns(CLOCK_MONOTONIC);
+      real_minus_mono = r - (m0 + (m1 - m0) / 2);
+      have_offset = true;
+    }
+    return real_ns - real_minus_mono;
+  };
   while (got < out.size()) {
     can_frame kf{};
     iovec iov{&kf, sizeof kf};
@@ -136,22 +162,24 @@ std::size_t SocketCanBus::receive(std::span<TimedFrame> out) noexcept {
     const ssize_t n = ::recvmsg(fd_, &msg, MSG_DONTWAIT);
     if (n < 0) break;  // EAGAIN: nothing more; other errors are retried next cycle
     if (static_cast<std::size_t>(n) < sizeof kf) continue;  // CAN FD frame on an FD-enabled socket: not ours
-    std::int64_t t_ns = 0;
+    std::int64_t t_ns = -1;
+    std::uint32_t drops = last_kernel_drops_;
     for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
       if (c->cmsg_level != SOL_SOCKET) continue;
       if (c->cmsg_type == SO_TIMESTAMPNS) {
         timespec ts{};
         std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
-        t_ns = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+        t_ns = to_rx_clock(static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec);
       } else if (c->cmsg_type == SO_RXQ_OVFL) {
-        std::uint32_t drops = 0;
         std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
-        if (drops != last_kernel_drops_) {
-          counters_.rx_dropped += drops - last_kernel_drops_;
-          push_event(BusEvent{BusEvent::Kind::kRxOverflow, state_, drops - last_kernel_drops_, t_ns});
-          last_kernel_drops_ = drops;
-        }
       }
+    }
+    if (t_ns < 0)  // no stamp from the kernel: the time of reading
+      t_ns = clock_ns(rx_clock_ == RxClock::kRealtime ? CLOCK_REALTIME : CLOCK_MONOTONIC);
+    if (drops != last_kernel_drops_) {
+      counters_.rx_dropped += drops - last_kernel_drops_;
+      push_event(BusEvent{BusEvent::Kind::kRxOverflow, state_, drops - last_kernel_drops_, t_ns});
+      last_kernel_drops_ = drops;
     }
     if ((kf.can_id & CAN_ERR_FLAG) != 0) {
       ++counters_.error_frames;

@@ -8,7 +8,12 @@
 ///   warning, error passive, bus-off, restarted, other error classes;
 /// - a full transmit queue (ENOBUFS/EAGAIN) is counted and reported as an
 ///   event, never fatal;
-/// - kernel receive timestamps kept (SO_TIMESTAMPNS) in TimedFrame::t_ns;
+/// - kernel receive timestamps (SO_TIMESTAMPNS) in TimedFrame::t_ns, on
+///   CLOCK_MONOTONIC by default: the kernel stamps CAN frames with
+///   CLOCK_REALTIME, and receive() converts each stamp with the offset
+///   between the two clocks read at that call, so a frame's time compares
+///   with the cycle's clock (DESIGN.md, "Clocks"). `set_rx_clock(kRealtime)`
+///   keeps the kernel's stamps (candump-compatible times for a trace tool);
 /// - kernel drop counter (SO_RXQ_OVFL) reported as kRxOverflow.
 ///
 /// `open` is not realtime-safe (it allocates and makes system calls);
@@ -28,6 +33,12 @@ namespace canmotion::can {
 
 class SocketCanBus final : public Transport {
  public:
+  /// The clock of TimedFrame::t_ns for received frames and of BusEvent::t_ns.
+  enum class RxClock : std::uint8_t {
+    kMonotonic,  ///< CLOCK_MONOTONIC (default): the clock the cyclic executive runs on
+    kRealtime,   ///< CLOCK_REALTIME as stamped by the kernel (what candump prints)
+  };
+
   /// Largest number of filters accepted by open() (the kernel allows more;
   /// 2 per node for 127 nodes plus NMT/SYNC/EMCY covers any CANopen bus).
   static constexpr std::size_t kMaxFilters = 512;
@@ -56,6 +67,11 @@ class SocketCanBus final : public Transport {
   [[nodiscard]] BusCounters counters() const noexcept override { return counters_; }
   [[nodiscard]] std::string_view name() const noexcept override { return name_; }
 
+  /// Choose the clock of the receive stamps (default kMonotonic). Not realtime
+  /// relevant: call it once after open().
+  void set_rx_clock(RxClock c) noexcept { rx_clock_ = c; }
+  [[nodiscard]] RxClock rx_clock() const noexcept { return rx_clock_; }
+
   /// The socket, for poll()/epoll in non-RT tools that want to block.
   [[nodiscard]] int fd() const noexcept { return fd_; }
   /// errno of the last failed send (0 if none). Realtime-safe.
@@ -76,6 +92,7 @@ class SocketCanBus final : public Transport {
   BusState state_ = BusState::kErrorActive;
   BusCounters counters_{};
   int last_errno_ = 0;
+  RxClock rx_clock_ = RxClock::kMonotonic;
   std::uint32_t last_kernel_drops_ = 0;
   std::array<BusEvent, kEventCapacity> events_{};
   std::size_t ev_head_ = 0;  // next to read

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <linux/can/error.h>
 
+#include <time.h>
+
 #include <array>
 
 #include "fieldbus/can/socketcan_bus.hpp"
@@ -85,6 +87,64 @@ TEST_F(ErrorFrames, OtherClassesAndRingOverflow) {
   std::array<BusEvent, 128> all{};
   EXPECT_EQ(bus_->poll_events(all), SocketCanBus::kEventCapacity);
   EXPECT_EQ(all[0].t_ns, 100 - static_cast<std::int64_t>(SocketCanBus::kEventCapacity));  // oldest dropped
+}
+
+// One clock domain (DESIGN.md, "Clocks"): a received frame's t_ns lies on
+// CLOCK_MONOTONIC between the send and the receive (the kernel stamps with
+// CLOCK_REALTIME; SocketCanBus converts). With the realtime stamps the
+// master's timeouts compared a ~1.7e18 ns time with a ~1e10 ns one.
+std::int64_t now_ns(clockid_t id) {
+  timespec ts{};
+  clock_gettime(id, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+class ReceiveStamps : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::error_code ec;
+    tx_ = SocketCanBus::open("vcan0", {}, ec);
+    rx_ = SocketCanBus::open("vcan0", {}, ec);
+    if (!tx_ || !rx_) GTEST_SKIP() << "no vcan0 here (" << ec.message() << "); covered in the vcan test run";
+  }
+  /// Send one frame on tx_, read it on rx_ (bounded wait); its stamp and the
+  /// clock `id` read just before sending and just after receiving.
+  void round_trip(clockid_t id, std::int64_t& before, std::int64_t& stamp, std::int64_t& after) {
+    std::array<TimedFrame, 4> got{};
+    while (rx_->receive(got) > 0) {
+    }
+    before = now_ns(id);
+    ASSERT_EQ(tx_->send(Frame{0x123, {1, 2}}), SendResult::kOk);
+    std::size_t n = 0;
+    for (int i = 0; i < 2000 && n == 0; ++i) {
+      n = rx_->receive(got);
+      if (n == 0) {
+        timespec ms{0, 1'000'000};
+        nanosleep(&ms, nullptr);
+      }
+    }
+    after = now_ns(id);
+    ASSERT_EQ(n, 1u) << "the frame did not come back on vcan0";
+    EXPECT_EQ(got[0].frame.id, 0x123u);
+    stamp = got[0].t_ns;
+  }
+  std::unique_ptr<SocketCanBus> tx_, rx_;
+};
+
+TEST_F(ReceiveStamps, AreOnTheMonotonicClockByDefault) {
+  EXPECT_EQ(rx_->rx_clock(), SocketCanBus::RxClock::kMonotonic);
+  std::int64_t before = 0, stamp = 0, after = 0;
+  round_trip(CLOCK_MONOTONIC, before, stamp, after);
+  EXPECT_GE(stamp, before - 1'000'000) << "stamp " << stamp << " is not CLOCK_MONOTONIC (" << before << ".." << after << ")";
+  EXPECT_LE(stamp, after + 1'000'000) << "stamp " << stamp << " is not CLOCK_MONOTONIC (" << before << ".." << after << ")";
+}
+
+TEST_F(ReceiveStamps, RealtimeOnRequest) {
+  rx_->set_rx_clock(SocketCanBus::RxClock::kRealtime);
+  std::int64_t before = 0, stamp = 0, after = 0;
+  round_trip(CLOCK_REALTIME, before, stamp, after);
+  EXPECT_GE(stamp, before - 1'000'000);
+  EXPECT_LE(stamp, after + 1'000'000);
 }
 
 }  // namespace canmotion::can

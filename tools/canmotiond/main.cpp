@@ -72,9 +72,10 @@ class Outputs {
     writer_.emplace(std::move(wc));
     rt.controller->set_trace(writer_->tracing());
     rt.controller->set_telemetry(writer_->recording_csv());
-    // Real time: transmit records and simulated buses carry CLOCK_MONOTONIC,
-    // SocketCAN receive stamps CLOCK_REALTIME; put all on the realtime scale
-    // like candump. In --sim every stamp is virtual time.
+    // Real time: every record carries CLOCK_MONOTONIC (transmitted frames
+    // the cycle's time, SocketCAN receive stamps converted by SocketCanBus);
+    // put all on the realtime scale like candump. In --sim every stamp is
+    // virtual time.
     if (!o.sim) {
       timespec m{}, r{};
       clock_gettime(CLOCK_MONOTONIC, &m);
@@ -89,9 +90,7 @@ class Outputs {
     // The RT thread only pushed records; the writer formats them (no stdio).
     rt::TraceRecord tr;
     while (c.pop_trace(tr)) {
-      std::int64_t t = tr.frame.t_ns;
-      if (tr.tx || !rt_.is_socket[tr.bus]) t += mono_to_real_;  // 0 in --sim
-      writer_->trace(tr.frame.frame, t, tr.bus);
+      writer_->trace(tr.frame.frame, tr.frame.t_ns + mono_to_real_, tr.bus);  // 0 in --sim
     }
     rt::Sample s;
     while (c.pop_sample(s)) writer_->sample(s);

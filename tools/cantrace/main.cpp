@@ -388,6 +388,7 @@ int App::read_live() {
     std::fprintf(stderr, "cantrace: --live %s: %s\n", opt_.live.c_str(), detail.empty() ? ec.message().c_str() : detail.c_str());
     return 1;
   }
+  bus->set_rx_clock(can::SocketCanBus::RxClock::kRealtime);  // times as candump prints them
   Bus* b = bus_for(opt_.live);
   fmt_opt_.has_time = true;
   std::fprintf(stderr, "cantrace: listening on %s (CTRL-C stops)\n", opt_.live.c_str());
