@@ -184,9 +184,39 @@ Planner::Planner(double cycle_period) noexcept : T_(cycle_period > 0 ? cycle_per
   init_instruction_tables();  // operand positions, looked up once outside the cycle
 }
 
-std::uint32_t Planner::reset_grace_cycles() const noexcept {
-  // 100 ms (at least 3 cycles) for the drive to leave Fault after a reset
-  return std::max<std::uint32_t>(3, static_cast<std::uint32_t>(0.1 / T_));
+bool Planner::begin_fault_reset(const Request& r, AxisRt& a) noexcept {
+  a.faulted = false;
+  a.tag.exception_faults = 0;
+  a.tag.motion_fault_status = 0;
+  if (a.cfg.type != AxisType::CipDrive) return true;
+  a.fault_reset_pulse = true;
+  const bool clear = a.fb.link == DriveLink::Up && a.fb.drive != DriveState::Fault && !a.fb.drive_fault && !a.fb.node_lost;
+  if (clear) return true;
+  // The drive acts on the reset this cycle (the pulse goes out with this
+  // cycle's RPDO); DN when its feedback shows it left Fault.
+  if (a.reset != kNoControl && a.reset != r.control)
+    if (ControlTag* old = owner_tag(a.reset, a.reset_gen)) old->reject(Err::ServoMessageFailure, 16);
+  a.reset = r.control;
+  a.reset_gen = controls_[r.control].generation;
+  a.reset_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+  return false;
+}
+
+void Planner::end_fault_reset(AxisRt& a, bool ok) noexcept {
+  const ControlId ctl = a.reset;
+  const std::uint32_t gen = a.reset_gen;
+  a.reset = kNoControl;
+  ControlTag* c = owner_tag(ctl, gen);
+  if (!c) return;
+  if (!ok) {
+    c->reject(Err::ServoMessageFailure, 16);  // device in wrong state
+    for (std::size_t i = 0; i < axis_count_; ++i)  // MGSR: the other axes stop waiting
+      if (axes_[i].reset == ctl && axes_[i].reset_gen == gen) axes_[i].reset = kNoControl;
+    return;
+  }
+  for (std::size_t i = 0; i < axis_count_; ++i)  // MGSR: DN with the last axis
+    if (axes_[i].reset == ctl && axes_[i].reset_gen == gen) return;
+  c->set(flag::DN, true);
 }
 
 bool Planner::configure_axis(AxisId id, const AxisConfig& cfg) noexcept {
@@ -456,6 +486,10 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
 Err Planner::common_checks(const AxisRt& a, bool need_servo) const noexcept {
   if (!a.present || !a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  // A CIP drive that refused its configuration or never answered: the axis
+  // is not configured (Logix Axis Configuration State not "configured").
+  if (a.cfg.type == AxisType::CipDrive && (a.fb.link == DriveLink::ConfigFailed || a.fb.link == DriveLink::NoModule))
+    return Err::AxisNotConfigured;
   if (a.shutdown) return Err::ShutdownState;
   if (a.faulted) return Err::AxisInFaultedState;
   if (need_servo && !a.servo) return Err::ServoOffState;
@@ -608,12 +642,9 @@ Err Planner::start_masr(const Request& r, AxisRt& a) noexcept {
 Err Planner::start_mafr(const Request& r, AxisRt& a) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
-  a.faulted = false;
-  a.tag.exception_faults = 0;
-  a.tag.motion_fault_status = 0;
-  a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
-  a.reset_grace = a.fault_reset_pulse ? reset_grace_cycles() : 0;
-  controls_[r.control].set(flag::DN, true);
+  // CIP: the drive's fault reset goes out this cycle; DN once the drive has
+  // left Fault (and is connected again after a lost node or a reboot).
+  if (begin_fault_reset(r, a)) controls_[r.control].set(flag::DN, true);
   return Err::None;
 }
 
@@ -1050,14 +1081,15 @@ Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mo
         do_shutdown(a);
       } else {
         a.shutdown = false;
-        a.faulted = false;
-        a.tag.exception_faults = 0;
-        a.tag.motion_fault_status = 0;
-        a.fault_reset_pulse = a.cfg.type == AxisType::CipDrive;
-        a.reset_grace = a.fault_reset_pulse ? reset_grace_cycles() : 0;
+        (void)begin_fault_reset(r, a);
       }
     }
-    c.set(flag::DN, true);
+    // MGSR: DN when every CIP drive of the group has left Fault (the last
+    // end_fault_reset sets it), at once if none has to.
+    bool waiting = false;
+    for (std::size_t i = 0; i < axis_count_; ++i)
+      waiting = waiting || (axes_[i].reset == r.control && axes_[i].reset_gen == c.generation);
+    if (!waiting) c.set(flag::DN, true);
     return Err::None;
   }
   bool ramping = false;
@@ -1105,6 +1137,19 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
     a.fb_pos = fb->position;
     a.fb_vel = fb->velocity;
   }
+  const bool link_failed = a.fb.link == DriveLink::ConfigFailed || a.fb.link == DriveLink::NoModule;
+  // pending fault reset (MAFR, MASR, MGSR), judged on feedback given after
+  // the pulse went out (the runtime acts on it: clears its failure, retries
+  // a failed boot)
+  if (a.reset != kNoControl && !a.fault_reset_pulse) {
+    if (!owner_tag(a.reset, a.reset_gen)) {
+      a.reset = kNoControl;
+    } else if (a.fb.link == DriveLink::Up && a.fb.drive != DriveState::Fault && !a.fb.drive_fault && !a.fb.node_lost) {
+      end_fault_reset(a, true);
+    } else if (link_failed || a.fb.transition_timeout || cycle_ >= a.reset_deadline) {
+      end_fault_reset(a, false);
+    }
+  }
   // pending MSO
   if (a.mso != kNoControl) {
     ControlTag* c = owner_tag(a.mso, a.mso_gen);
@@ -1117,7 +1162,9 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
       c->state = 1;
       c->set(flag::DN, true);
       a.mso = kNoControl;
-    } else if (a.fb.drive == DriveState::Fault || cycle_ >= a.mso_deadline) {
+    } else if ((a.fb.drive == DriveState::Fault && a.reset == kNoControl) || link_failed || a.fb.transition_timeout ||
+               cycle_ >= a.mso_deadline) {
+      // (a drive still in Fault while a fault reset waits for it: wait too)
       c->reject(Err::ServoMessageFailure, 16);
       a.enable_req = false;
       a.mso = kNoControl;
@@ -1144,7 +1191,7 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
       a.servo = true;
       a.mds_waiting = false;
       if (c) { c->state = 1; c->set(flag::DN, true); }
-    } else if (a.fb.drive == DriveState::Fault || cycle_ >= a.mso_deadline) {
+    } else if (a.fb.drive == DriveState::Fault || link_failed || a.fb.transition_timeout || cycle_ >= a.mso_deadline) {
       a.mds_waiting = false;
       end_direct(a, false);
       a.enable_req = false;
@@ -1173,7 +1220,7 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
       a.base = a.fb_pos;
       a.cmd = Kin{a.fb_pos, 0, 0};
       if (c) { c->set(flag::IP, false); c->set(flag::PC, true); }
-    } else if (a.fb.homing_error) {
+    } else if (a.fb.homing_error || link_failed) {
       a.homing = false;
       a.base = a.fb_pos;
       if (c) { c->set(flag::IP, false); c->reject(Err::ServoMessageFailure, 16); }
@@ -1194,10 +1241,11 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
   auto bit = [](ExceptionKind k) { return 1u << static_cast<unsigned>(k); };
   if (a.cfg.type == AxisType::CipDrive) {
     const bool drive_fault = a.fb.drive_fault || a.fb.drive == DriveState::Fault;
-    // after a fault reset the drive needs a few cycles to leave Fault
-    if (a.reset_grace > 0) a.reset_grace = drive_fault ? a.reset_grace - 1 : 0;
-    if (drive_fault && a.reset_grace == 0) active |= bit(ExceptionKind::DriveFault);
-    if (a.fb.node_lost) active |= bit(ExceptionKind::NodeLost);
+    // while a fault reset waits for the drive to leave Fault (or to come
+    // back), its conditions are not latched again; they are if it fails
+    const bool resetting = a.reset != kNoControl;
+    if (drive_fault && !resetting) active |= bit(ExceptionKind::DriveFault);
+    if (a.fb.node_lost && !resetting) active |= bit(ExceptionKind::NodeLost);
     if (a.fb.bus_off) active |= bit(ExceptionKind::BusOff);
     if (a.servo && a.cfg.position_error_tolerance > 0 &&
         std::fabs(a.cmd.p - a.fb_pos) > a.cfg.position_error_tolerance)
@@ -1208,10 +1256,17 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
     if (p > a.cfg.soft_limit_pos) active |= bit(ExceptionKind::SoftOvertravelPos);
     if (p < a.cfg.soft_limit_neg) active |= bit(ExceptionKind::SoftOvertravelNeg);
   }
+  // A drive that refused its configuration or never answered (not latched:
+  // it shows while the condition lasts; MAFR retries the drive's boot).
+  std::uint32_t link_fault = 0;
+  if (a.cfg.type == AxisType::CipDrive) {
+    if (a.fb.link == DriveLink::ConfigFailed) link_fault = 1u << axis_fault::ConfigFault;
+    if (a.fb.link == DriveLink::NoModule) link_fault = 1u << axis_fault::ModuleFault;
+  }
   if (active == 0 && a.tag.exception_faults == 0) {  // the usual case: what the code below gives then
     a.tag.exception_alarms = 0;
     a.tag.motion_alarm_status = 0;
-    a.tag.axis_fault = 0;
+    a.tag.axis_fault = link_fault;
     return;
   }
   std::uint32_t alarms = 0, faults = 0;
@@ -1263,7 +1318,7 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
   if (f & (bit(ExceptionKind::DriveFault) | bit(ExceptionKind::PositionError))) af |= 1u << axis_fault::PhysicalAxisFault;
   if (f & (bit(ExceptionKind::NodeLost) | bit(ExceptionKind::BusOff))) af |= 1u << axis_fault::ModuleFault;
   if (f & (bit(ExceptionKind::SoftOvertravelPos) | bit(ExceptionKind::SoftOvertravelNeg))) af |= 1u << axis_fault::MotionFault;
-  a.tag.axis_fault = af;
+  a.tag.axis_fault = af | link_fault;
 }
 
 // Called once per axis per cycle from update() only: inlined there.

@@ -56,6 +56,16 @@ enum class DriveState : std::uint8_t {
   Fault = 3,     ///< fault or fault reaction active
 };
 
+/// The drive's connection as the runtime reports it for an AXIS_CIP_DRIVE
+/// (Logix: the module connection and the axis configuration sent to the drive;
+/// CANopen: boot-up, the SDO configuration, NMT start, cyclic data flowing).
+enum class DriveLink : std::uint8_t {
+  Up = 0,            ///< configured and exchanging cyclic data
+  Configuring = 1,   ///< booting or being configured (at start, or again after a drive reset)
+  ConfigFailed = 2,  ///< the drive refused its configuration: AxisFault.ConfigFault; MSO, MAH, MDS get ERR 11
+  NoModule = 3,      ///< the drive never answered (no boot-up, no cyclic data): AxisFault.ModuleFault; ERR 11
+};
+
 /// CiA 402 mode the drive should run (0x6060).
 enum class DriveMode : std::int8_t { Homing = 6, CyclicPosition = 8, CyclicVelocity = 9, CyclicTorque = 10 };
 
@@ -70,6 +80,11 @@ struct AxisFeedback {
   bool bus_off = false;       ///< the CAN interface is bus-off
   bool homing_attained = false;  ///< statusword bit 12 in homing mode
   bool homing_error = false;     ///< statusword bit 13 in homing mode
+  DriveLink link = DriveLink::Up;
+  /// The drive did not make a requested state transition within the
+  /// runtime's transition timeout (enabling, fault reset): a pending MSO,
+  /// MDS or MAFR/MASR/MGSR ends with ERR 12 at once.
+  bool transition_timeout = false;
 };
 
 /// Homing parameters to write before starting drive homing (mode 6).
@@ -364,7 +379,12 @@ class Planner {
     bool faulted = false;       ///< StopDrive/Shutdown fault latched: ERR 20 until MAFR/MASR
     bool homed = false;
     bool fault_reset_pulse = false;
-    std::uint32_t reset_grace = 0;  ///< cycles during which a drive fault is not re-latched after a fault reset
+    /// MAFR/MASR/MGSR on a CIP drive: DN when the drive has left Fault and is
+    /// connected, ER on a transition timeout or kDriveTimeout. While it waits,
+    /// the drive fault and lost node conditions are not latched again.
+    ControlId reset = kNoControl;
+    std::uint32_t reset_gen = 0;
+    std::uint64_t reset_deadline = 0;
     std::array<Generator, kSlots> gen{};
     /// Bit per Slot: the slot holds a generator (not std::monostate). Kept by
     /// set_slot() and fold(), the only writers of `gen`, so that the cycle
@@ -453,7 +473,11 @@ class Planner {
   void step_axis(AxisRt& a, AxisOutput* out) noexcept;
   void step_gear(GearGen& g) noexcept;
   void compute_order() noexcept;
-  std::uint32_t reset_grace_cycles() const noexcept;
+  /// The fault reset of MAFR/MASR/MGSR on axis `a` (control tag of request r):
+  /// pulse the drive's fault reset; DN now unless a CIP drive still has to
+  /// leave Fault or reconnect (then AxisRt::reset waits). Returns whether it is done.
+  bool begin_fault_reset(const Request& r, AxisRt& a) noexcept;
+  void end_fault_reset(AxisRt& a, bool ok) noexcept;
   void handle_feedback(AxisId id, AxisRt& a, const AxisFeedback* fb) noexcept;
   void handle_exceptions(AxisRt& a) noexcept;
   void fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept;
