@@ -65,8 +65,34 @@ std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
   return w;
 }
 
-cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s) {
+namespace {
+/// The `direct_control:` key behind one of direct_control_writes()'s objects.
+std::string direct_control_key(const cia402::SdoWrite& w) {
+  namespace obj = cia402::obj;
+  switch (w.index) {
+    case obj::kProfileAcceleration: return "direct_control.ramp.acceleration";
+    case obj::kProfileDeceleration: return "direct_control.ramp.deceleration";
+    case obj::kRampVelocityLimit:
+      return w.sub == obj::kRampVelocityPositiveSub ? "direct_control.ramp.velocity_positive"
+                                                    : "direct_control.ramp.velocity_negative";
+    case obj::kRampJerkControl: return "direct_control.ramp.jerk_control";
+    case obj::kSlatConfiguration: return "direct_control.slat.configuration";
+    case obj::kSlatSetPoint: return "direct_control.slat.set_point";
+    case obj::kSlatTimeDelay: return "direct_control.slat.time_delay_ms";
+    default: return "direct_control";
+  }
+}
+}  // namespace
+
+cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s, std::size_t axis_index) {
   cia402::DriveConfig d;
+  const std::string axis = fmt::format("axes[{}]", axis_index);
+  // Keys under `drive:` may also come from the `drives:` defaults.
+  auto drive_key = [&](std::string_view k) { return fmt::format("{}.drive.{} (or drives.{})", axis, k, k); };
+  d.hints.interpolation_period = "controller.period_ms";
+  d.hints.pdo = drive_key("pdo");
+  d.hints.producer_heartbeat = drive_key("heartbeat_ms");
+  d.hints.consumer_heartbeat = drive_key("master_heartbeat_timeout_ms");
   d.node = a.node;
   d.mode = cia402::Mode::kCsp;
   d.cycle_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));
@@ -81,11 +107,18 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
     cia402::SdoWrite w = od_write(cia402::obj::kFollowingErrorWindow, 0);
     w.value = a.drive.following_error_window;
     d.extra_writes.push_back(w);
+    d.hints.extra.push_back(drive_key("following_error_window") + " (0 leaves it out)");
   }
   d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
-  for (const cia402::SdoWrite& w : direct_control_writes(a)) d.extra_writes.push_back(w);
-  for (const SdoWrite& w : a.drive.sdo_writes)
+  for (const cia402::SdoWrite& w : direct_control_writes(a)) {
+    d.extra_writes.push_back(w);
+    d.hints.extra.push_back(fmt::format("{}.{}", axis, direct_control_key(w)));
+  }
+  for (std::size_t i = 0; i < a.drive.sdo_writes.size(); ++i) {
+    const SdoWrite& w = a.drive.sdo_writes[i];
     d.extra_writes.push_back({w.index, w.sub, w.size, static_cast<std::uint32_t>(static_cast<std::int64_t>(w.value))});
+    d.hints.extra.push_back(fmt::format("{}.drive.sdo_writes[{}] (line {})", axis, i, w.where.line));
+  }
   return d;
 }
 
@@ -140,7 +173,7 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       std::size_t bi = 0;
       while (bi < cfg.buses.size() && cfg.buses[bi].name != a.bus) ++bi;
       as.bus = static_cast<int>(bi);
-      as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s);
+      as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s, spec.axes.size());
       if (force_sim || cfg.buses[bi].is_sim()) {
         // The simulated bus index equals the bus index: every simulated bus was added in order.
         std::size_t sim_index = 0;

@@ -32,8 +32,11 @@ struct Runtime {
 [[nodiscard]] Runtime build_runtime(const Config& cfg, bool force_sim);
 
 /// The master-side drive configuration of a CIP axis (timeouts in ns, extra
-/// SDO writes, heartbeats, PDO profile), for the controller's period.
-[[nodiscard]] cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s);
+/// SDO writes, heartbeats, PDO profile), for the controller's period. The
+/// write hints name the YAML keys behind each boot write (`axes[axis_index]...`),
+/// for the message when the drive refuses one.
+[[nodiscard]] cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s,
+                                               std::size_t axis_index = 0);
 
 /// The SDO writes of an axis's `direct_control:` (ramps 0x6083, 0x6084,
 /// 0x2010:1/2, 0x2011; SLAT 0x2020..0x2022) in drive units; empty without one.

@@ -91,7 +91,7 @@ void Master::set_heartbeat_timeout(std::uint8_t node, std::int64_t timeout_ns, s
   if (st.last_heartbeat_ns < now_ns) st.last_heartbeat_ns = now_ns;  // the timer starts now
 }
 
-void Master::step_timers(std::int64_t now_ns, FrameSink& out) noexcept {
+void Master::produce_heartbeat(std::int64_t now_ns, FrameSink& out) noexcept {
   if (cfg_.heartbeat_period_ms > 0) {
     if (!heartbeat_started_ || now_ns >= next_heartbeat_ns_) {
       // The master is always operational while it runs the cycle.
@@ -102,6 +102,9 @@ void Master::step_timers(std::int64_t now_ns, FrameSink& out) noexcept {
       heartbeat_started_ = true;
     }
   }
+}
+
+void Master::check_heartbeats(std::int64_t now_ns) noexcept {
   for (NodeStatus& st : nodes_) {
     if (st.heartbeat_timeout_ns > 0 && !st.lost && now_ns - st.last_heartbeat_ns > st.heartbeat_timeout_ns) {
       st.lost = true;
@@ -128,10 +131,19 @@ void Master::send_sync(FrameSink& out) noexcept {
 
 void Master::send_nmt(NmtCommand cs, std::uint8_t node, FrameSink& out) noexcept {
   out.send(make_nmt_frame(cs, node));
-  if (node == 0) {
-    for (NodeStatus& st : nodes_) st.booted = false;
-  } else if (has_node(node) && (cs == NmtCommand::kResetNode || cs == NmtCommand::kResetCommunication)) {
-    nodes_[static_cast<std::size_t>(slot_[node])].booted = false;
+  NmtState commanded = NmtState::kUnknown;
+  switch (cs) {
+    case NmtCommand::kStart: commanded = NmtState::kOperational; break;
+    case NmtCommand::kStop: commanded = NmtState::kStopped; break;
+    case NmtCommand::kEnterPreOperational: commanded = NmtState::kPreOperational; break;
+    default: break;  // resets: the node boots (boot-up), then is pre-operational on its own
+  }
+  const bool reset = cs == NmtCommand::kResetNode || cs == NmtCommand::kResetCommunication;
+  for (NodeStatus& st : nodes_) {
+    if (node != 0 && st.node != node) continue;
+    st.commanded = commanded;
+    // (a node-0 command of any kind has always cleared `booted`; kept so)
+    if (node == 0 || reset) st.booted = false;
   }
 }
 

@@ -57,6 +57,10 @@ struct NodeStatus {
   bool seen = false;         ///< any boot-up or heartbeat received
   bool booted = false;       ///< a boot-up message was received
   bool lost = false;         ///< heartbeat consumer timed out (and not recovered)
+  /// The NMT state this master last commanded (start: operational, stop:
+  /// stopped, enter pre-operational), kUnknown before any or after a reset:
+  /// a heartbeat showing it is expected, any other change is the node's own.
+  NmtState commanded = NmtState::kUnknown;
   std::int64_t last_heartbeat_ns = 0;
   std::int64_t heartbeat_timeout_ns = 0;  ///< 0 = not monitored
   std::uint64_t boot_ups = 0;
@@ -90,7 +94,16 @@ class Master {
     step_sdo(now_ns, out);
   }
   /// Heartbeat production and heartbeat consumer timeouts only.
-  void step_timers(std::int64_t now_ns, FrameSink& out) noexcept;
+  void step_timers(std::int64_t now_ns, FrameSink& out) noexcept {
+    produce_heartbeat(now_ns, out);
+    check_heartbeats(now_ns);
+  }
+  /// The master's own heartbeat, when it is due.
+  void produce_heartbeat(std::int64_t now_ns, FrameSink& out) noexcept;
+  /// Heartbeat consumer timeouts: a node is lost (kHeartbeatLost, once) when
+  /// `now_ns` is more than its timeout after its last heartbeat's receive
+  /// time. Both on the cycle's clock (TimedFrame::t_ns). Idempotent within a cycle.
+  void check_heartbeats(std::int64_t now_ns) noexcept;
   /// Step every SDO client (start queued transfers, timeouts).
   void step_sdo(std::int64_t now_ns, FrameSink& out) noexcept;
   /// Send one SYNC (with the counter if configured). Call once per cycle,

@@ -14,8 +14,39 @@ namespace canmotion::cia402 {
 
 namespace {
 
-void put_u32(SdoWrite& w, std::uint16_t index, std::uint8_t sub, std::uint8_t size, std::uint32_t value) {
-  w = SdoWrite{index, sub, size, value};
+/// Aborts by which a drive says it has no such PDO (CiA 301: the
+/// communication or mapping object, or the sub-index, does not exist): fine
+/// for a PDO the master does not use.
+constexpr bool no_such_pdo(canopen::SdoAbort a) noexcept {
+  return a == canopen::SdoAbort::kNoObject || a == canopen::SdoAbort::kNoSubindex;
+}
+
+/// The sentence that follows a refused write in Failure::describe: where its
+/// value comes from (`key`, may be null) and what to do.
+int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key) noexcept {
+  const bool k = key != nullptr && key[0] != '\0';
+  switch (origin) {
+    case WriteOrigin::kMode:
+      return std::snprintf(out, size, "; canmotiond runs every drive in a cyclic synchronous mode (0x6060 = 8, 9 or 10): "
+                                      "the drive must accept it");
+    case WriteOrigin::kInterpolationPeriod:
+      return std::snprintf(out, size, "; 0x60C2 is the cycle period%s%s: the drive must accept it in cyclic synchronous modes",
+                           k ? ", " : "", k ? key : "");
+    case WriteOrigin::kPdo:
+      return std::snprintf(out, size, "; the PDO mapping comes from %s: the drive must accept it (see fieldbus/README.md, PDO mapping)",
+                           k ? key : "the drive's PDO profile");
+    case WriteOrigin::kUnusedPdo:
+      return std::snprintf(out, size, "; canmotiond writes the PDOs it does not use invalid (a drive without that PDO may "
+                                      "answer 0x06020000 or 0x06090011, which is accepted)");
+    case WriteOrigin::kProducerHeartbeat:
+      return std::snprintf(out, size, "; the drive's heartbeat period comes from %s", k ? key : "the drive configuration");
+    case WriteOrigin::kConsumerHeartbeat:
+      return k ? std::snprintf(out, size, "; to leave this write out (the drive then does not watch the master's heartbeat) set %s: 0", key)
+               : std::snprintf(out, size, "; set the drive's consumer_heartbeat_ms to 0 to leave this write out");
+    case WriteOrigin::kExtra:
+      return std::snprintf(out, size, "; the write comes from %s: correct or remove it", k ? key : "the extra configuration writes");
+  }
+  return 0;
 }
 }  // namespace
 
@@ -42,12 +73,18 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                         node, waited_ms, static_cast<double>(timeout_ns) / 1e6);
       break;
     case FailureKind::kSdoAbort: {
-      const auto name = canopen::object_name(sdo_index, sdo_sub);
+      auto name = canopen::object_name(sdo_index, sdo_sub);
+      if (name.empty()) name = "an object canmotion does not know";
       const auto text = canopen::sdo_abort_text(sdo_abort);
+      char why[320] = "";
+      write_hint(why, sizeof why, sdo_origin, hint);
       n = std::snprintf(out.data(), out.size(),
-                        "node %u: configuration write to 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms",
+                        "node %u: configuration write to 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms: %s%s",
                         node, sdo_index, sdo_sub, static_cast<int>(name.size()), name.data(), sdo_abort,
-                        static_cast<int>(text.size()), text.data(), waited_ms);
+                        static_cast<int>(text.size()), text.data(), waited_ms,
+                        sdo_abort == static_cast<std::uint32_t>(canopen::SdoAbort::kTimeout) ? "the drive did not answer"
+                                                                                             : "the drive refused it",
+                        why);
       break;
     }
     case FailureKind::kSdoQueueFull:
@@ -89,9 +126,19 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
       break;
     }
     case FailureKind::kUnexpectedBootUp:
-      n = std::snprintf(out.data(), out.size(), "node %u: unexpected boot-up while %.*s (drive reset itself)%s", node,
-                        static_cast<int>(phase_name(phase).size()), phase_name(phase).data(), emcy);
+      n = std::snprintf(out.data(), out.size(),
+                        "node %u: unexpected boot-up while %.*s (the drive reset itself or was power-cycled; it is "
+                        "configured again)%s",
+                        node, static_cast<int>(phase_name(phase).size()), phase_name(phase).data(), emcy);
       break;
+    case FailureKind::kNmtState: {
+      const auto st = canopen::nmt_state_name(nmt_state);
+      n = std::snprintf(out.data(), out.size(),
+                        "node %u: left NMT operational: its heartbeat shows %.*s (no PDOs are exchanged; many drives do "
+                        "this on a communication error, CiA 301 0x1029)%s",
+                        node, static_cast<int>(st.size()), st.data(), emcy);
+      break;
+    }
   }
   if (n < 0) {
     out[0] = '\0';
@@ -153,45 +200,48 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
 
 void DriveProxy::build_configuration() {
   writes_.clear();
-  SdoWrite w;
-  put_u32(w, obj::kModesOfOperation, 0, 1, static_cast<std::uint8_t>(static_cast<std::int8_t>(cfg_.mode)));
-  writes_.push_back(w);
+  auto add = [this](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) { writes_.push_back(BootWrite{w, o, extra}); };
+  add(WriteOrigin::kMode,
+      SdoWrite{obj::kModesOfOperation, 0, 1, static_cast<std::uint8_t>(static_cast<std::int8_t>(cfg_.mode))});
   const auto ip = *encode_interpolation_period(cfg_.cycle_ns);
-  writes_.push_back(SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value});
-  writes_.push_back(SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)});
+  add(WriteOrigin::kInterpolationPeriod, SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value});
+  add(WriteOrigin::kInterpolationPeriod,
+      SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)});
   // PDOs: the CiA 301 procedure for the used ones, COB-ID invalid for PDO 1..4 not used.
-  auto add_map = [this](const canopen::PdoMap& m) {
+  auto add_map = [&](const canopen::PdoMap& m) {
     const std::uint32_t cob = m.cob_id & 0x7FFu;
-    writes_.push_back(SdoWrite{m.comm_index(), 1, 4, cob | canopen::kPdoInvalid});
-    writes_.push_back(SdoWrite{m.map_index(), 0, 1, 0});
+    add(WriteOrigin::kPdo, SdoWrite{m.comm_index(), 1, 4, cob | canopen::kPdoInvalid});
+    add(WriteOrigin::kPdo, SdoWrite{m.map_index(), 0, 1, 0});
     for (std::uint8_t i = 0; i < m.count; ++i)
-      writes_.push_back(SdoWrite{m.map_index(), static_cast<std::uint8_t>(i + 1), 4, m.entries[i].raw()});
-    writes_.push_back(SdoWrite{m.map_index(), 0, 1, m.count});
-    writes_.push_back(SdoWrite{m.comm_index(), 2, 1, m.transmission_type});
-    writes_.push_back(SdoWrite{m.comm_index(), 1, 4, cob});
+      add(WriteOrigin::kPdo, SdoWrite{m.map_index(), static_cast<std::uint8_t>(i + 1), 4, m.entries[i].raw()});
+    add(WriteOrigin::kPdo, SdoWrite{m.map_index(), 0, 1, m.count});
+    add(WriteOrigin::kPdo, SdoWrite{m.comm_index(), 2, 1, m.transmission_type});
+    add(WriteOrigin::kPdo, SdoWrite{m.comm_index(), 1, 4, cob});
   };
   for (std::uint8_t n = 1; n <= 4; ++n) {
     if (n <= pdos_.rpdo_count) {
       add_map(pdos_.rpdo[n - 1]);
     } else {
-      writes_.push_back(SdoWrite{static_cast<std::uint16_t>(0x1400 + n - 1), 1, 4,
-                                 canopen::cob::rpdo(n, cfg_.node) | canopen::kPdoInvalid});
+      add(WriteOrigin::kUnusedPdo, SdoWrite{static_cast<std::uint16_t>(0x1400 + n - 1), 1, 4,
+                                            canopen::cob::rpdo(n, cfg_.node) | canopen::kPdoInvalid});
     }
   }
   for (std::uint8_t n = 1; n <= 4; ++n) {
     if (n <= pdos_.tpdo_count) {
       add_map(pdos_.tpdo[n - 1]);
     } else {
-      writes_.push_back(SdoWrite{static_cast<std::uint16_t>(0x1800 + n - 1), 1, 4,
-                                 canopen::cob::tpdo(n, cfg_.node) | canopen::kPdoInvalid});
+      add(WriteOrigin::kUnusedPdo, SdoWrite{static_cast<std::uint16_t>(0x1800 + n - 1), 1, 4,
+                                            canopen::cob::tpdo(n, cfg_.node) | canopen::kPdoInvalid});
     }
   }
-  writes_.push_back(SdoWrite{0x1017, 0, 2, cfg_.producer_heartbeat_ms});
-  const std::uint32_t consumer =
-      cfg_.consumer_heartbeat_ms == 0 ? 0u
-                                      : (static_cast<std::uint32_t>(master_.config().node_id) << 16) | cfg_.consumer_heartbeat_ms;
-  writes_.push_back(SdoWrite{0x1016, 1, 4, consumer});
-  for (const SdoWrite& x : cfg_.extra_writes) writes_.push_back(x);
+  add(WriteOrigin::kProducerHeartbeat, SdoWrite{0x1017, 0, 2, cfg_.producer_heartbeat_ms});
+  // 0x1016 is optional (CiA 301): written only when the drive is to watch
+  // the master's heartbeat.
+  if (cfg_.consumer_heartbeat_ms > 0)
+    add(WriteOrigin::kConsumerHeartbeat,
+        SdoWrite{0x1016, 1, 4, (static_cast<std::uint32_t>(master_.config().node_id) << 16) | cfg_.consumer_heartbeat_ms});
+  for (std::size_t i = 0; i < cfg_.extra_writes.size(); ++i)
+    add(WriteOrigin::kExtra, cfg_.extra_writes[i], static_cast<std::uint16_t>(i));
 }
 
 void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept {
@@ -211,14 +261,38 @@ void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, s
 void DriveProxy::restart() noexcept {
   phase_ = Phase::kWaitBoot;
   started_ = false;
-  next_write_ = done_writes_ = 0;
+  next_write_ = done_writes_ = tolerated_ = 0;
   tpdo_seen_ = expect_tpdo_ = got_tpdo_ = false;
   state_ = State::kUnknown;
   wanted_ = State::kSwitchOnDisabled;
   in_flight_ = false;
+  reset_requested_ = homing_requested_ = false;
   mode_switch_pending_ = false;
+  nmt_left_ = false;
   failure_ = Failure{};
   master_.sdo(cfg_.node).cancel_all();
+}
+
+void DriveProxy::begin_configuration(std::int64_t now_ns) noexcept {
+  master_.sdo(cfg_.node).cancel_all();
+  next_write_ = done_writes_ = tolerated_ = 0;
+  phase_ = Phase::kConfiguring;
+  phase_since_ns_ = now_ns;
+  started_ = true;
+}
+
+void DriveProxy::reboot(std::int64_t now_ns) noexcept {
+  ++reboots_;
+  tpdo_seen_ = expect_tpdo_ = got_tpdo_ = false;
+  state_ = State::kUnknown;
+  wanted_ = State::kSwitchOnDisabled;
+  in_flight_ = false;
+  reset_requested_ = homing_requested_ = false;
+  mode_switch_pending_ = false;
+  nmt_left_ = false;
+  mode_ = cfg_.mode;  // the drive is back to its defaults: configured with the boot mode
+  follow_actual();
+  begin_configuration(now_ns);  // a boot-up leaves the node pre-operational: configure at once
 }
 
 bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
@@ -232,7 +306,12 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
     const std::uint64_t w = canopen::payload_word(f);
     const canopen::PdoPlan& plan = tpdo_plan_[p];
     auto get = [&](const Slot& s) { return plan.get(w, static_cast<std::size_t>(s.entry)); };
-    if (sw_slot_.pdo == p) fb_.statusword = static_cast<std::uint16_t>(get(sw_slot_));
+    if (sw_slot_.pdo == p) {
+      fb_.statusword = static_cast<std::uint16_t>(get(sw_slot_));
+      // The state is this cycle's for whoever reads it before step() (the
+      // controller's feedback to the planner), not the last cycle's.
+      if (phase_ == Phase::kOperational) state_ = decode_state(fb_.statusword);
+    }
     if (pos_slot_.pdo == p) fb_.position = static_cast<std::int32_t>(canopen::sign_extend(get(pos_slot_), 32));
     if (vel_slot_.pdo == p) fb_.velocity = static_cast<std::int32_t>(canopen::sign_extend(get(vel_slot_), 32));
     if (trq_slot_.pdo == p) fb_.torque = static_cast<std::int16_t>(canopen::sign_extend(get(trq_slot_), 16));
@@ -250,26 +329,61 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
 
 void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
   if (e.node != cfg_.node) return;
+  using K = canopen::NodeEvent::Kind;
   switch (e.kind) {
-    case canopen::NodeEvent::Kind::kEmcy:
+    case K::kEmcy:
       if (e.emcy.code != canopen::emcy_code::kNoError) {
         has_emcy_ = true;
         emcy_code_ = e.emcy.code;
       }
       break;
-    case canopen::NodeEvent::Kind::kHeartbeatLost:
-      if (phase_ == Phase::kOperational || phase_ == Phase::kStarting) {
+    case K::kHeartbeatLost:
+      if ((phase_ == Phase::kOperational || phase_ == Phase::kStarting) && !is_boot_failure(failure_.kind)) {
         fail(FailureKind::kHeartbeatLost, e.t_ns, 0, master_.status(cfg_.node).heartbeat_timeout_ns);
       }
       break;
-    case canopen::NodeEvent::Kind::kBootUp:
-      if (phase_ == Phase::kOperational || phase_ == Phase::kStarting || phase_ == Phase::kConfiguring) {
-        fail(FailureKind::kUnexpectedBootUp, e.t_ns, 0, 0);
-        phase_ = Phase::kFailed;
-        expect_tpdo_ = false;
+    case K::kHeartbeatRecovered:
+      // The condition is gone (the planner has latched the axis fault until
+      // MAFR/MASR); a node that rebooted meanwhile is being configured again.
+      if (failure_.kind == FailureKind::kHeartbeatLost) failure_ = Failure{};
+      break;
+    case K::kStateChanged:
+      if (phase_ != Phase::kOperational) break;
+      if ((e.state == canopen::NmtState::kPreOperational || e.state == canopen::NmtState::kStopped) &&
+          e.state != master_.status(cfg_.node).commanded) {  // not the master's own command (controlled stop)
+        nmt_left_ = true;
+        if (failure_.kind == FailureKind::kNone || failure_.kind == FailureKind::kTransitionTimeout) {
+          fail(FailureKind::kNmtState, e.t_ns, 0, 0);
+          failure_.nmt_state = e.state;
+        }
+        expect_tpdo_ = false;  // no PDOs in these states: not counted as missed
+      } else if (e.state == canopen::NmtState::kOperational && nmt_left_) {
+        nmt_left_ = false;  // started again (by another master or tool)
+        if (failure_.kind == FailureKind::kNmtState) failure_ = Failure{};
       }
       break;
-    default: break;
+    case K::kBootUp:
+      switch (phase_) {
+        case Phase::kOperational:
+        case Phase::kStarting:
+          // The drive reset itself or was power-cycled: it lost its enable
+          // and its configuration. Record it (the axis faults) and configure
+          // it again right away, so that MAFR + MSO work once it is back.
+          if (!failed() || failure_.kind == FailureKind::kTransitionTimeout) fail(FailureKind::kUnexpectedBootUp, e.t_ns, 0, 0);
+          reboot(e.t_ns);
+          break;
+        case Phase::kConfiguring:
+          reboot(e.t_ns);  // reset in the middle of its configuration: from the start
+          break;
+        case Phase::kFailed:
+          // A node whose boot failed (no answer, refused write) booted (again):
+          // try again, e.g. after it was repaired or replaced.
+          failure_ = Failure{};
+          reboot(e.t_ns);
+          break;
+        default: break;  // waiting for it: step_boot() sees it
+      }
+      break;
   }
 }
 
@@ -307,11 +421,31 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
       canopen::SdoResult r;
       while (sdo.poll(r)) {
         if (r.tag == kModeWriteTag) continue;
-        if (!r.ok()) {
-          fail(FailureKind::kSdoAbort, now_ns, r.finished_ns - r.started_ns, r.abort == canopen::SdoAbort::kTimeout ? sdo.timeout() : 0);
+        const BootWrite* bw = r.tag < writes_.size() ? &writes_[r.tag] : nullptr;
+        if (!r.ok() && bw != nullptr && bw->origin == WriteOrigin::kUnusedPdo && no_such_pdo(r.abort)) {
+          ++tolerated_;  // the drive has fewer PDOs: fine for one we do not use
+        } else if (!r.ok()) {
+          // Both times are on the cycle's clock (the response's receive stamp, or the timeout's cycle).
+          const std::int64_t waited = r.finished_ns >= r.started_ns ? r.finished_ns - r.started_ns : now_ns - r.started_ns;
+          fail(FailureKind::kSdoAbort, now_ns, waited, r.abort == canopen::SdoAbort::kTimeout ? sdo.timeout() : 0);
           failure_.sdo_index = r.index;
           failure_.sdo_sub = r.sub;
           failure_.sdo_abort = static_cast<std::uint32_t>(r.abort);
+          if (bw != nullptr) {
+            failure_.sdo_origin = bw->origin;
+            const std::string* key = nullptr;
+            switch (bw->origin) {
+              case WriteOrigin::kInterpolationPeriod: key = &cfg_.hints.interpolation_period; break;
+              case WriteOrigin::kPdo: key = &cfg_.hints.pdo; break;
+              case WriteOrigin::kProducerHeartbeat: key = &cfg_.hints.producer_heartbeat; break;
+              case WriteOrigin::kConsumerHeartbeat: key = &cfg_.hints.consumer_heartbeat; break;
+              case WriteOrigin::kExtra:
+                if (bw->extra < cfg_.hints.extra.size()) key = &cfg_.hints.extra[bw->extra];
+                break;
+              default: break;
+            }
+            failure_.hint = key != nullptr && !key->empty() ? key->c_str() : nullptr;
+          }
           sdo.cancel_all();
           phase_ = Phase::kFailed;
           return;
@@ -319,7 +453,7 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
         ++done_writes_;
       }
       while (next_write_ < writes_.size() && sdo.queued() < canopen::SdoClient::kQueueCapacity) {
-        const SdoWrite& w = writes_[next_write_];
+        const SdoWrite& w = writes_[next_write_].w;
         std::uint8_t b[4];
         for (int i = 0; i < 4; ++i) b[i] = static_cast<std::uint8_t>(w.value >> (8 * i));
         if (!sdo.download(w.index, w.sub, std::span<const std::uint8_t>(b, w.size), static_cast<std::uint32_t>(next_write_))) {
@@ -363,7 +497,9 @@ void DriveProxy::follow_actual() noexcept {
 
 void DriveProxy::set_wanted(State s) noexcept {
   wanted_ = s;
-  in_flight_ = false;
+  // A fault reset under way keeps its timing (and its bit 7 edge) when the
+  // target changes, e.g. enable() right after fault_reset().
+  if (!(in_flight_ && flight_.command == Command::kFaultReset && state_ == State::kFault)) in_flight_ = false;
   if (failure_.kind == FailureKind::kTransitionTimeout) failure_ = Failure{};
 }
 
@@ -372,9 +508,19 @@ void DriveProxy::disable() noexcept { set_wanted(State::kSwitchOnDisabled); }
 void DriveProxy::disable_operation() noexcept { set_wanted(State::kSwitchedOn); }
 void DriveProxy::quick_stop() noexcept { set_wanted(State::kQuickStopActive); }
 void DriveProxy::fault_reset() noexcept {
-  set_wanted(State::kSwitchOnDisabled);
+  if (phase_ == Phase::kFailed || nmt_left_ || failure_.kind == FailureKind::kNmtState) {
+    restart();  // boot and configure it again (NMT start included)
+    return;
+  }
+  switch (failure_.kind) {
+    case FailureKind::kHeartbeatLost:
+      if (!master_.status(cfg_.node).lost) failure_ = Failure{};
+      break;  // still lost: the condition stays (the planner's reset waits, then fails)
+    case FailureKind::kNone: break;
+    default: failure_ = Failure{};  // drive fault, mode switch, transition timeout, unexpected boot-up
+  }
   reset_requested_ = true;
-  if (failure_.kind == FailureKind::kDriveFault || failure_.kind == FailureKind::kModeSwitchTimeout) failure_ = Failure{};
+  if (state_ == State::kFault || state_ == State::kFaultReactionActive) set_wanted(State::kSwitchOnDisabled);
 }
 
 bool DriveProxy::start_homing() noexcept {
@@ -407,7 +553,9 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   state_ = decode_state(fb_.statusword);
   const bool faulted = state_ == State::kFault || state_ == State::kFaultReactionActive;
   if (faulted && !reset_requested_) {
-    if (failure_.kind == FailureKind::kNone || failure_.kind == FailureKind::kTransitionTimeout) {
+    // (a fault reset that timed out keeps that failure: it says why the drive is still in Fault)
+    if (failure_.kind == FailureKind::kNone ||
+        (failure_.kind == FailureKind::kTransitionTimeout && failure_.transition != 15)) {
       fail(FailureKind::kDriveFault, now_ns, 0, 0);
     }
     wanted_ = State::kSwitchOnDisabled;
@@ -471,8 +619,11 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   }
   if (plan) {
     if (plan->command == Command::kFaultReset) {
-      // The drive acts on the rising edge of bit 7: one cycle without it first.
-      cw_ = flight_cycles_ == 0 ? std::uint16_t{0} : cia402::controlword(Command::kFaultReset);
+      // The drive acts on the rising edge of bit 7. In Fault the proxy sends
+      // it clear, so the reset goes out in this cycle's RPDO; only when the
+      // last controlword had it set does one cycle without it come first.
+      cw_ = flight_cycles_ == 0 && (cw_ & cw::kFaultReset) != 0 ? std::uint16_t{0}
+                                                               : cia402::controlword(Command::kFaultReset);
     } else {
       cw_ = cia402::controlword(plan->command);
     }
@@ -553,7 +704,7 @@ void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {
   }
 }
 
-void DriveProxy::on_sync_sent() noexcept { expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_; }
+void DriveProxy::on_sync_sent() noexcept { expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_ && !nmt_left_; }
 
 // ============================================================================
 // DriveNetwork
@@ -597,8 +748,8 @@ void DriveNetwork::on_frame(const can::TimedFrame& f) noexcept {
   if (DriveProxy* d = drive(c.node)) d->on_frame(f);
 }
 
-void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
-  master_.step_timers(now_ns, out);
+void DriveNetwork::update(std::int64_t now_ns) noexcept {
+  master_.check_heartbeats(now_ns);
   canopen::NodeEvent e;
   while (master_.poll_event(e)) {
     if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
@@ -607,6 +758,11 @@ void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept 
       ++ev_count_;
     }
   }
+}
+
+void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
+  master_.produce_heartbeat(now_ns, out);
+  update(now_ns);
   for (auto& d : drives_) d->step(now_ns, out);
   // After the proxies so that what they queued this cycle goes out now.
   master_.step_sdo(now_ns, out);

@@ -6,11 +6,14 @@
 ///
 /// Per node: boot (wait for boot-up / heartbeat, or reset the node), SDO
 /// configuration (0x6060 mode, 0x60C2 interpolation period = cycle, PDO
-/// maps by the CiA 301 procedure, heartbeat producer 0x1017 and consumer
-/// 0x1016 watching the master, extra writes), NMT start, then the 402 state
-/// machine through its numbered transitions with a per-node timeout. Until
-/// Operation enabled is reached the targets follow the actual values, so
-/// enabling never jumps. A failure explains itself (Failure::describe).
+/// maps by the CiA 301 procedure, heartbeat producer 0x1017, the consumer
+/// 0x1016 watching the master when asked for, extra writes), NMT start, then
+/// the 402 state machine through its numbered transitions with a per-node
+/// timeout. Until Operation enabled is reached the targets follow the actual
+/// values, so enabling never jumps. A failure explains itself
+/// (Failure::describe). A boot-up while running (the drive reset or was
+/// power-cycled) re-runs the boot and configuration; so does a boot-up of a
+/// node whose boot failed, and fault_reset() after a failed boot.
 ///
 /// Set-up (constructors, add_drive) allocates. on_frame(), step()/cycle(),
 /// the setters and getters are realtime-safe: no allocation, no locks, no
@@ -42,13 +45,36 @@ struct SdoWrite {
   std::uint32_t value = 0;
 };
 
+/// Configuration keys to name when the drive refuses a boot configuration
+/// write (Failure::describe): where the value of each kind of write comes
+/// from, e.g. canmotiond's YAML keys. Empty: nothing is named.
+struct WriteHints {
+  std::string interpolation_period;  ///< 0x60C2, e.g. "controller.period_ms"
+  std::string pdo;                   ///< the PDO mapping, e.g. "axes[0].drive.pdo"
+  std::string producer_heartbeat;    ///< 0x1017, e.g. "axes[0].drive.heartbeat_ms"
+  std::string consumer_heartbeat;    ///< 0x1016:1, e.g. "axes[0].drive.master_heartbeat_timeout_ms" (0 leaves it out)
+  std::vector<std::string> extra;    ///< one per DriveConfig::extra_writes entry, e.g. "axes[0].drive.sdo_writes[1]"
+};
+
+/// What a boot configuration write is for.
+enum class WriteOrigin : std::uint8_t {
+  kMode,                ///< 0x6060
+  kInterpolationPeriod, ///< 0x60C2:1/2
+  kPdo,                 ///< communication or mapping parameter of a PDO the master uses
+  kUnusedPdo,           ///< COB-ID of a PDO the master does not use, written invalid; a drive
+                        ///< without that PDO (abort 0x06020000 / 0x06090011) is fine
+  kProducerHeartbeat,   ///< 0x1017
+  kConsumerHeartbeat,   ///< 0x1016:1
+  kExtra,               ///< DriveConfig::extra_writes
+};
+
 struct DriveConfig {
   std::uint8_t node = 1;
   Mode mode = Mode::kCsp;                  ///< written to 0x6060 at boot
   std::int64_t cycle_ns = 1'000'000;       ///< written to 0x60C2
   PdoProfile pdo_profile = PdoProfile::kCsp;
   std::uint16_t producer_heartbeat_ms = 100;  ///< drive's 0x1017 (0 = off)
-  std::uint16_t consumer_heartbeat_ms = 300;  ///< drive's 0x1016:1, watching the master (0 = off)
+  std::uint16_t consumer_heartbeat_ms = 300;  ///< drive's 0x1016:1, watching the master (0 = not written: 0x1016 is optional)
   std::int64_t heartbeat_timeout_ns = 0;      ///< master-side consumer; 0 = 3 x producer period
   std::vector<SdoWrite> extra_writes;         ///< written after the standard configuration
   std::int64_t boot_timeout_ns = 2'000'000'000;     ///< wait for boot-up/heartbeat before resetting the node
@@ -57,6 +83,7 @@ struct DriveConfig {
   std::int64_t transition_timeout_ns = 500'000'000; ///< per state machine transition
   std::int64_t mode_switch_timeout_ns = 500'000'000; ///< 0x6061 must show a set_mode() request within this; 0 = unchecked
   bool reset_node_first = false;  ///< send NMT reset node instead of waiting for a boot-up first
+  WriteHints hints;               ///< named in the message when a configuration write is refused
 };
 
 /// Where the proxy is in bringing its node up.
@@ -84,7 +111,15 @@ enum class FailureKind : std::uint8_t {
   kHeartbeatLost,      ///< heartbeat consumer timed out
   kUnexpectedBootUp,   ///< the drive rebooted while operational
   kModeSwitchTimeout,  ///< 0x6061 did not show the mode requested in 0x6060 in time (mode_requested / mode_shown)
+  kNmtState,           ///< while operational, the node's heartbeat shows pre-operational or stopped (`nmt_state`)
 };
+
+/// True for the failures of the boot itself (phase kFailed): the node never
+/// booted, refused its configuration, or sent no TPDO after NMT start.
+[[nodiscard]] constexpr bool is_boot_failure(FailureKind k) noexcept {
+  return k == FailureKind::kBootTimeout || k == FailureKind::kSdoAbort || k == FailureKind::kSdoQueueFull ||
+         k == FailureKind::kStartTimeout;
+}
 
 /// A failure with everything needed to explain it.
 struct Failure {
@@ -105,6 +140,11 @@ struct Failure {
   std::int64_t t_ns = 0;                    ///< when it was detected
   std::int8_t mode_requested = 0;           ///< kModeSwitchTimeout: 0x6060 written
   std::int8_t mode_shown = 0;               ///< kModeSwitchTimeout: 0x6061 still shown
+  WriteOrigin sdo_origin = WriteOrigin::kMode;  ///< kSdoAbort: what the write was for
+  /// kSdoAbort: the configuration key the write comes from (WriteHints), or
+  /// nullptr. Points into the DriveProxy's configuration: valid while it lives.
+  const char* hint = nullptr;
+  canopen::NmtState nmt_state = canopen::NmtState::kUnknown;  ///< kNmtState: the state shown
 
   /// One sentence, e.g. "node 2: transition 4 (Switched on -> Operation
   /// enabled) timed out after 500.0 ms: drive is in Switched on, statusword
@@ -158,7 +198,11 @@ class DriveProxy {
   void disable_operation() noexcept;
   /// Quick stop (11).
   void quick_stop() noexcept;
-  /// Reset a fault (15, with the 0 -> 1 edge of bit 7); ends in Switch on disabled.
+  /// Reset a fault and clear the recorded failure: a drive in Fault gets the
+  /// fault reset (15, on the 0 -> 1 edge of bit 7: in the next RPDO, since
+  /// the proxy sends bit 7 clear in Fault) and ends in Switch on disabled; a
+  /// drive that is not in Fault keeps its state. After a failed boot, or a
+  /// node that left NMT operational, the boot and configuration run again.
   void fault_reset() noexcept;
   /// Switch between CSP, CSV, CST and homing (through RPDO2 with
   /// PdoProfile::kCspCsvCst, otherwise an SDO write of 0x6060). The new
@@ -175,7 +219,8 @@ class DriveProxy {
   void set_target_position(std::int32_t counts) noexcept { target_position_ = counts; }
   void set_target_velocity(std::int32_t counts_per_s) noexcept { target_velocity_ = counts_per_s; }
   void set_target_torque(std::int16_t per_mille) noexcept { target_torque_ = per_mille; }
-  /// Restart the boot sequence (after a failure or an unexpected reboot).
+  /// Restart the boot sequence from the start (wait for the node, NMT
+  /// pre-operational if needed, configure, start) and clear the failure.
   void restart() noexcept;
 
   // ---- state --------------------------------------------------------------
@@ -195,6 +240,16 @@ class DriveProxy {
   [[nodiscard]] std::uint16_t controlword() const noexcept { return cw_; }
   [[nodiscard]] const Failure& failure() const noexcept { return failure_; }
   [[nodiscard]] bool failed() const noexcept { return failure_.kind != FailureKind::kNone; }
+  /// The conditions behind the failures, as they are now (the planner latches
+  /// them): the master's heartbeat consumer has the node lost, or the node's
+  /// heartbeat shows it left NMT operational while the proxy runs it.
+  [[nodiscard]] bool heartbeat_lost() const noexcept { return master_.status(cfg_.node).lost; }
+  [[nodiscard]] bool left_operational() const noexcept { return nmt_left_; }
+  /// Configuration writes the drive refused that do not matter (unused PDOs
+  /// it does not have), since the last (re)start of the configuration.
+  [[nodiscard]] std::size_t tolerated_aborts() const noexcept { return tolerated_; }
+  /// Boot-ups seen while running or configuring (each re-ran the configuration).
+  [[nodiscard]] std::uint32_t reboots() const noexcept { return reboots_; }
   /// Clear the recorded failure (the state machine keeps its state).
   void clear_failure() noexcept { failure_ = Failure{}; }
   [[nodiscard]] std::uint16_t last_emcy_code() const noexcept { return emcy_code_; }
@@ -204,6 +259,8 @@ class DriveProxy {
 
  private:
   void build_configuration();
+  void begin_configuration(std::int64_t now_ns) noexcept;  ///< (again) from the first write
+  void reboot(std::int64_t now_ns) noexcept;               ///< the drive reset itself: configure it again
   void fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept;
   void step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
   void step_state_machine(std::int64_t now_ns) noexcept;
@@ -214,9 +271,17 @@ class DriveProxy {
   DriveConfig cfg_;
   canopen::Master& master_;
   DrivePdoSet pdos_;
-  std::vector<SdoWrite> writes_;  // the whole boot configuration, built at set-up
+  struct BootWrite {
+    SdoWrite w;
+    WriteOrigin origin = WriteOrigin::kMode;
+    std::uint16_t extra = 0;  ///< kExtra: index in cfg_.extra_writes
+  };
+  std::vector<BootWrite> writes_;  // the whole boot configuration, built at set-up
   std::size_t next_write_ = 0;
   std::size_t done_writes_ = 0;
+  std::size_t tolerated_ = 0;
+  std::uint32_t reboots_ = 0;
+  bool nmt_left_ = false;  // heartbeat showed pre-operational / stopped while operational
 
   Phase phase_ = Phase::kWaitBoot;
   bool started_ = false;
@@ -280,8 +345,15 @@ class DriveNetwork {
 
   /// Feed one received frame (heartbeat, EMCY, SDO, TPDO). Realtime-safe.
   void on_frame(const can::TimedFrame& f) noexcept;
-  /// One cycle: master step (heartbeat, SDO), events to the proxies, each
-  /// proxy's step (RPDOs), then SYNC. Realtime-safe.
+  /// After the cycle's frames: heartbeat consumer timeouts, then the master's
+  /// events (boot-up, NMT state, heartbeat lost, EMCY) to the proxies, so
+  /// that their state (failure(), feedback) is this cycle's before the
+  /// application reads it: a lost heartbeat reaches the planner in the cycle
+  /// that detects it. cycle() does it too (a no-op when update() ran).
+  /// Realtime-safe.
+  void update(std::int64_t now_ns) noexcept;
+  /// One cycle: master heartbeat, update(), each proxy's step (RPDOs), SDO,
+  /// then SYNC. Realtime-safe.
   void cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
 
   [[nodiscard]] canopen::Master& master() noexcept { return master_; }

@@ -191,6 +191,11 @@ void Emulator::build_dictionary() {
   add(obj::kSupportedDriveModes, 0,
       cia402::supported_mode_bit(cia402::Mode::kHoming) | cia402::supported_mode_bit(cia402::Mode::kCsp) |
           cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst));
+  // A drive without some optional objects (EmulatorConfig::absent_objects).
+  std::erase_if(od_, [this](const Entry& e) {
+    return std::find(cfg_.absent_objects.begin(), cfg_.absent_objects.end(), static_cast<std::uint16_t>(e.key >> 8)) !=
+           cfg_.absent_objects.end();
+  });
   std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
   od_.shrink_to_fit();  // od_ never changes size after this: Entry pointers stay valid
   rebuild_pdos();
@@ -208,8 +213,9 @@ std::vector<Emulator::ObjectDescription> Emulator::dictionary() const {
 }
 
 void Emulator::resolve_hot() noexcept {
-  // Every object below is added unconditionally by build_dictionary(), so
-  // none of these is nullptr; val()/sval()/put() still accept nullptr.
+  // Every object below is added by build_dictionary(); one named in
+  // EmulatorConfig::absent_objects is nullptr here, which val()/sval()/put()
+  // accept (the drive then behaves as if it were 0 and ignores writes).
   auto must_find = [this](std::uint16_t index, std::uint8_t sub = 0) { return find(index, sub); };
   Hot& h = hot_;
   h.error_register = must_find(0x1001);
@@ -321,7 +327,7 @@ void Emulator::rebuild_pdos() noexcept {
         m.add(e.index, e.sub, e.bits);
       }
       const bool ok = m.finalize();
-      const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0;
+      const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0 && find(comm, 1) != nullptr;
       auto& cache = rx ? rpdo_entries_[p] : tpdo_entries_[p];
       cache = {};
       for (std::uint8_t i = 0; i < m.count; ++i) {

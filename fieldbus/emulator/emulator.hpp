@@ -67,6 +67,11 @@ struct EmulatorConfig {
   /// 0x6061 (the drive refuses the mode switch); the master's mode-switch
   /// timeout (drive.timeouts.mode_switch_ms) must catch it.
   bool refuse_mode_switch = false;
+  /// Objects (indices) this drive does not have, e.g. the optional 0x1016, or
+  /// 0x1402/0x1602 for a drive with fewer PDOs: SDO access to them aborts with
+  /// 0x06020000 (object does not exist), as on a real drive without them.
+  /// A PDO whose communication object is absent is never valid.
+  std::vector<std::uint16_t> absent_objects;
   // Load model of CST (see README "Motor and load model"): motor torque T
   // (per mille of rated torque, 0x6071 clamped to 0x6072) accelerates the
   // motor by (T - load_torque - viscous_friction * v) / 1000 * rated_torque_acceleration.

@@ -1,5 +1,7 @@
 #include "rt/controller/controller.hpp"
 
+#include "fieldbus/canopen/sdo_abort.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -203,11 +205,28 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   ax.prev_counts = d.position;
   ax.have_prev = d.tpdo_count > 0;
   f.drive = drive_state_of(p.state(), operational);
+  using FK = cia402::FailureKind;
+  const FK kind = p.failure().kind;
   // A refused mode switch (0x6061 never showed the mode, drive.timeouts.mode_switch_ms)
-  // reaches the planner as a drive fault, handled per its exception action.
-  f.drive_fault = f.drive == motion::DriveState::Fault || p.failure().kind == cia402::FailureKind::kModeSwitchTimeout;
+  // and a drive that reset itself while running reach the planner as a drive
+  // fault, handled per its exception action (MAFR clears it).
+  f.drive_fault = f.drive == motion::DriveState::Fault || kind == FK::kModeSwitchTimeout || kind == FK::kUnexpectedBootUp;
   f.emcy_code = p.last_emcy_code();
-  f.node_lost = p.failure().kind == cia402::FailureKind::kHeartbeatLost;
+  // A lost heartbeat and a node out of NMT operational: the node is lost
+  // (AxisFault.ModuleFault) while the condition lasts.
+  f.node_lost = p.heartbeat_lost() || p.left_operational();
+  f.transition_timeout = kind == FK::kTransitionTimeout;
+  if (operational) {
+    f.link = motion::DriveLink::Up;
+  } else if (p.phase() == cia402::Phase::kFailed) {
+    // No answer at all (no boot-up, no SDO response, no TPDO) is a missing
+    // module; an answer that refuses a write is a configuration fault.
+    const bool no_answer = kind == FK::kBootTimeout || kind == FK::kStartTimeout ||
+                           (kind == FK::kSdoAbort && p.failure().sdo_abort == static_cast<std::uint32_t>(canopen::SdoAbort::kTimeout));
+    f.link = no_answer ? motion::DriveLink::NoModule : motion::DriveLink::ConfigFailed;
+  } else {
+    f.link = motion::DriveLink::Configuring;
+  }
   f.bus_off = buses_[static_cast<std::size_t>(ax.bus)].bus_off;
   f.homing_attained = (d.statusword & (1u << 12)) != 0 && d.mode_display == 6;
   f.homing_error = (d.statusword & (1u << 13)) != 0 && d.mode_display == 6;
@@ -250,9 +269,11 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
 }
 
 void Controller::cycle(std::int64_t now_ns) noexcept {
-  // 2. Drain received frames on every bus.
+  // 2. Drain received frames on every bus; heartbeat timeouts and node
+  // events reach the drive proxies now, before the planner reads them.
   for (std::size_t b = 0; b < buses_.size(); ++b) receive(b, now_ns);
   for (std::size_t b = 0; b < buses_.size(); ++b) {
+    buses_[b].network->update(now_ns);
     canopen::NodeEvent ne;
     while (buses_[b].network->poll_event(ne)) {
       Event e;
@@ -310,7 +331,7 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
       // The drives stop watching the master's heartbeat first, or they fault
       // (EMCY 0x8130) once the master is gone.
       for (auto& ax : axes_) {
-        if (ax.proxy == nullptr) continue;
+        if (ax.proxy == nullptr || ax.proxy->config().consumer_heartbeat_ms == 0) continue;  // not armed
         auto& sdo = buses_[static_cast<std::size_t>(ax.bus)].network->master().sdo(ax.proxy->node());
         (void)sdo.download_value<std::uint32_t>(0x1016, 1, 0, kDisarmTag);
       }

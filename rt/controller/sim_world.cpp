@@ -49,6 +49,14 @@ void SimWorld::power_on(std::int64_t now_ns) {
   }
 }
 
+void SimWorld::power_cycle(std::size_t drive, std::int64_t now_ns) {
+  Drive& d = drives_.at(drive);
+  d.connected = true;
+  canopen::TransportSink sink(*d.ep);
+  d.emu->power_on(now_ns, sink);
+  refresh_filter(d);
+}
+
 void SimWorld::begin_cycle(std::int64_t now_ns) noexcept {
   for (auto& b : buses_) b.bus->set_time(now_ns);
   for (auto& d : drives_) refresh_filter(d);  // e.g. after a test wrote to a drive directly

@@ -46,6 +46,10 @@ class SimWorld {
   [[nodiscard]] emulator::Emulator* find_drive(std::size_t bus, std::uint8_t node) noexcept;
   /// Detach a drive (a dead node: it neither receives nor sends any more).
   void disconnect(std::size_t drive) noexcept { drives_[drive].connected = false; }
+  /// Reattach a detached drive and power it on again at `now_ns` (a drive
+  /// killed and restarted, or power-cycled): dictionary defaults, boot-up
+  /// message, NMT pre-operational. Not realtime (tests and tools).
+  void power_cycle(std::size_t drive, std::int64_t now_ns);
 
  private:
   struct Bus {

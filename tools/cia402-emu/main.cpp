@@ -47,6 +47,8 @@ constexpr const char* kFooter = R"(Examples:
       CST with a load: torque accelerates against friction (SLAT 0x2020..0x2022)
   cia402-emu -i vcan0 -n 2 --refuse-mode-switch
       0x6061 never follows 0x6060: the master's mode-switch timeout fires
+  cia402-emu -i vcan0 -n 2 --without-object 0x1016 --without-object 0x1403 --without-object 0x1603
+      a drive without the optional 0x1016 and without RPDO4 (SDO aborts 0x06020000)
 
 The drive waits in NMT pre-operational until a master configures it over SDO
 and starts it (NMT 0x000 01 <node>). It sends its TPDOs on each SYNC (0x080)
@@ -79,6 +81,7 @@ int main(int argc, char** argv) {
   bool verbose = false;
   double rated_torque_accel = 0.0, load_torque = 0.0, viscous = 0.0;
   bool refuse_mode = false;
+  std::vector<std::string> absent;
   app.add_option("-i,--interface", iface, "CAN interface (vcan0, can0)")->required();
   app.add_option("-n,--node", nodes, "node-ID of an emulated drive (1..127); repeat for several drives")
       ->required()
@@ -100,6 +103,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--refuse-mode-switch", refuse_mode,
                "fault injection: accept 0x6060 but never show a new mode in 0x6061 (the master's mode-switch timeout)");
+  app.add_option("--without-object", absent,
+                 "emulate a drive without this object (index, e.g. 0x1016); SDO access aborts with 0x06020000; repeat "
+                 "for several");
   app.add_option("--duration", duration, "exit after this many seconds (0 = run until SIGINT/SIGTERM)");
   app.add_flag("-v,--verbose", verbose, "print NMT and CiA 402 state changes");
   bool check_args = false;
@@ -116,6 +122,22 @@ int main(int argc, char** argv) {
   } catch (const std::exception&) {
     std::fprintf(stderr, "cia402-emu: --fail-code '%s' is not a 16-bit EMCY code (e.g. 0x2310)\n", fail_code.c_str());
     return 1;
+  }
+  std::vector<std::uint16_t> absent_objects;
+  for (const std::string& a : absent) {
+    std::size_t pos = 0;
+    unsigned long v = 0;
+    try {
+      v = std::stoul(a, &pos, 0);
+    } catch (const std::exception&) {
+      pos = 0;
+    }
+    if (pos != a.size() || v < 0x1000 || v > 0xFFFF) {
+      std::fprintf(stderr, "cia402-emu: --without-object '%s' is not an object index 0x1000..0xFFFF (e.g. 0x1016)\n",
+                   a.c_str());
+      return 1;
+    }
+    absent_objects.push_back(static_cast<std::uint16_t>(v));
   }
   for (std::size_t i = 0; i < nodes.size(); ++i)
     for (std::size_t j = i + 1; j < nodes.size(); ++j)
@@ -149,6 +171,7 @@ int main(int argc, char** argv) {
     c.load_torque = load_torque;
     c.viscous_friction = viscous;
     c.refuse_mode_switch = refuse_mode;
+    c.absent_objects = absent_objects;
     c.heartbeat_loss_reaction = hb_reaction == "fault"       ? emulator::HeartbeatLossReaction::kFault
                                 : hb_reaction == "quickstop" ? emulator::HeartbeatLossReaction::kQuickStop
                                                              : emulator::HeartbeatLossReaction::kNone;

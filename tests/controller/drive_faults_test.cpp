@@ -1,0 +1,469 @@
+// The fault matrix on the SimBus (issue 12): the Controller with an emulated
+// CiA 402 drive in virtual time, each fault with its reaction (what the axis
+// and the drive proxy show, and when) and its recovery without restarting
+// the controller. The same scenarios run over vcan with separate processes
+// (tests/faults/); the reaction times measured here are in BENCHMARKS.md.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fieldbus/canopen/sdo_abort.hpp"
+#include "rt/controller/controller.hpp"
+#include "rt/controller/host.hpp"
+#include "rt/controller/sim_world.hpp"
+
+namespace canmotion::rt {
+namespace {
+
+constexpr std::int64_t kPeriod = 1'000'000;  // 1 ms
+constexpr std::uint8_t kNode = 2;
+constexpr std::uint32_t kDriveHeartbeatId = 0x700 + kNode;
+double ms(std::int64_t ns) { return static_cast<double>(ns) / 1e6; }
+
+/// One CIP axis "X" (node 2, 1000 counts per mm) with an emulated drive on
+/// one SimBus, driven through ST calls like a script.
+struct FaultRig {
+  SimWorld world;
+  std::unique_ptr<Controller> ctl;
+  std::unique_ptr<ControllerHost> host;
+  std::int64_t now = 0;
+  std::int64_t last_hb_rx_ns = -1;  ///< receive time of the drive's last heartbeat (trace)
+  std::uint64_t hb_rx = 0;
+  /// Controlword of the RPDO1 sent in each cycle (cycle time -> controlword), from the trace.
+  std::vector<std::pair<std::int64_t, std::uint16_t>> cw;
+  std::function<void()> each_cycle;  ///< test hook after every cycle
+
+  explicit FaultRig(const std::function<void(AxisSpec&, emulator::EmulatorConfig&)>& tweak = {}, bool power_on = true) {
+    ControllerSpec spec;
+    spec.period_ns = kPeriod;
+    BusSpec bus;
+    bus.name = "sim0";
+    bus.transport = &world.add_bus("sim0");
+    spec.buses.push_back(bus);
+    AxisSpec x;
+    x.name = "X";
+    x.config.type = motion::AxisType::CipDrive;
+    x.config.conversion_constant = 1000;
+    x.config.max_speed = 200;
+    x.config.max_accel = 2000;
+    x.config.max_decel = 2000;
+    x.bus = 0;
+    x.drive.node = kNode;
+    emulator::EmulatorConfig ec;
+    ec.node = kNode;
+    if (tweak) tweak(x, ec);
+    spec.axes.push_back(x);
+    world.add_drive(0, ec);
+    ctl = std::make_unique<Controller>(spec);
+    host = std::make_unique<ControllerHost>(*ctl);
+    ctl->set_trace(true);
+    if (power_on) {
+      world.power_on(0);
+    } else {
+      world.disconnect(0);  // the drive is off (or not there)
+    }
+  }
+  void step() {
+    world.begin_cycle(now);
+    ctl->cycle(now);
+    world.end_cycle(now);
+    now += kPeriod;
+    TraceRecord tr;
+    while (ctl->pop_trace(tr)) {
+      const can::Frame& f = tr.frame.frame;
+      if (!tr.tx && f.id == kDriveHeartbeatId) {
+        last_hb_rx_ns = tr.frame.t_ns;
+        ++hb_rx;
+      }
+      if (tr.tx && f.id == 0x200u + kNode && f.len >= 2)
+        cw.emplace_back(tr.frame.t_ns, static_cast<std::uint16_t>(f.data[0] | (f.data[1] << 8)));
+    }
+    if (each_cycle) each_cycle();
+  }
+  void cycles(int n) {
+    for (int i = 0; i < n; ++i) step();
+  }
+  Status status() const {
+    Status s;
+    ctl->read_status(s);
+    return s;
+  }
+  const AxisSnapshot& axis() {
+    host->refresh();
+    return host->refresh().axes[0];
+  }
+  bool run_until(const std::function<bool()>& done, int max_cycles) {
+    for (int i = 0; i < max_cycles; ++i) {
+      step();
+      if (done()) return true;
+    }
+    return false;
+  }
+  double read(const std::string& tag) {
+    std::string e;
+    auto v = host->read(tag, &e);
+    EXPECT_TRUE(v) << tag << ": " << e;
+    return v.value_or(-1);
+  }
+  /// Execute an ST call and run until the planner took it.
+  void exec(const std::string& call) {
+    std::string ctl_name;
+    const auto err = host->execute(call, &ctl_name);
+    ASSERT_FALSE(err) << call << ": " << *err;
+    ASSERT_TRUE(run_until([&] { return host->settled(); }, 10)) << call;
+  }
+  /// Run until `tag` (a control tag bit) is 1; fails the test after max cycles.
+  bool wait(const std::string& tag, int max_cycles) {
+    return run_until([&] { return read(tag) != 0.0; }, max_cycles);
+  }
+  bool operational() {
+    return run_until([&] { return axis().phase == cia402::Phase::kOperational; }, 5000);
+  }
+  /// Boot, MSO, and jog forward at 10 mm/s.
+  void enable_and_jog() {
+    ASSERT_TRUE(operational()) << axis().failure.to_string();
+    exec("MSO(X, mso1)");
+    ASSERT_TRUE(wait("mso1.DN", 2000)) << "MSO ERR " << read("mso1.ERR");
+    exec("MAJ(X, maj1, Forward, 10, UnitsPerSec, 100, UnitsPerSec2, 100, UnitsPerSec2, Trapezoidal, 100, 100, "
+         "%ofTime, Disabled, Programmed, 0, None)");
+    cycles(300);
+    ASSERT_EQ(read("X.JogStatus"), 1.0);
+  }
+  /// After a fault: reset with `reset` (MAFR or MASR), MSO, and a move that
+  /// arrives. The axis is usable again without restarting anything.
+  void recover(const std::string& reset) {
+    exec(reset + "(X, rst)");
+    ASSERT_TRUE(run_until([&] { return read("rst.DN") != 0.0 || read("rst.ER") != 0.0; }, 5000));
+    ASSERT_EQ(read("rst.DN"), 1.0) << reset << " ERR " << read("rst.ERR") << " EXERR " << read("rst.EXERR")
+                                   << "; failure: " << axis().failure.to_string();
+    enable_and_move();
+  }
+  void enable_and_move() {
+    exec("MSO(X, mso2)");
+    ASSERT_TRUE(run_until([&] { return read("mso2.DN") != 0.0 || read("mso2.ER") != 0.0; }, 3000));
+    ASSERT_EQ(read("mso2.DN"), 1.0) << "MSO after the reset: ERR " << read("mso2.ERR") << " EXERR "
+                                    << read("mso2.EXERR");
+    const double target = read("X.ActualPosition") + 5.0;
+    char mam[256];
+    std::snprintf(mam, sizeof mam,
+                  "MAM(X, mam2, Absolute, %.6f, 20, UnitsPerSec, 200, UnitsPerSec2, 200, UnitsPerSec2, Trapezoidal, "
+                  "100, 100, %%ofTime, Disabled, Programmed, 0, None, 0, 0)",
+                  target);
+    exec(mam);
+    ASSERT_TRUE(run_until([&] { return read("mam2.PC") != 0.0 || read("mam2.ER") != 0.0; }, 5000));
+    ASSERT_EQ(read("mam2.PC"), 1.0) << "MAM ERR " << read("mam2.ERR");
+    cycles(50);
+    EXPECT_NEAR(read("X.ActualPosition"), target, 0.01);
+    EXPECT_EQ(read("X.AxisFault"), 0.0);
+  }
+};
+
+bool fault_bit(double axis_fault, unsigned bit) { return (static_cast<std::uint32_t>(axis_fault) >> bit) & 1u; }
+bool module_fault(double axis_fault) { return fault_bit(axis_fault, motion::axis_fault::ModuleFault); }
+bool physical_fault(double axis_fault) { return fault_bit(axis_fault, motion::axis_fault::PhysicalAxisFault); }
+bool config_fault(double axis_fault) { return fault_bit(axis_fault, motion::axis_fault::ConfigFault); }
+
+// ---------------------------------------------------------------------------
+// Drive vanishes (stops heartbeats and TPDOs) while jogging.
+// Reaction: the master's heartbeat consumer (3 x the drive's 0x1017 period
+// unless drive.heartbeat_timeout) expires; the axis gets AxisFault.ModuleFault
+// (node_lost exception, default action Shutdown: the jog is aborted, the
+// drive disabled) in the cycle that detects it: at most the consumer time
+// plus one cycle after the last heartbeat was received, never before.
+// Recovery: the drive comes back (boot-up: reconfigured), MASR, MSO, move.
+TEST(DriveFaults, VanishedDriveFaultsTheAxisWithinConsumerTimePlusOneCycle) {
+  FaultRig r;
+  r.enable_and_jog();
+  const std::int64_t consumer_ns = 3 * 100 * 1'000'000;  // DriveConfig default: 0x1017 = 100 ms
+  r.world.disconnect(0);
+  const std::int64_t vanished = r.now;
+  ASSERT_TRUE(r.run_until([&] { return module_fault(r.read("X.AxisFault")); }, 1000)) << "the lost drive was not noticed";
+  const std::int64_t faulted_at = r.status().time_ns;  // the cycle that showed the fault
+  const std::int64_t after_hb = faulted_at - r.last_hb_rx_ns;
+  std::printf("vanished drive: last heartbeat received %.1f ms before the drive vanished; axis faulted %.1f ms after "
+              "that heartbeat (consumer time %.1f ms, cycle %.1f ms)\n",
+              ms(vanished - r.last_hb_rx_ns), ms(after_hb), ms(consumer_ns), ms(kPeriod));
+  EXPECT_GT(after_hb, consumer_ns) << "faulted before the consumer time expired";
+  EXPECT_LE(after_hb, consumer_ns + kPeriod) << "faulted later than the consumer time plus one cycle";
+  EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+  EXPECT_EQ(r.read("X.ServoActionStatus"), 0.0);
+  EXPECT_EQ(r.axis().failure.kind, cia402::FailureKind::kHeartbeatLost);
+  // The drive comes back (killed and restarted: boot-up) and is reconfigured.
+  r.cycles(100);
+  r.world.power_cycle(0, r.now);
+  r.recover("MASR");
+}
+
+// ---------------------------------------------------------------------------
+// EMCY fault while jogging, then the Logix recovery MAFR; WAIT r.DN; MSO; move.
+// Reaction: the EMCY and the Fault statusword arrive together; the axis
+// faults (PhysicalAxisFault, drive_fault action Stop Drive) in that cycle.
+// MAFR: the fault reset (bit 7 rising) goes out in the RPDO of the cycle
+// that executes MAFR (the proxy sends 0x0000 in Fault, so the edge is there);
+// DN in the first cycle whose feedback shows the drive out of Fault, not before.
+TEST(DriveFaults, EmcyFaultThenMafrResetsOnTheNextRpdoAndDnWhenTheDriveLeftFault) {
+  FaultRig r;
+  r.enable_and_jog();
+  const std::int64_t injected = r.now;
+  r.world.drive(0).inject_fault(0xFF00);  // as a write of 0x2000 does
+  ASSERT_TRUE(r.run_until([&] { return physical_fault(r.read("X.AxisFault")); }, 100));
+  const std::int64_t faulted_at = r.status().time_ns;
+  std::printf("EMCY fault: injected before the SYNC of %.0f ms, axis faulted in the cycle of %.0f ms\n", ms(injected),
+              ms(faulted_at));
+  EXPECT_LE(faulted_at - injected, 2 * kPeriod);  // the drive faults at its SYNC; its EMCY/TPDO come next cycle
+  EXPECT_EQ(r.read("X.LastEmcy"), 0xFF00);
+  EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+  EXPECT_TRUE(r.axis().drive_state == cia402::State::kFault || r.axis().drive_state == cia402::State::kFaultReactionActive);
+  r.cycles(20);
+  EXPECT_EQ(r.axis().drive_state, cia402::State::kFault);
+  ASSERT_FALSE(r.cw.empty());
+  EXPECT_EQ(r.cw.back().second & 0x80, 0) << "bit 7 must be clear in Fault before the reset";
+  // MAFR runs in the next cycle.
+  std::string ctl_name;
+  ASSERT_FALSE(r.host->execute("MAFR(X, rst)", &ctl_name));
+  const std::int64_t mafr_cycle = r.now;
+  r.step();
+  ASSERT_TRUE(r.host->settled());
+  ASSERT_EQ(r.cw.back().first, mafr_cycle);
+  EXPECT_EQ(r.cw.back().second, 0x0080) << "the fault reset is not in the RPDO of the MAFR's cycle";
+  EXPECT_EQ(r.read("rst.DN"), 0.0) << "MAFR DN while the drive is still in Fault";
+  int cycles = 0;
+  while (r.read("rst.DN") == 0.0 && r.read("rst.ER") == 0.0 && cycles < 1000) {
+    EXPECT_EQ(r.axis().drive_state, cia402::State::kFault) << "the drive left Fault but MAFR is not DN";
+    r.step();
+    ++cycles;
+  }
+  ASSERT_EQ(r.read("rst.DN"), 1.0) << "MAFR ERR " << r.read("rst.ERR");
+  EXPECT_NE(r.axis().drive_state, cia402::State::kFault);
+  std::printf("MAFR: reset controlword in the MAFR's cycle, DN %d cycle(s) later\n", cycles + 1);
+  EXPECT_LE(cycles + 1, 3);
+  EXPECT_EQ(r.read("X.AxisFault"), 0.0);
+  r.enable_and_move();
+}
+
+// A drive that does not leave Fault after the reset (here: its RPDOs are
+// lost, so it never sees bit 7): MAFR ends with ERR 12 (EXERR 16) after the
+// transition timeout, the failure names transition 15, and the axis is
+// faulted again. Once the drive hears the master again, MAFR works.
+TEST(DriveFaults, FaultResetTimeoutEndsMafrWithErrorAndAClearMessage) {
+  FaultRig r([](AxisSpec& x, emulator::EmulatorConfig&) { x.drive.transition_timeout_ns = 200'000'000; });
+  r.enable_and_jog();
+  r.world.drive(0).inject_fault(0x2310);
+  ASSERT_TRUE(r.run_until([&] { return physical_fault(r.read("X.AxisFault")); }, 100));
+  r.cycles(10);
+  r.world.bus(0).add_fault({0x200u + kNode, can::SimFault::Action::kDrop, 0, 0});  // every RPDO1 lost
+  const std::int64_t t0 = r.now;
+  r.exec("MAFR(X, rst)");
+  ASSERT_TRUE(r.run_until([&] { return r.read("rst.DN") != 0.0 || r.read("rst.ER") != 0.0; }, 2000));
+  const std::int64_t t_er = r.status().time_ns;
+  EXPECT_EQ(r.read("rst.ER"), 1.0);
+  EXPECT_EQ(r.read("rst.ERR"), 12.0);
+  EXPECT_EQ(r.read("rst.EXERR"), 16.0);
+  EXPECT_GT(t_er - t0, 200'000'000);
+  EXPECT_LE(t_er - t0, 200'000'000 + 3 * kPeriod);
+  const std::string why = r.axis().failure.to_string();
+  EXPECT_NE(why.find("transition 15 (Fault -> Switch on disabled)"), std::string::npos) << why;
+  EXPECT_NE(why.find("timed out after"), std::string::npos) << why;
+  EXPECT_NE(why.find("last EMCY 0x2310"), std::string::npos) << why;
+  r.cycles(2);
+  EXPECT_TRUE(physical_fault(r.read("X.AxisFault"))) << "the unreset drive fault is latched again";
+  r.world.bus(0).clear_faults();
+  r.recover("MAFR");
+}
+
+// ---------------------------------------------------------------------------
+// The drive reboots while operational (reset or power cycle, heartbeats go on):
+// the unexpected boot-up faults the axis at once (drive fault: Stop Drive)
+// and the boot and configuration run again without being asked, so that
+// MAFR (DN once it is configured and out of Fault) + MSO + a move work.
+TEST(DriveFaults, DriveRebootWhileOperationalIsReconfiguredAndMafrMsoWork) {
+  FaultRig r;
+  r.enable_and_jog();
+  const std::int64_t rebooted = r.now;
+  r.world.power_cycle(0, r.now);
+  ASSERT_TRUE(r.run_until([&] { return physical_fault(r.read("X.AxisFault")); }, 100));
+  const std::int64_t faulted_at = r.status().time_ns;
+  std::printf("drive reboot: boot-up sent at %.0f ms, axis faulted in the cycle of %.0f ms\n", ms(rebooted), ms(faulted_at));
+  EXPECT_LE(faulted_at - rebooted, kPeriod);
+  EXPECT_EQ(r.axis().failure.kind, cia402::FailureKind::kUnexpectedBootUp) << r.axis().failure.to_string();
+  EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+  EXPECT_NE(r.axis().phase, cia402::Phase::kOperational);
+  EXPECT_NE(r.axis().phase, cia402::Phase::kFailed);
+  // Configured again by itself.
+  ASSERT_TRUE(r.run_until([&] { return r.axis().phase == cia402::Phase::kOperational; }, 2000));
+  EXPECT_EQ(r.ctl->network(0).at(0).reboots(), 1u);
+  EXPECT_EQ(r.world.drive(0).nmt_state(), canopen::NmtState::kOperational);
+  EXPECT_EQ(r.world.drive(0).read_int(0x60C2, 1), 1) << "0x60C2 not written again";
+  r.recover("MAFR");
+}
+
+// MAFR right after the reboot, while the drive is still being configured:
+// DN waits for the configuration, then MSO works.
+TEST(DriveFaults, MafrDuringTheReconfigurationWaitsForIt) {
+  FaultRig r;
+  r.enable_and_jog();
+  r.world.power_cycle(0, r.now);
+  ASSERT_TRUE(r.run_until([&] { return physical_fault(r.read("X.AxisFault")); }, 100));
+  ASSERT_EQ(r.axis().phase, cia402::Phase::kConfiguring);
+  r.exec("MAFR(X, rst)");
+  EXPECT_EQ(r.read("rst.DN"), 0.0);
+  ASSERT_TRUE(r.run_until([&] { return r.read("rst.DN") != 0.0 || r.read("rst.ER") != 0.0; }, 2000));
+  ASSERT_EQ(r.read("rst.DN"), 1.0) << "ERR " << r.read("rst.ERR");
+  EXPECT_EQ(r.axis().phase, cia402::Phase::kOperational);
+  r.enable_and_move();
+}
+
+// ---------------------------------------------------------------------------
+// NMT state while running: a drive that drops to pre-operational or stopped
+// (CiA 301 0x1029 on a communication error, or another tool) stops its
+// PDOs. Its next heartbeat shows it: the axis faults at once (node lost:
+// ModuleFault, default action Shutdown). MASR runs the boot again (NMT
+// start included), then MSO and a move.
+class NmtStateWhileRunning : public ::testing::TestWithParam<std::uint8_t> {};
+
+TEST_P(NmtStateWhileRunning, FaultsTheAxisAtTheHeartbeatAndMasrRestartsTheNode) {
+  FaultRig r;
+  auto& tool = r.world.bus(0).add_endpoint("tool");
+  r.enable_and_jog();
+  const std::uint64_t hb_before = r.hb_rx;
+  can::Frame nmt;
+  nmt.id = 0x000;
+  nmt.len = 2;
+  nmt.data[0] = GetParam();  // 0x80 enter pre-operational, 0x02 stop
+  nmt.data[1] = kNode;
+  ASSERT_EQ(tool.send(nmt), can::SendResult::kOk);
+  ASSERT_TRUE(r.run_until([&] { return module_fault(r.read("X.AxisFault")); }, 1000));
+  EXPECT_EQ(r.hb_rx, hb_before + 1) << "the axis faulted at the first heartbeat after the NMT change";
+  EXPECT_GE(r.status().time_ns, r.last_hb_rx_ns);
+  EXPECT_LE(r.status().time_ns - r.last_hb_rx_ns, kPeriod) << "not in the cycle that received the heartbeat";
+  EXPECT_EQ(r.axis().failure.kind, cia402::FailureKind::kNmtState) << r.axis().failure.to_string();
+  const std::string why = r.axis().failure.to_string();
+  EXPECT_NE(why.find(GetParam() == 0x80 ? "pre-operational" : "stopped"), std::string::npos) << why;
+  EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+  r.recover("MASR");
+  EXPECT_EQ(r.world.drive(0).nmt_state(), canopen::NmtState::kOperational);
+}
+
+INSTANTIATE_TEST_SUITE_P(DriveFaults, NmtStateWhileRunning, ::testing::Values(std::uint8_t{0x80}, std::uint8_t{0x02}));
+
+// ---------------------------------------------------------------------------
+// Boot failures. An axis whose drive refused its configuration, or never
+// answered, is not configured: MSO, MAH (and MDS) end with ERR 11 at once, a
+// MSO issued while it was booting with ERR 12 (EXERR 16) as soon as the boot
+// fails; AxisFault shows ConfigFault (refused) or ModuleFault (no answer).
+// MAFR runs the boot again; so does a boot-up of the node (drive repaired,
+// replaced or switched on).
+
+// SDO abort at boot, with the configuration key that causes it.
+TEST(DriveFaults, RefusedConfigurationWriteEndsMsoAtOnceAndNamesTheKey) {
+  FaultRig r([](AxisSpec& x, emulator::EmulatorConfig&) {
+    x.drive.extra_writes.push_back({0x2FFF, 0, 4, 1});  // no such object in the drive
+    x.drive.hints.extra.push_back("axes[0].drive.sdo_writes[0] (line 12)");
+  });
+  r.exec("MSO(X, mso0)");  // while booting: waits for the drive
+  ASSERT_TRUE(r.run_until([&] { return r.axis().phase == cia402::Phase::kFailed; }, 3000));
+  const std::int64_t failed_at = r.status().time_ns;
+  ASSERT_TRUE(r.run_until([&] { return r.read("mso0.ER") != 0.0; }, 2)) << "the pending MSO did not end at once";
+  EXPECT_EQ(r.read("mso0.ERR"), 12.0);
+  EXPECT_EQ(r.read("mso0.EXERR"), 16.0);
+  EXPECT_LE(r.status().time_ns - failed_at, kPeriod);
+  const cia402::Failure f = r.axis().failure;
+  EXPECT_EQ(f.kind, cia402::FailureKind::kSdoAbort);
+  const std::string why = f.to_string();
+  std::printf("%s\n", why.c_str());
+  for (const char* part : {"node 2", "0x2FFF:0", "the drive refused it", "0x06020000", "object does not exist",
+                           "axes[0].drive.sdo_writes[0] (line 12)"})
+    EXPECT_NE(why.find(part), std::string::npos) << "missing '" << part << "' in: " << why;
+  EXPECT_LT(f.waited_ns, 10 * kPeriod) << why;  // the response's time on the cycle's clock
+  EXPECT_TRUE(config_fault(r.read("X.AxisFault")));
+  EXPECT_EQ(r.read("X.ServoActionStatus"), 0.0);
+  r.exec("MSO(X, mso1)");
+  EXPECT_EQ(r.read("mso1.ER"), 1.0);
+  EXPECT_EQ(r.read("mso1.ERR"), 11.0) << "MSO on an axis whose drive refused its configuration";
+  r.exec("MAH(X, mah1)");
+  EXPECT_EQ(r.read("mah1.ERR"), 11.0);
+  // MAFR runs the boot again; the same refusal ends it with ER.
+  r.exec("MAFR(X, rst)");
+  ASSERT_TRUE(r.run_until([&] { return r.read("rst.DN") != 0.0 || r.read("rst.ER") != 0.0; }, 3000));
+  EXPECT_EQ(r.read("rst.ER"), 1.0);
+  EXPECT_EQ(r.read("rst.ERR"), 12.0);
+  EXPECT_EQ(r.axis().failure.kind, cia402::FailureKind::kSdoAbort);
+}
+
+// A drive without the optional 0x1016 and with two PDOs per direction (like
+// the independent peer drive): 0x1016 is written only when the drive is to
+// watch the master, and the unused PDOs it does not have are fine.
+TEST(DriveFaults, DriveWithoutHeartbeatConsumerAndWithFewerPdosBoots) {
+  FaultRig r([](AxisSpec& x, emulator::EmulatorConfig& e) {
+    x.drive.consumer_heartbeat_ms = 0;  // master_heartbeat_timeout_ms: 0
+    e.absent_objects = {0x1016, 0x1402, 0x1403, 0x1602, 0x1603, 0x1802, 0x1803, 0x1A02, 0x1A03};
+  });
+  ASSERT_TRUE(r.operational()) << r.axis().failure.to_string();
+  EXPECT_EQ(r.ctl->network(0).at(0).tolerated_aborts(), 4u) << "RPDO3/4 and TPDO3/4 answered 0x06020000";
+  r.enable_and_move();
+}
+
+// The same drive asked to watch the master: the refused 0x1016 write names
+// the key that leaves it out.
+TEST(DriveFaults, RefusedHeartbeatConsumerNamesTheKeyThatLeavesItOut) {
+  FaultRig r([](AxisSpec& x, emulator::EmulatorConfig& e) {
+    x.drive.consumer_heartbeat_ms = 300;
+    x.drive.hints.consumer_heartbeat = "axes[0].drive.master_heartbeat_timeout_ms";
+    e.absent_objects = {0x1016};
+  });
+  ASSERT_TRUE(r.run_until([&] { return r.axis().phase == cia402::Phase::kFailed; }, 3000));
+  const std::string why = r.axis().failure.to_string();
+  std::printf("%s\n", why.c_str());
+  for (const char* part : {"node 2", "0x1016:1", "0x06020000", "set axes[0].drive.master_heartbeat_timeout_ms: 0"})
+    EXPECT_NE(why.find(part), std::string::npos) << "missing '" << part << "' in: " << why;
+}
+
+// SDO timeout at boot: the drive sends boot-up and heartbeats but its SDO
+// answers are lost. The failure says the write got no answer after the SDO
+// timeout; ModuleFault; MSO ERR 11. MAFR runs the boot again once the
+// answers come through, and the axis works.
+TEST(DriveFaults, SdoTimeoutAtBootThenMafrRetriesTheBoot) {
+  FaultRig r;
+  r.world.bus(0).add_fault({0x580u + kNode, can::SimFault::Action::kDrop, 0, 0});  // every SDO response lost
+  ASSERT_TRUE(r.run_until([&] { return r.axis().phase == cia402::Phase::kFailed; }, 3000));
+  const cia402::Failure f = r.axis().failure;
+  const std::string why = f.to_string();
+  std::printf("%s\n", why.c_str());
+  EXPECT_EQ(f.sdo_abort, 0x05040000u);
+  EXPECT_NE(why.find("0x6060:0"), std::string::npos) << why;
+  EXPECT_NE(why.find("the drive did not answer"), std::string::npos) << why;
+  EXPECT_GE(f.waited_ns, 200'000'000);  // DriveConfig::sdo_timeout_ns
+  EXPECT_LE(f.waited_ns, 200'000'000 + 2 * kPeriod);
+  r.cycles(1);
+  EXPECT_TRUE(module_fault(r.read("X.AxisFault")));
+  r.exec("MSO(X, mso1)");
+  EXPECT_EQ(r.read("mso1.ERR"), 11.0);
+  r.world.bus(0).clear_faults();
+  r.recover("MAFR");
+}
+
+// No boot-up at all (the drive is off): after boot_timeout the master resets
+// the node, after another the boot fails (ModuleFault, ERR 11). The drive is
+// switched on later: its boot-up runs the boot by itself.
+TEST(DriveFaults, AbsentDriveFailsTheBootAndItsLaterBootUpConfiguresIt) {
+  FaultRig r([](AxisSpec& x, emulator::EmulatorConfig&) { x.drive.boot_timeout_ns = 200'000'000; }, false);
+  ASSERT_TRUE(r.run_until([&] { return r.axis().phase == cia402::Phase::kFailed; }, 3000));
+  EXPECT_EQ(r.axis().failure.kind, cia402::FailureKind::kBootTimeout);
+  EXPECT_GE(r.status().time_ns, 400'000'000);
+  r.cycles(1);
+  EXPECT_TRUE(module_fault(r.read("X.AxisFault")));
+  r.exec("MSO(X, mso1)");
+  EXPECT_EQ(r.read("mso1.ERR"), 11.0);
+  r.world.power_cycle(0, r.now);
+  ASSERT_TRUE(r.operational()) << r.axis().failure.to_string();
+  EXPECT_EQ(r.read("X.AxisFault"), 0.0);
+  r.enable_and_move();
+}
+
+}  // namespace
+}  // namespace canmotion::rt
