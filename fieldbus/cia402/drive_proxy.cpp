@@ -258,10 +258,7 @@ void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, s
   failure_.t_ns = now_ns;
 }
 
-void DriveProxy::restart() noexcept {
-  phase_ = Phase::kWaitBoot;
-  started_ = false;
-  next_write_ = done_writes_ = tolerated_ = 0;
+void DriveProxy::forget_drive(std::int64_t now_ns) noexcept {
   tpdo_seen_ = expect_tpdo_ = got_tpdo_ = false;
   state_ = State::kUnknown;
   wanted_ = State::kSwitchOnDisabled;
@@ -269,30 +266,29 @@ void DriveProxy::restart() noexcept {
   reset_requested_ = homing_requested_ = false;
   mode_switch_pending_ = false;
   nmt_left_ = false;
-  failure_ = Failure{};
+  mode_ = cfg_.mode;  // configured again with the boot mode
+  next_write_ = done_writes_ = tolerated_ = 0;
   master_.sdo(cfg_.node).cancel_all();
+  // A rebooted drive sends no heartbeat until 0x1017 is written again: the
+  // consumer is armed again when the configuration is done.
+  master_.set_heartbeat_timeout(cfg_.node, 0, now_ns);
 }
 
-void DriveProxy::begin_configuration(std::int64_t now_ns) noexcept {
-  master_.sdo(cfg_.node).cancel_all();
-  next_write_ = done_writes_ = tolerated_ = 0;
-  phase_ = Phase::kConfiguring;
-  phase_since_ns_ = now_ns;
-  started_ = true;
+void DriveProxy::restart() noexcept {
+  forget_drive(now_ns_);
+  phase_ = Phase::kWaitBoot;
+  started_ = false;
+  failure_ = Failure{};
 }
 
 void DriveProxy::reboot(std::int64_t now_ns) noexcept {
   ++reboots_;
-  tpdo_seen_ = expect_tpdo_ = got_tpdo_ = false;
-  state_ = State::kUnknown;
-  wanted_ = State::kSwitchOnDisabled;
-  in_flight_ = false;
-  reset_requested_ = homing_requested_ = false;
-  mode_switch_pending_ = false;
-  nmt_left_ = false;
-  mode_ = cfg_.mode;  // the drive is back to its defaults: configured with the boot mode
+  forget_drive(now_ns);
   follow_actual();
-  begin_configuration(now_ns);  // a boot-up leaves the node pre-operational: configure at once
+  // A boot-up leaves the node pre-operational: configure it at once.
+  phase_ = Phase::kConfiguring;
+  phase_since_ns_ = now_ns;
+  started_ = true;
 }
 
 bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
@@ -607,6 +603,10 @@ bool DriveProxy::set_mode(Mode m) noexcept {
     flight_since_ns_ = now_ns;
     flight_cycles_ = 0;
   }
+  // A node that cannot hear us (heartbeat lost, out of NMT operational) is
+  // not timed: that is its own failure, and the transition starts afresh
+  // when it is back.
+  if (heartbeat_lost() || nmt_left_) flight_since_ns_ = now_ns;
   const std::int64_t waited = now_ns - flight_since_ns_;
   if (waited > cfg_.transition_timeout_ns) {
     fail(FailureKind::kTransitionTimeout, now_ns, waited, cfg_.transition_timeout_ns);

@@ -248,7 +248,8 @@ class DriveProxy {
   /// Configuration writes the drive refused that do not matter (unused PDOs
   /// it does not have), since the last (re)start of the configuration.
   [[nodiscard]] std::size_t tolerated_aborts() const noexcept { return tolerated_; }
-  /// Boot-ups seen while running or configuring (each re-ran the configuration).
+  /// Boot-ups that (re-)ran the configuration: while running, while
+  /// configuring, or after a failed boot.
   [[nodiscard]] std::uint32_t reboots() const noexcept { return reboots_; }
   /// Clear the recorded failure (the state machine keeps its state).
   void clear_failure() noexcept { failure_ = Failure{}; }
@@ -259,8 +260,8 @@ class DriveProxy {
 
  private:
   void build_configuration();
-  void begin_configuration(std::int64_t now_ns) noexcept;  ///< (again) from the first write
-  void reboot(std::int64_t now_ns) noexcept;               ///< the drive reset itself: configure it again
+  void forget_drive(std::int64_t now_ns) noexcept;  ///< what the proxy knew of the drive's state and configuration
+  void reboot(std::int64_t now_ns) noexcept;        ///< the node booted (again): configure it from the first write
   void fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept;
   void step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
   void step_state_machine(std::int64_t now_ns) noexcept;

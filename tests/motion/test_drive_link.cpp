@@ -39,6 +39,12 @@ Rig faulted_rig() {
 
 bool fault_bit(const AxisTag& t, unsigned b) { return (t.axis_fault >> b) & 1u; }
 
+/// Drive `i` leaves Fault (Switch on disabled).
+void leave_fault(Rig& r, std::size_t i = 0) {
+  r.fb[i].drive = DriveState::NotReady;
+  r.fb[i].drive_fault = false;
+}
+
 TEST(FaultReset, MafrIsDoneWhenTheDriveHasLeftFaultNotBefore) {
   Rig r = faulted_rig();
   ASSERT_EQ(r.exec("MAFR(D, fr);"), Err::None);
@@ -51,8 +57,7 @@ TEST(FaultReset, MafrIsDoneWhenTheDriveHasLeftFaultNotBefore) {
   EXPECT_FALSE(r.tag("fr").dn());
   EXPECT_FALSE(r.tag("fr").er());
   EXPECT_EQ(r.axis("D").state, AxisState::Ready);
-  r.fb[0].drive = DriveState::NotReady;  // Switch on disabled
-  r.fb[0].drive_fault = false;
+  leave_fault(r);
   r.step();
   EXPECT_TRUE(r.tag("fr").dn());
   EXPECT_EQ(r.axis("D").axis_fault, 0u);
@@ -104,8 +109,7 @@ TEST(FaultReset, MasrLeavesShutdownAndWaitsForTheDrive) {
   EXPECT_EQ(r.axis("D").state, AxisState::Ready);
   r.step(2);
   EXPECT_FALSE(r.tag("sr").dn());
-  r.fb[0].drive = DriveState::NotReady;
-  r.fb[0].drive_fault = false;
+  leave_fault(r);
   r.step();
   EXPECT_TRUE(r.tag("sr").dn());
 }
@@ -127,12 +131,10 @@ TEST(FaultReset, MgsrIsDoneWhenEveryDriveOfTheGroupLeftFault) {
   r.step();
   EXPECT_TRUE(r.out[0].fault_reset);
   EXPECT_TRUE(r.out[1].fault_reset);
-  r.fb[0].drive = DriveState::NotReady;
-  r.fb[0].drive_fault = false;
+  leave_fault(r);
   r.step(2);
   EXPECT_FALSE(r.tag("sr").dn()) << "B is still in Fault";
-  r.fb[1].drive = DriveState::NotReady;
-  r.fb[1].drive_fault = false;
+  leave_fault(r, 1);
   r.step();
   EXPECT_TRUE(r.tag("sr").dn());
   EXPECT_FALSE(r.tag("sr").er());
@@ -150,8 +152,7 @@ TEST(FaultReset, MgsrEndsWithErrorWhenOneDriveStaysInFault) {
   r.step();
   ASSERT_EQ(r.exec("MGSR(g, sr);"), Err::None);
   r.step();  // the pulses go out
-  r.fb[0].drive = DriveState::NotReady;
-  r.fb[0].drive_fault = false;
+  leave_fault(r);
   r.fb[1].transition_timeout = true;
   r.step();
   EXPECT_TRUE(r.tag("sr").er());
@@ -166,8 +167,7 @@ TEST(FaultReset, MsoIssuedWhileTheResetWaitsWaitsToo) {
   ASSERT_EQ(r.exec("MSO(D, mso2);"), Err::None);
   r.step(3);  // still in Fault: the MSO does not fail (ERR 12) meanwhile
   EXPECT_FALSE(r.tag("mso2").er());
-  r.fb[0].drive = DriveState::NotReady;
-  r.fb[0].drive_fault = false;
+  leave_fault(r);
   r.step();
   EXPECT_TRUE(r.tag("fr").dn());
   r.fb[0].drive = DriveState::Enabled;
