@@ -338,7 +338,11 @@ TEST_P(NmtStateWhileRunning, FaultsTheAxisAtTheHeartbeatAndMasrRestartsTheNode) 
   nmt.data[0] = GetParam();  // 0x80 enter pre-operational, 0x02 stop
   nmt.data[1] = kNode;
   ASSERT_EQ(tool.send(nmt), can::SendResult::kOk);
+  const std::int64_t sent = r.now;
   ASSERT_TRUE(r.run_until([&] { return module_fault(r.read("X.AxisFault")); }, 1000));
+  std::printf("NMT 0x%02X sent at %.0f ms: the drive's next heartbeat received at %.0f ms, axis faulted in the cycle "
+              "of %.0f ms (0x1017 = 100 ms)\n",
+              GetParam(), ms(sent), ms(r.last_hb_rx_ns), ms(r.status().time_ns));
   EXPECT_EQ(r.hb_rx, hb_before + 1) << "the axis faulted at the first heartbeat after the NMT change";
   EXPECT_GE(r.status().time_ns, r.last_hb_rx_ns);
   EXPECT_LE(r.status().time_ns - r.last_hb_rx_ns, kPeriod) << "not in the cycle that received the heartbeat";
