@@ -3,7 +3,9 @@
 /// The Controller: one cycle of canmotion, joining the motion planner and the
 /// CANopen drive networks (DESIGN.md, "One cycle"):
 ///
-///   2. drain received frames on every bus (TPDOs, EMCY, heartbeats, SDO)
+///   2. drain received frames on every bus (TPDOs, EMCY, heartbeats, SDO);
+///      heartbeat timeouts and node events reach the drive proxies
+///      (DriveNetwork::update), so the planner sees them this cycle
 ///   3. convert drive feedback from counts to position units
 ///   4. take pending instruction requests from the command ring
 ///   5. plan: Planner::update (masters before slaves, inside the planner)
