@@ -61,8 +61,10 @@ required=(
 unitdir=$(pkg-config --variable=systemdsystemunitdir systemd 2>/dev/null || echo /usr/lib/systemd/system)
 sysusersdir=$(pkg-config --variable=sysusersdir systemd 2>/dev/null || echo /usr/lib/sysusers.d)
 networkdir=$(pkg-config --variable=systemdutildir systemd 2>/dev/null || echo /usr/lib/systemd)/network
+udevdir=$(dirname "$(pkg-config --variable=systemdutildir systemd 2>/dev/null || echo /usr/lib/systemd)")/udev/rules.d
 required+=("$unitdir/canmotiond.service" "$unitdir/cia402-emu@.service" "$unitdir/canmotion-vcan@.service"
-           "$sysusersdir/canmotion.conf" "$networkdir/80-vcan0.netdev" "$networkdir/80-vcan0.network")
+           "$sysusersdir/canmotion.conf" "$networkdir/80-vcan0.netdev" "$networkdir/80-vcan0.network"
+           "$udevdir/60-canmotion-cpu-dma-latency.rules")
 # Every example of the source tree (EDS files included, wherever they are kept) is in the package.
 while IFS= read -r f; do required+=("/usr/share/canmotion/examples/${f#"$src"/config/examples/}"); done < <(
   find "$src/config/examples" -type f \( -name '*.yaml' -o -name '*.script' -o -iname '*.eds' \))
@@ -98,6 +100,7 @@ done
 [[ $(cat "$work/control/conffiles" 2>/dev/null) == /etc/canmotion/canmotiond.yaml ]] ||
   fail "conffiles: '$(cat "$work/control/conffiles" 2>/dev/null)', expected /etc/canmotion/canmotiond.yaml"
 grep -q 'systemd-sysusers' "$work/control/postinst" || fail "postinst does not run systemd-sysusers"
+grep -q 'udevadm control --reload' "$work/control/postinst" || fail "postinst does not reload udev's rules"
 grep -q 'daemon-reload' "$work/control/postinst" || fail "postinst does not run daemon-reload"
 grep -q '/run/systemd/system' "$work/control/postinst" || fail "postinst calls systemctl unguarded"
 
