@@ -1,0 +1,552 @@
+"""Unit tests of the independent CiA 402 peer (tests/peers/cia402_peer.py).
+
+Run: /usr/bin/python3 -m unittest discover -s tests/peers -p 'test_*.py'
+(ctest label `unit`). Everything runs on python-can's in-process `virtual`
+bus and a virtual clock (link.VirtualLink): no AF_CAN, no sleeping.
+Each expectation is written from the CiA 301 / CiA 402 tables, not from
+canmotion's fieldbus/ code: spec_checks.py's conformance checks (each
+names its clause) plus the peer's own options and fault injection below.
+"""
+
+import os
+import struct
+import subprocess
+import sys
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+import cia402_peer as peer  # noqa: E402
+import spec_checks  # noqa: E402
+from link import SdoAbort, SdoClient, VirtualLink  # noqa: E402
+
+NODE = 5
+SYNC, EMCY, TPDO1, TPDO2, RPDO1, HB = 0x080, 0x080 + NODE, 0x180 + NODE, 0x280 + NODE, 0x200 + NODE, 0x700 + NODE
+PERIOD = 0.004
+
+
+class PeerCase(unittest.TestCase):
+    def make(self, **kw):
+        self.link = VirtualLink(peer.Drive(NODE, **kw))
+        self.drive = self.link.drive
+        self.sdo = SdoClient(self.link, NODE)
+        self.addCleanup(self.link.close)
+        return self.link
+
+    def frames(self, can_id):
+        """Queued frames with this id (consumed), oldest first."""
+        self.link.poll()
+        got = [f for f in self.link.queue if f[1] == can_id]
+        self.link.queue = [f for f in self.link.queue if f[1] != can_id]
+        return got
+
+    def nmt(self, cs, node=NODE):
+        self.link.send(0x000, bytes([cs, node]))
+
+    def sync(self, n=1):
+        out = []
+        for _ in range(n):
+            self.link.send(SYNC)
+            out += self.frames(TPDO1)
+            self.link.advance(PERIOD)
+        return out
+
+    def csp(self, position=None):
+        """The CSP set-up a master does: PDOs remapped, 0x6060 = 8, NMT start."""
+        c = spec_checks.Ctx(self.link, NODE, PERIOD)
+        c.csp_pdos()
+        self.sdo.write(0x6060, 0, 8, '<b')
+        self.nmt(0x01)
+        return c
+
+    def rpdo(self, cw, target):
+        self.link.send(RPDO1, struct.pack('<Hi', cw, target))
+
+    def enable(self, target):
+        for cw in (0x0006, 0x0007, 0x000F):
+            self.rpdo(cw, target)
+            self.sync()
+        self.assertEqual(self.drive.state, peer.OPERATION_ENABLED)
+
+
+class SpecConformance(unittest.TestCase):
+    """spec_checks.CHECKS against the peer: every one must pass (none may skip)."""
+
+
+def _add_spec_test(name, clause, fn):
+    def test(self):
+        link = VirtualLink(peer.Drive(NODE))
+        self.addCleanup(link.close)
+        c = spec_checks.Ctx(link, NODE, PERIOD)
+        c.reset()
+        fn(c)
+    test.__doc__ = clause
+    setattr(SpecConformance, 'test_' + name, test)
+
+
+for _name, _clause, _fn in spec_checks.CHECKS:
+    _add_spec_test(_name, _clause, _fn)
+
+
+class Sdo(PeerCase):
+    def test_multi_segment_download_and_upload(self):
+        self.make()
+        for n in (5, 7, 14, 20, 64):        # 7 and 14: the last segment is full (n = 0)
+            text = bytes(range(0x41, 0x41 + n))
+            self.sdo.download(0x2000, 0, text)
+            self.assertEqual(self.sdo.upload(0x2000, 0), text, f'{n} bytes')
+
+    def test_segmented_upload_frames(self):
+        # 0x1008 = 21 bytes: 41h + size 21, then 3 segments: 00h, 10h, then
+        # 0x0B = toggle 0, n = 0 (7 bytes), c = 1 (CiA 301 upload segment).
+        self.make()
+        self.link.send(0x600 + NODE, struct.pack('<BHB4x', 0x40, 0x1008, 0))
+        self.assertEqual(self.frames(0x580 + NODE)[0][2], struct.pack('<BHBI', 0x41, 0x1008, 0, 21))
+        cmds = []
+        for toggle in (0, 1, 0):
+            self.link.send(0x600 + NODE, bytes([0x60 | toggle << 4]) + bytes(7))
+            cmds.append(self.frames(0x580 + NODE)[0][2][0])
+        self.assertEqual(cmds, [0x00, 0x10, 0x01])
+
+    def test_expedited_download_without_size(self):
+        # e = 1, s = 0 (22h): the server takes the object's size from 4 data bytes.
+        self.make()
+        self.link.send(0x600 + NODE, struct.pack('<BHBI', 0x22, 0x607A, 0, 0xFFFFFF85))
+        self.assertEqual(self.frames(0x580 + NODE)[0][2][0], 0x60)
+        self.assertEqual(self.sdo.read(0x607A, 0, '<i'), -123)
+
+    def test_segmented_download_size_mismatch_at_initiate(self):
+        self.make()
+        self.assertEqual(self.sdo.abort_code(self.sdo.download, 0x6040, 0, b'\x0f\x00\x00\x00', segmented=True),
+                         peer.ABORT_LENGTH)
+
+    def test_segmented_download_unsized_too_long(self):
+        self.make()
+        r = self.sdo.request(struct.pack('<BHB', 0x20, 0x6040, 0))     # no size indicated
+        self.assertEqual(r[0], 0x60)
+        r = self.sdo.request(bytes([0x00 | 3 << 1 | 1, 1, 2, 3, 4]))    # 4 bytes, last
+        self.assertEqual(struct.unpack_from('<BHBI', r), (0x80, 0x6040, 0, peer.ABORT_LENGTH))
+
+    def test_string_too_long(self):
+        self.make()
+        self.assertEqual(self.sdo.abort_code(self.sdo.download, 0x2000, 0, bytes(65)), peer.ABORT_LENGTH_HIGH)
+
+    def test_server_timeout(self):
+        self.make()
+        r = self.sdo.request(struct.pack('<BHB', 0x40, 0x1008, 0))
+        self.assertEqual(r[0], 0x41)
+        self.link.advance(0.9)
+        self.assertEqual(self.frames(0x580 + NODE), [])
+        self.link.advance(0.2)
+        (t, _, data), = self.frames(0x580 + NODE)
+        self.assertEqual(struct.unpack_from('<BHBI', data), (0x80, 0x1008, 0, peer.ABORT_TIMEOUT))
+
+    def test_client_abort_ends_transfer(self):
+        self.make()
+        self.sdo.request(struct.pack('<BHB', 0x40, 0x1008, 0))
+        self.link.send(0x600 + NODE, struct.pack('<BHBI', 0x80, 0x1008, 0, 0x05040000))
+        self.assertEqual(self.frames(0x580 + NODE), [])
+        r = self.sdo.request(bytes([0x60]))
+        self.assertEqual(struct.unpack_from('<I', r, 4)[0], peer.ABORT_COMMAND)
+
+    def test_block_transfer_refused(self):
+        self.make()
+        r = self.sdo.request(struct.pack('<BHB', 0xA4, 0x1008, 0))      # block upload initiate
+        self.assertEqual(struct.unpack_from('<BHBI', r), (0x80, 0x1008, 0, peer.ABORT_COMMAND))
+
+    def test_value_range(self):
+        self.make()
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x6060, 0, 1, '<b'), peer.ABORT_VALUE)   # PP: not supported
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x605A, 0, 9, '<h'), peer.ABORT_VALUE)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1005, 0, 0x40000080), peer.ABORT_VALUE)  # SYNC producer
+
+    def test_short_request_ignored(self):
+        self.make()
+        self.link.send(0x600 + NODE, bytes([0x40, 0x00, 0x10, 0x00]))
+        self.assertEqual(self.frames(0x580 + NODE), [])
+
+
+class Nmt(PeerCase):
+    def test_boot_up_first(self):
+        self.make()
+        self.assertEqual(self.link.log[0][1:], (HB, b'\x00'))
+
+    def test_broadcast_and_other_nodes(self):
+        self.make(heartbeat_ms=10)
+        self.nmt(0x01, node=6)
+        self.assertEqual(self.drive.nmt, peer.PREOPERATIONAL)
+        self.nmt(0x01, node=0)
+        self.assertEqual(self.drive.nmt, peer.OPERATIONAL)
+        self.link.advance(0.011)
+        self.assertEqual(self.frames(HB)[-1][2], b'\x05')
+
+    def test_pdos_only_in_operational(self):
+        self.make()
+        spec_checks.Ctx(self.link, NODE, PERIOD).csp_pdos()
+        self.sdo.write(0x6040, 0, 0x0006, '<H')
+        self.rpdo(0x0000, 0)                    # ignored in pre-operational
+        self.assertEqual(self.sync(2), [])      # no TPDO in pre-operational
+        self.assertEqual(self.drive.state, peer.READY_TO_SWITCH_ON)
+        self.nmt(0x01)
+        self.assertEqual(len(self.sync(2)), 2)
+        self.nmt(0x02)
+        self.assertEqual(self.sync(2), [])
+
+    def test_reset_node_restores_defaults_keeps_position(self):
+        self.make(position=123456)
+        self.csp()
+        self.sdo.write(0x1017, 0, 100, '<H')
+        self.nmt(0x81)
+        self.assertEqual(self.frames(HB)[-1][2], b'\x00')
+        self.assertEqual(self.sdo.read(0x1A00, 0, '<B'), 1)             # default mapping: statusword
+        self.assertEqual(self.sdo.read(0x1A00, 1), 0x60410010)
+        self.assertEqual(self.sdo.read(0x1800, 1), 0x40000000 | TPDO1)  # valid, no RTR
+        self.assertEqual(self.sdo.read(0x1801, 1) >> 31, 1)             # TPDO2 not valid
+        self.assertEqual(self.sdo.read(0x1017, 0, '<H'), 0)
+        self.assertEqual(self.sdo.read(0x6060, 0, '<b'), 0)
+        self.assertEqual(self.sdo.read(0x6064, 0, '<i'), 123456)
+        self.assertEqual(self.drive.nmt, peer.PREOPERATIONAL)
+
+    def test_reset_communication_keeps_drive_state(self):
+        self.make()
+        self.sdo.write(0x6040, 0, 0x0006, '<H')
+        self.sdo.write(0x6060, 0, 8, '<b')
+        self.nmt(0x82)
+        self.assertEqual(self.frames(HB)[-1][2], b'\x00')
+        self.assertEqual(self.drive.state, peer.READY_TO_SWITCH_ON)
+        self.assertEqual(self.sdo.read(0x6060, 0, '<b'), 8)
+
+
+class Heartbeat(PeerCase):
+    def test_producer_period_exact(self):
+        self.make()
+        self.link.clear()
+        self.sdo.write(0x1017, 0, 100, '<H')
+        t0 = self.link.now()
+        self.link.advance(1.0)
+        times = [round(t - t0, 9) for t, _, _ in self.frames(HB)]
+        self.assertEqual(times, [round(0.1 * k, 9) for k in range(1, 11)])
+
+    def test_default_from_option(self):
+        self.make(heartbeat_ms=20)
+        self.link.advance(0.1)
+        self.assertEqual(len(self.frames(HB)) - 1, 5)   # boot-up + 5 heartbeats
+
+    def test_no_1016_by_default(self):
+        self.make()
+        self.assertEqual(self.sdo.abort_code(self.sdo.upload, 0x1016, 0), peer.ABORT_NO_OBJECT)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1016, 1, 0x007F012C), peer.ABORT_NO_OBJECT)
+
+    def test_1016_with_option(self):
+        self.make(consumer_heartbeat=2)
+        self.assertEqual(self.sdo.read(0x1016, 0, '<B'), 2)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1016, 0, 3, '<B'), peer.ABORT_READ_ONLY)
+        self.sdo.write(0x1016, 1, 0x007F012C)               # node 127, 300 ms
+        # CiA 301 0x1016: the same node-ID twice -> 0604 0043h
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1016, 2, 0x007F00C8), peer.ABORT_PARAM_INCOMPATIBLE)
+        self.sdo.write(0x1016, 2, 0x007E00C8)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1016, 2, 0x017E00C8), peer.ABORT_VALUE)
+
+    def test_consumer_loss(self):
+        self.make(consumer_heartbeat=1)
+        self.sdo.write(0x1016, 1, 0x007F0064)               # node 127, 100 ms
+        self.csp()
+        self.enable(0)
+        self.link.advance(0.5)
+        self.assertEqual(self.frames(EMCY), [], 'monitoring starts at the first heartbeat')
+        self.link.send(0x77F, b'\x05')
+        self.link.advance(0.099)
+        self.assertEqual(self.frames(EMCY), [])
+        self.link.advance(0.002)
+        emcy = [d for _, _, d in self.frames(EMCY)]
+        self.assertEqual(emcy, [bytes([0x30, 0x81, 0x11, 0, 0, 0, 0, 0])])   # 8130h, generic + communication
+        self.assertIn(self.drive.state, (peer.FAULT_REACTION_ACTIVE, peer.FAULT))
+        self.assertEqual(self.drive.nmt, peer.PREOPERATIONAL)               # 0x1029 default
+        self.link.send(0x77F, b'\x05')                     # back; the fault stays until reset
+        self.assertEqual(self.frames(EMCY), [])
+        self.link.send(SYNC)
+        for cw in (0x0000, 0x0080):
+            self.sdo.write(0x6040, 0, cw, '<H')
+        self.assertEqual([d for _, _, d in self.frames(EMCY)], [bytes(8)])
+        self.assertEqual(self.drive.state, peer.SWITCH_ON_DISABLED)
+
+
+class PdoRules(PeerCase):
+    def test_fewer_pdos(self):
+        self.make()
+        for index in (0x1402, 0x1602, 0x1802, 0x1A02):
+            self.assertEqual(self.sdo.abort_code(self.sdo.upload, index, 1), peer.ABORT_NO_OBJECT, hex(index))
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1802, 1, 0x80000385), peer.ABORT_NO_OBJECT)
+        self.make(rpdos=4, tpdos=3)
+        self.assertEqual(self.sdo.read(0x1403, 1), 0x80000505)
+        self.assertEqual(self.sdo.read(0x1802, 1), 0xC0000385)
+        self.assertEqual(self.sdo.abort_code(self.sdo.upload, 0x1803, 1), peer.ABORT_NO_OBJECT)
+
+    def test_pdo_changes_refused_in_operational(self):
+        self.make()
+        self.nmt(0x01)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1800, 1, 0x80000000 | TPDO1), peer.ABORT_DEVICE_STATE)
+        self.nmt(0x80)
+        self.sdo.write(0x1800, 1, 0x80000000 | TPDO1)
+        self.nmt(0x01)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1A00, 0, 0, '<B'), peer.ABORT_DEVICE_STATE)
+
+    def test_unset_entry(self):
+        self.make()
+        self.sdo.write(0x1800, 1, 0x80000000 | TPDO1)
+        self.sdo.write(0x1A00, 0, 0, '<B')
+        self.sdo.write(0x1A00, 1, 0x60410010)
+        self.sdo.write(0x1A00, 2, 0)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1A00, 0, 2, '<B'), peer.ABORT_PARAM_INCOMPATIBLE)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1A00, 0, 9, '<B'), peer.ABORT_PDO_LENGTH)
+
+    def test_cob_id_rules(self):
+        self.make()
+        self.sdo.write(0x1801, 1, 0x80000000 | TPDO2)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1801, 1, 0x581), peer.ABORT_VALUE)     # restricted
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1801, 1, 0x20000285), peer.ABORT_VALUE)  # 29 bit
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1800, 3, 10, '<H'), peer.ABORT_VALUE)   # inhibit, valid
+        self.sdo.write(0x1801, 3, 10, '<H')                                                          # invalid: ok
+        self.assertEqual(self.sdo.abort_code(self.sdo.upload, 0x1800, 4), peer.ABORT_NO_SUB)
+
+    def test_transmission_type_every_nth_sync(self):
+        self.make()
+        c = spec_checks.Ctx(self.link, NODE, PERIOD)
+        c.remap(False, 1, [0x60410010], ttype=3)
+        self.nmt(0x01)
+        self.link.clear()
+        got = []
+        for k in range(1, 10):
+            self.link.send(SYNC)
+            got += [k] * len(self.frames(TPDO1))
+        self.assertEqual(got, [3, 6, 9])
+
+    def test_event_driven_tpdo_timer_and_inhibit(self):
+        self.make()
+        c = spec_checks.Ctx(self.link, NODE, PERIOD)
+        c.remap(False, 2, [0x60410010], ttype=255)
+        self.sdo.write(0x1801, 1, 0x80000000 | TPDO2)
+        self.sdo.write(0x1801, 3, 500, '<H')                 # inhibit 50 ms
+        self.sdo.write(0x1801, 5, 200, '<H')                 # event timer 200 ms
+        self.sdo.write(0x1801, 1, TPDO2)
+        self.nmt(0x01)
+        t0 = self.link.now()
+        self.assertEqual(len(self.frames(TPDO2)), 1)         # first: on NMT start
+        self.sdo.write(0x6040, 0, 0x0006, '<H')              # change within the inhibit time
+        self.assertEqual(self.frames(TPDO2), [])
+        self.link.advance(0.05)
+        (t, _, d), = self.frames(TPDO2)
+        self.assertAlmostEqual(t - t0, 0.05, places=6)
+        self.assertEqual(d, struct.pack('<H', 0x0231))
+        self.link.advance(0.45)
+        self.assertEqual([round(f[0] - t0, 6) for f in self.frames(TPDO2)], [0.25, 0.45])
+
+class StateMachine(PeerCase):
+    def test_fault_from_every_state_and_reset(self):
+        # 13 from any state, 14 at the next SYNC, 15 on the 0->1 edge of bit 7.
+        for cws in ((), (0x06,), (0x06, 0x07), (0x06, 0x0F), (0x06, 0x0F, 0x02)):
+            self.make()
+            self.sdo.write(0x605A, 0, 6, '<h')
+            self.sdo.write(0x6060, 0, 8, '<b')
+            for cw in cws:
+                self.sdo.write(0x6040, 0, cw, '<H')
+            before = self.drive.state
+            self.link.send(0x000, bytes([0x01, NODE]))
+            self.link.runner.command('fault 0x2310')
+            self.assertEqual(self.drive.state, peer.FAULT_REACTION_ACTIVE, peer.STATE_NAMES[before])
+            self.sdo.write(0x6040, 0, 0x0080, '<H')                 # ignored in fault reaction
+            self.link.send(SYNC)
+            self.assertEqual(self.drive.state, peer.FAULT)
+            self.assertEqual(self.sdo.read(0x6041, 0, '<H') & 0x4F, 0x08)
+            self.sdo.write(0x6040, 0, 0x0080, '<H')                 # bit 7 still 1: no edge
+            self.assertEqual(self.drive.state, peer.FAULT)
+            self.sdo.write(0x6040, 0, 0x0000, '<H')
+            self.sdo.write(0x6040, 0, 0x0080, '<H')
+            self.assertEqual(self.drive.state, peer.SWITCH_ON_DISABLED)
+            self.assertEqual(self.drive.transitions[-3:], [13, 14, 15])
+
+    def test_held_fault_refuses_reset_until_clear(self):
+        self.make()
+        self.link.runner.command('fault 0x4310 hold')
+        self.link.send(SYNC)
+        for cw in (0x0000, 0x0080):
+            self.sdo.write(0x6040, 0, cw, '<H')
+        self.assertEqual(self.drive.state, peer.FAULT)
+        self.link.runner.command('clear')
+        for cw in (0x0000, 0x0080):
+            self.sdo.write(0x6040, 0, cw, '<H')
+        self.assertEqual(self.drive.state, peer.SWITCH_ON_DISABLED)
+
+    def test_bit7_blocks_commands(self):
+        self.make()
+        self.sdo.write(0x6040, 0, 0x0086, '<H')                     # shutdown + fault reset bit
+        self.assertEqual(self.drive.state, peer.SWITCH_ON_DISABLED)
+        self.sdo.write(0x6040, 0, 0x0006, '<H')
+        self.assertEqual(self.drive.state, peer.READY_TO_SWITCH_ON)
+
+    def test_statusword_bits(self):
+        self.make()
+        self.sdo.write(0x6060, 0, 8, '<b')
+        got = []
+        for cw in (0x0000, 0x0006, 0x0007, 0x000F, 0x0002):
+            self.sdo.write(0x6040, 0, cw, '<H')
+            got.append(self.sdo.read(0x6041, 0, '<H'))
+        # SOD, RTSO, SO, OE + bit 12 (CSP follows), QSA: + voltage (4) and remote (9)
+        self.assertEqual(got, [0x0250, 0x0231, 0x0233, 0x1237, 0x0217])
+
+
+class Emcy(PeerCase):
+    def test_emcy_bytes_and_registers(self):
+        self.make()
+        self.link.runner.command('fault 0x2310')
+        self.assertEqual([d for _, _, d in self.frames(EMCY)], [bytes([0x10, 0x23, 0x03, 0, 0, 0, 0, 0])])
+        self.assertEqual(self.sdo.read(0x603F, 0, '<H'), 0x2310)
+        self.assertEqual(self.sdo.read(0x1001, 0, '<B'), 0x03)      # generic + current
+        self.link.send(SYNC)
+        for cw in (0x0000, 0x0080):
+            self.sdo.write(0x6040, 0, cw, '<H')
+        self.assertEqual([d for _, _, d in self.frames(EMCY)], [bytes(8)])   # 0000h, register 0
+        self.assertEqual(self.sdo.read(0x603F, 0, '<H'), 0)
+        self.assertEqual(self.sdo.read(0x1001, 0, '<B'), 0)
+
+    def test_default_code_is_manufacturer_specific(self):
+        self.make()
+        self.link.runner.command('fault')
+        self.assertEqual(self.frames(EMCY)[0][2][:3], bytes([0x00, 0xFF, 0x81]))
+
+    def test_no_emcy_when_stopped_or_invalid(self):
+        self.make()
+        self.nmt(0x02)
+        self.link.runner.command('fault')
+        self.assertEqual(self.frames(EMCY), [])
+        self.make()
+        self.sdo.write(0x1014, 0, 0x80000000 | EMCY)
+        self.link.runner.command('fault')
+        self.assertEqual(self.frames(EMCY), [])
+        self.assertIsNone(self.sdo.abort_code(self.sdo.write, 0x1014, 0, 0x90))
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x1014, 0, 0x91), peer.ABORT_VALUE)
+
+
+class Csp(PeerCase):
+    def test_enable_at_start_position_without_jump(self):
+        self.make(position=123456)
+        self.csp()
+        self.link.clear()
+        self.enable(123456)
+        positions = [struct.unpack('<Hi', d)[1] for _, _, d in self.sync(5)]
+        self.assertEqual(set(positions), {123456})
+        self.assertEqual(self.drive.enable_log, [(123456, 123456)])
+        self.assertEqual(self.drive.max_step, 0)
+
+    def test_enable_with_a_stale_target_jumps(self):
+        # What a master that forgets 0x607A := 0x6064 gets: the peer obeys.
+        self.make(position=123456)
+        self.csp()
+        self.enable(0)
+        positions = [struct.unpack('<Hi', d)[1] for _, _, d in self.sync(2)]
+        self.assertEqual(positions[-1], 0)
+        self.assertEqual(self.drive.max_step, 123456)
+
+    def test_target_taken_at_sync_reported_at_next(self):
+        self.make()
+        self.csp()
+        self.enable(0)
+        seen = []
+        for k in range(1, 6):
+            self.rpdo(0x000F, 100 * k)
+            self.assertEqual(self.drive.target, 0 if k == 1 else 100 * (k - 1), 'RPDO applied before SYNC')
+            seen += [struct.unpack('<Hi', d)[1] for _, _, d in self.sync()]
+        self.assertEqual(seen, [0, 100, 200, 300, 400])
+
+    def test_velocity_uses_60c2(self):
+        self.make()
+        self.sdo.write(0x60C2, 1, 4, '<B')
+        self.sdo.write(0x60C2, 2, -3, '<b')
+        self.csp()
+        self.enable(0)
+        for k in range(1, 4):
+            self.rpdo(0x000F, 40 * k)
+            self.sync()
+        self.assertEqual(self.sdo.read(0x606C, 0, '<i'), 10000)      # 40 counts per 4 ms
+
+    def test_no_motion_unless_enabled_in_csp(self):
+        self.make(position=7)
+        self.csp()
+        self.sdo.write(0x6060, 0, 0, '<b')
+        self.enable(1000)
+        self.sync(3)
+        self.assertEqual(self.drive.actual, 7, 'mode 0: no motion')
+        self.sdo.write(0x6060, 0, 8, '<b')
+        self.rpdo(0x0006, 2000)
+        self.sync(3)
+        self.assertEqual(self.drive.actual, 7, 'ready to switch on: no motion')
+
+    def test_quick_stop_holds_position(self):
+        self.make()
+        self.csp()
+        self.enable(0)
+        self.rpdo(0x000F, 500)
+        self.sync(2)
+        self.rpdo(0x0002, 900)
+        sw = [struct.unpack('<Hi', d) for _, _, d in self.sync(3)]
+        self.assertEqual([peer.STATE_BITS[peer.QUICK_STOP_ACTIVE], 0x0040], [sw[1][0] & 0x6F, sw[2][0] & 0x4F])
+        self.assertEqual(self.drive.actual, 500)
+
+
+class ControlAndCli(PeerCase):
+    def test_silence_and_resume(self):
+        self.make(heartbeat_ms=10)
+        self.link.runner.command('silence')
+        self.link.advance(0.1)
+        self.assertEqual(self.frames(HB)[1:], [])
+        self.link.runner.command('resume')
+        self.link.advance(0.1)
+        self.assertGreaterEqual(len(self.frames(HB)), 9)
+
+    def test_local_nmt_and_reset(self):
+        self.make(heartbeat_ms=10)
+        self.nmt(0x01)
+        self.link.runner.command('nmt preop')
+        self.assertEqual(self.drive.nmt, peer.PREOPERATIONAL)
+        self.link.runner.command('reset')
+        self.assertEqual(self.frames(HB)[-1][2], b'\x00')
+
+    def test_bad_command(self):
+        import contextlib
+        import io
+        self.make()
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            self.link.runner.command('fault xyz')
+            self.link.runner.command('explode')
+        self.assertIn("'fault xyz'", err.getvalue())
+        self.assertIn("'explode': unknown command", err.getvalue())
+
+    def run_cli(self, *args):
+        return subprocess.run([sys.executable, os.path.join(HERE, 'cia402_peer.py'), *args],
+                              capture_output=True, text=True, timeout=60)
+
+    def test_help(self):
+        r = self.run_cli('--help')
+        self.assertEqual(r.returncode, 0)
+        for word in ('--control', '--position', '--consumer-heartbeat', 'fault [CODE] [hold]', 'Exit status'):
+            self.assertIn(word, r.stdout)
+
+    def test_bad_arguments(self):
+        r = self.run_cli('-i', 'vcan0', '-n', '0')
+        self.assertEqual(r.returncode, 2)
+        self.assertIn('--node 0: a node-ID is 1..127', r.stderr)
+        r = self.run_cli('-i', 'vcan0', '-n', '5', '--rpdos', '9')
+        self.assertEqual(r.returncode, 2)
+
+    def test_virtual_bus_run(self):
+        # The whole program on python-can's virtual bus: boot-up, then exit at --duration.
+        r = self.run_cli('-i', 'peer-cli-test', '--bus-type', 'virtual', '-n', '5', '--duration', '0.2', '-v')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn('boot-up, NMT pre-operational', r.stdout)
+        self.assertIn('0 SYNC;', r.stdout)
+
+
+if __name__ == '__main__':
+    unittest.main()

@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# vcan.peer.*, COMMAND part (runs where vcan0 is up, candump -L writing
+# $CANMOTION_TRACE): canmotiond against the independent peer as separate
+# processes.
+#   vcan-peer-run.sh SCENARIO CANMOTIOND [PEER_OPTION...]
+# SCENARIO is boot_enable_move, fault_recovery or vanish (scenarios/*.script).
+# 1. canmotiond --config vcan.yaml --script scenarios/SCENARIO.script --csv,
+#    real time; then the peer powers up (/usr/bin/python3 cia402_peer.py
+#    -i vcan0 -n 5 --position 123456 --control FIFO -v PEER_OPTION...);
+# 2. fault_recovery: after canmotiond printed the `X.JogStatus` line, the
+#    peer gets `fault 0xFF00` on its control FIFO; vanish: the peer is
+#    killed with SIGKILL at that point (the kill time is logged);
+# 3. canmotiond's exit status goes to canmotiond.status (vcan_peer_check.py
+#    fails on anything but 0, after its analysis of the trace); then the
+#    peer is stopped (SIGTERM: it prints its summary) and the trace is left
+#    to settle. This script fails only when the processes cannot be run.
+# Artefacts: vcan.yaml, canmotiond.log, canmotiond.csv, canmotiond.status,
+# peer.log, events.log.
+set -euo pipefail
+scenario="$1" daemon="$2"; shift 2
+peer_opts=("$@")
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)"
+art="$CANMOTION_ARTIFACTS" trace="$CANMOTION_TRACE"
+fail() { echo "vcan-peer-run: $*" >&2; exit 1; }
+script="$here/scenarios/$scenario.script"
+[[ -f "$script" ]] || fail "no scenario '$scenario' ($script)"
+cp "$here/vcan.yaml" "$art/vcan.yaml"
+ctl="$art/peer.ctl"
+rm -f "$ctl" "$art/events.log"
+mkfifo "$ctl"
+event() { echo "$(date +%s.%N) $*" >> "$art/events.log"; }
+
+settle() {  # wait (bounded, 30 s) until the trace has not grown for 1 s
+  local last=-1 n i same=0
+  for ((i = 0; i < 60 && same < 2; i++)); do
+    n=$(wc -l < "$trace")
+    if [[ $n == "$last" ]]; then same=$((same + 1)); else same=0; fi
+    last=$n
+    sleep 0.5
+  done
+}
+ppid_=""
+cleanup() {
+  [[ -n "$ppid_" ]] && kill -TERM "$ppid_" 2>/dev/null && wait "$ppid_" 2>/dev/null
+  ppid_=""
+  settle
+}
+trap cleanup EXIT
+
+timeout -s INT -k 30 120 stdbuf -oL "$daemon" --config "$art/vcan.yaml" --script "$script" --csv "$art/canmotiond.csv" \
+  > "$art/canmotiond.log" 2>&1 &
+dpid=$!
+for ((i = 0; i < 600; i++)); do   # the banner is printed after the bus is open
+  grep -q '^canmotiond: .* buses (real time)' "$art/canmotiond.log" && break
+  kill -0 "$dpid" 2>/dev/null || break
+  sleep 0.05
+done
+grep -q '^canmotiond: .* buses (real time)' "$art/canmotiond.log" || { cat "$art/canmotiond.log" >&2; fail "canmotiond did not start"; }
+/usr/bin/python3 "$here/cia402_peer.py" -i vcan0 -n 5 --position 123456 --control "$ctl" -v "${peer_opts[@]}" \
+  > "$art/peer.log" 2>&1 &
+ppid_=$!
+event "peer started (pid $ppid_)"
+echo "vcan-peer-run: $scenario: canmotiond started, then the peer (node 5, position 123456) ${peer_opts[*]}"
+
+if [[ $scenario == fault_recovery || $scenario == vanish ]]; then
+  for ((i = 0; i < 1200; i++)); do
+    grep -q 'X.JogStatus=' "$art/canmotiond.log" && break
+    kill -0 "$dpid" 2>/dev/null || break
+    sleep 0.05
+  done
+  if grep -q 'X.JogStatus=' "$art/canmotiond.log"; then
+    if [[ $scenario == fault_recovery ]]; then
+      echo 'fault 0xFF00' > "$ctl"
+      event "peer: fault 0xFF00 injected"
+    else
+      kill -KILL "$ppid_"
+      event "peer killed (SIGKILL)"
+      wait "$ppid_" 2>/dev/null || true
+      ppid_=""
+    fi
+  fi
+fi
+
+status=0
+wait "$dpid" || status=$?
+event "canmotiond exit $status"
+echo "vcan-peer-run: canmotiond exit $status"
+cat "$art/canmotiond.log"
+cleanup
+trap - EXIT
+echo "$status" > "$art/canmotiond.status"
+echo "--- peer.log (last lines)"
+tail -n 25 "$art/peer.log"

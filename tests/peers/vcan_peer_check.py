@@ -1,0 +1,303 @@
+#!/usr/bin/python3
+"""vcan.peer.*, CHECK part: canmotiond against the independent peer, read
+from the candump -L trace ($CANMOTION_TRACE) and the artefacts of
+vcan-peer-run.sh (canmotiond.log, canmotiond.status, peer.log, events.log).
+
+  vcan_peer_check.py SCENARIO [--period-ms 10] [--node 5] [--start 123456]
+
+Every item prints PASS or FAIL with what was measured; the exit status is 1
+when any item failed. Frames are decoded here from the CiA 301/402 layouts
+(RPDO1 = controlword + target position, TPDO1 = statusword + position
+actual, as canmotiond's `pdo: csp` maps them); on a failure the frames
+around it are also shown decoded by canmotion's `cantrace`.
+"""
+
+import argparse
+import os
+import re
+import struct
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cia402_peer import ABORT_TEXT  # noqa: E402
+from spec_checks import state_of  # noqa: E402
+
+
+class Trace:
+    def __init__(self, path):
+        self.frames = []                    # (t, can_id, data)
+        with open(path) as f:
+            for line in f:
+                m = re.match(r'\((\d+\.\d+)\) \S+ ([0-9A-Fa-f]+)#([0-9A-Fa-f]*)$', line.strip())
+                if m:
+                    self.frames.append((float(m.group(1)), int(m.group(2), 16), bytes.fromhex(m.group(3))))
+
+    def of(self, can_id, t0=None, t1=None):
+        return [f for f in self.frames if f[1] == can_id and (t0 is None or f[0] >= t0) and (t1 is None or f[0] <= t1)]
+
+
+class Check:
+    def __init__(self, a):
+        self.a, self.failed = a, []
+        self.art = os.environ.get('CANMOTION_ARTIFACTS', '.')
+        self.trace_path = os.environ['CANMOTION_TRACE']
+        self.t = Trace(self.trace_path)
+        n = a.node
+        self.SYNC, self.EMCY, self.TPDO, self.RPDO = 0x080, 0x080 + n, 0x180 + n, 0x200 + n
+        self.SDO_REQ, self.SDO_RSP, self.HB = 0x600 + n, 0x580 + n, 0x700 + n
+        self.log = self.read('canmotiond.log')
+        self.peer_log = self.read('peer.log')
+        self.period = a.period_ms / 1000.0
+
+    def read(self, name):
+        try:
+            with open(os.path.join(self.art, name)) as f:
+                return f.read()
+        except OSError:
+            return ''
+
+    def item(self, ok, name, detail, around=None):
+        print(f"vcan-peer-check: {'PASS' if ok else 'FAIL'} {name}: {detail}", flush=True)
+        if not ok:
+            self.failed.append(name)
+            if around is not None:
+                self.show(around)
+        return ok
+
+    def show(self, t):
+        """The frames within 50 ms of time t, decoded by cantrace."""
+        lines = [ln for ln in open(self.trace_path) if ln.startswith('(')
+                 and abs(float(ln[1:ln.index(')')]) - t) <= 0.05]
+        cantrace = os.path.join(os.environ.get('CANMOTION_BUILD_DIR', ''), 'tools', 'cantrace', 'cantrace')
+        if lines and os.access(cantrace, os.X_OK):
+            r = subprocess.run([cantrace, '-'], input=''.join(lines), capture_output=True, text=True)
+            print('  ' + r.stdout.replace('\n', '\n  ').rstrip())
+
+    # ---- decoding ------------------------------------------------------------------
+    def tpdos(self, t0=None, t1=None):
+        return [(t, *struct.unpack('<Hi', d[:6])) for t, _, d in self.t.of(self.TPDO, t0, t1) if len(d) >= 6]
+
+    def rpdos(self, t0=None, t1=None):
+        return [(t, *struct.unpack('<Hi', d[:6])) for t, _, d in self.t.of(self.RPDO, t0, t1) if len(d) >= 6]
+
+    def sdo_transfers(self):
+        """Expedited downloads by the master: (t, index, sub, value, abort or 0 or None)."""
+        reqs, rsps = self.t.of(self.SDO_REQ), self.t.of(self.SDO_RSP)
+        out, j = [], 0
+        for t, _, d in reqs:
+            while j < len(rsps) and rsps[j][0] < t:
+                j += 1
+            rsp = rsps[j][2] if j < len(rsps) else None
+            j += 1
+            if d[0] >> 5 != 1:
+                continue
+            index, sub = struct.unpack_from('<HB', d, 1)
+            n = (d[0] >> 2) & 3 if d[0] & 1 else 0
+            value = int.from_bytes(d[4:8 - n], 'little')
+            result = None if rsp is None else (struct.unpack_from('<I', rsp, 4)[0] if rsp[0] == 0x80 else 0)
+            out.append((t, index, sub, value, result))
+        return out
+
+    def printed(self, tag):
+        return re.findall(rf'\b{re.escape(tag)}=(\S+)', self.log)
+
+    # ---- items -----------------------------------------------------------------------
+    def status(self):
+        st = self.read('canmotiond.status').strip()
+        errs = [ln for ln in self.log.splitlines() if 'ERR' in ln or 'failed' in ln]
+        self.item(st == '0', 'canmotiond exit status', f"{st or 'missing'}" + (f'; {errs[0]}' if errs else ''))
+
+    def boot(self):
+        boot = [f for f in self.t.of(self.HB) if f[2] == b'\x00']
+        if not self.item(bool(boot), 'boot-up', f'{len(boot)} boot-up message(s) 0x{self.HB:03X}#00'):
+            return None
+        xs = self.sdo_transfers()
+        aborts = [x for x in xs if x[4]]
+        unanswered = [x for x in xs if x[4] is None]
+        self.item(not aborts, 'SDO configuration without aborts',
+                  f'{len(xs)} writes, {len(aborts)} aborted' + ''.join(
+                      f'; 0x{i:04X}:{s:02X} := 0x{v:X}: abort 0x{c:08X} {ABORT_TEXT.get(c, "")}'
+                      for _, i, s, v, c in aborts[:6]), around=aborts[0][0] if aborts else None)
+        self.item(not unanswered, 'every SDO request answered', f'{len(unanswered)} without a response')
+        written = {(i, s): v for _, i, s, v, c in xs if c == 0}
+        self.item(written.get((0x6060, 0)) == 8, '0x6060 = 8 (CSP)', f'written {written.get((0x6060, 0))}')
+        v, idx = written.get((0x60C2, 1)), written.get((0x60C2, 2))
+        ok = v is not None and idx is not None and abs(v * 10.0 ** (idx - 256 if idx > 127 else idx) - self.period) < 1e-12
+        self.item(ok, '0x60C2 = the period', f'value {v}, index {None if idx is None else (idx - 256 if idx > 127 else idx)}'
+                  f' (period {self.a.period_ms} ms)')
+        for name, comm, mapi, cob, entries in (('RPDO1', 0x1400, 0x1600, self.RPDO, [0x60400010, 0x607A0020]),
+                                               ('TPDO1', 0x1800, 0x1A00, self.TPDO, [0x60410010, 0x60640020])):
+            seq = [(i, s, v) for _, i, s, v, c in xs if c == 0 and i in (comm, mapi)]
+            steps = [(comm, 1, cob | 1 << 31), (mapi, 0, 0)] + [(mapi, k + 1, e) for k, e in enumerate(entries)] + \
+                    [(mapi, 0, len(entries))]
+            pos, ok = 0, True
+            for st in steps:                 # the CiA 301 steps 1..4 in order, then valid last
+                while pos < len(seq) and seq[pos] != st:
+                    pos += 1
+                ok = ok and pos < len(seq)
+            ok = ok and bool(seq) and seq[-1] == (comm, 1, cob)
+            self.item(ok, f'{name} remap (CiA 301 procedure)',
+                      ', '.join(f'0x{i:04X}:{s}=0x{v:X}' for i, s, v in seq))
+        self.item((0x1016, 1) not in {(i, s) for _, i, s, _, _ in xs}, '0x1016 not written',
+                  'master_heartbeat_timeout_ms: 0, and the peer has no 0x1016 (optional in CiA 301)')
+        last_cfg = max((x[0] for x in xs), default=0)
+        starts = [f[0] for f in self.t.of(0x000) if f[2] in (bytes([1, self.a.node]), b'\x01\x00')]
+        self.item(bool(starts) and starts[0] > last_cfg, 'NMT start after the configuration',
+                  f'NMT start at +{starts[0] - boot[0][0]:.3f} s after boot-up' if starts else 'no NMT start')
+        return starts[0] if starts else None
+
+    def enable(self, t_start):
+        tp = self.tpdos(t_start)
+        oe = [t for t, sw, _ in tp if state_of(sw) == 'operation enabled']
+        if not self.item(bool(oe), 'enabled', f'first TPDO1 with Operation enabled at +{oe[0] - t_start:.3f} s' if oe
+                         else 'no TPDO1 shows Operation enabled'):
+            return None
+        window_end = oe[0] + 0.4
+        pos = {p for _, _, p in self.tpdos(t_start, window_end)}
+        tgt = {p for _, _, p in self.rpdos(t_start, window_end)}
+        self.item(pos == {self.a.start} and tgt <= {self.a.start}, 'enable without a jump',
+                  f'TPDO1 positions {sorted(pos)}, RPDO1 targets {sorted(tgt)} up to 0.4 s after enable '
+                  f'(start {self.a.start})', around=oe[0])
+        m = re.search(r'operation enabled at position (-?\d+), first set-point (-?\d+)', self.peer_log)
+        self.item(bool(m) and m.group(1) == m.group(2) == str(self.a.start), "peer: first set-point = position",
+                  m.group(0) if m else 'no enable line in peer.log')
+        got = self.printed('X.ActualPosition')
+        want = f'{self.a.start / 1000:g}'
+        self.item(bool(got) and got[0] == want, 'X.ActualPosition after MSO', f'{got[:1]} (want {want})')
+        return oe[0]
+
+    def move(self, start, distance):
+        rp, tp = self.rpdos(), self.tpdos()
+        end = start + distance
+        moving = [p for _, _, p in rp if p != start]
+        self.item(bool(moving) and max(moving) == end and rp[-1][2] == end, 'MAM target',
+                  f'RPDO1 targets up to {max(moving) if moving else None}, last {rp[-1][2] if rp else None} (want {end})')
+        self.item(bool(tp) and tp[-1][2] == end, 'MAM arrives exactly', f'last TPDO1 position {tp[-1][2] if tp else None}'
+                  f' (want {end})', around=tp[-1][0] if tp else None)
+        got = self.printed('X.ActualPosition')
+        want = f'{end / 1000:g}'
+        self.item(bool(got) and got[-1] == want, 'X.ActualPosition after the MAM', f'{got[-1:]} (want {want})')
+
+    def sync_period(self, t_start):
+        syncs = [t for t, _, _ in self.t.of(self.SYNC)]
+        ints = sorted(b - a for a, b in zip(syncs, syncs[1:]))
+        if not self.item(len(ints) > 100, 'SYNC', f'{len(syncs)} SYNC frames'):
+            return
+        mean = sum(ints) / len(ints)
+        mx = float(os.environ.get('PEER_SYNC_MEAN_MAX', '1.5'))
+        self.item(0.95 * self.period <= mean <= mx * self.period, 'SYNC period',
+                  f'mean {1e3 * mean:.3f} ms, min {1e3 * ints[0]:.3f}, median {1e3 * ints[len(ints) // 2]:.3f}, '
+                  f'p99 {1e3 * ints[int(len(ints) * 0.99)]:.3f}, max {1e3 * ints[-1]:.3f} ms over {len(ints)} '
+                  f'(period {self.a.period_ms} ms; allowed 0.95 .. {mx} periods: the VM misses deadlines)')
+        n_sync = len([t for t in syncs if t > t_start])
+        n_tpdo = len(self.tpdos(t_start))
+        self.item(n_tpdo >= 0.9 * n_sync and n_tpdo <= n_sync, 'one TPDO1 per SYNC',
+                  f'{n_tpdo} TPDO1 for {n_sync} SYNC after NMT start')
+        m = re.search(r'(\d+) SYNC, interval mean ([\d.]+) ms', self.peer_log)
+        if m:
+            print(f'vcan-peer-check: info: the peer counted {m.group(1)} SYNC, mean interval {m.group(2)} ms '
+                  f'(time.monotonic)')
+
+    def fault_recovery(self, t_start):
+        emcy = [f for f in self.t.of(self.EMCY) if f[2][:2] == b'\x00\xff']
+        if not self.item(bool(emcy) and emcy[0][2] == bytes([0x00, 0xFF, 0x81, 0, 0, 0, 0, 0]), 'EMCY 0xFF00',
+                         emcy[0][2].hex() if emcy else 'none'):
+            return
+        t_e = emcy[0][0]
+        states = []
+        for t, sw, p in self.tpdos(t_e):
+            s = state_of(sw)
+            if not states or states[-1][1] != s:
+                states.append((t, s, p))
+        names = [s for _, s, _ in states]
+        self.item(names[:2] == ['fault reaction active', 'fault'], 'statusword after the EMCY',
+                  ' -> '.join(names[:6]))
+        t_fault = next((t for t, s, _ in states if s == 'fault'), None)
+        rp = self.rpdos(t_e)
+        edge = next((t for (t0, c0, _), (t, c, _) in zip(rp, rp[1:]) if c & 0x80 and not c0 & 0x80), None)
+        ok = edge is not None and t_fault is not None and edge - t_e <= 20 * self.period
+        self.item(ok, 'fault reset: rising edge of controlword bit 7',
+                  f'{1e3 * (edge - t_e):.1f} ms after the EMCY ({(edge - t_e) / self.period:.1f} cycles; at most 20)'
+                  if edge else 'no 0->1 edge of bit 7 after the EMCY', around=edge or t_e)
+        reset = [f for f in self.t.of(self.EMCY, t_e) if f[2] == bytes(8)]
+        self.item(bool(reset) and edge is not None and reset[0][0] >= edge, 'peer: EMCY 0000h (error reset) after it',
+                  f'at +{1e3 * (reset[0][0] - t_e):.1f} ms' if reset else 'none')
+        oe2 = next((t for t, s, _ in states if s == 'operation enabled'), None)
+        self.item(oe2 is not None, 're-enabled by MSO', ' -> '.join(names))
+        if oe2 is None:
+            return
+        pos = next(p for t, s, p in states if t == oe2)
+        tgt = {p for _, _, p in self.rpdos(oe2 - 0.1, oe2 + 0.3)}
+        self.item(tgt == {pos}, 're-enable without a jump', f'position {pos}, RPDO1 targets {sorted(tgt)}')
+        tp = self.tpdos()
+        self.item(tp[-1][2] == pos + 10000, 'MAM after the recovery arrives exactly',
+                  f'last TPDO1 position {tp[-1][2]} (want {pos} + 10000)')
+        got = self.printed('X.AxisFault')
+        self.item(got[:2] == ['1', '0'], 'X.AxisFault 1 after the EMCY, 0 after MAFR + MSO', f'{got}')
+
+    def vanish(self, t_start):
+        peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
+        killed = re.search(r'^(\d+\.\d+) peer killed', self.read('events.log'), re.M)
+        peer = [f for f in self.t.frames if f[1] in peer_ids]
+        if not self.item(bool(killed) and bool(peer), 'peer killed', f'at {killed.group(1)}' if killed else 'never'):
+            return
+        t_kill = float(killed.group(1))
+        t_last = peer[-1][0]
+        hb = [t for t, _, _ in self.t.of(self.HB) if t <= t_last]
+        t_hb = hb[-1]
+        consumer = 3 * 0.050                        # drives.heartbeat_ms x 3
+        print(f'vcan-peer-check: info: last peer frame {1e3 * (t_last - t_kill):+.1f} ms, last heartbeat '
+              f'{1e3 * (t_hb - t_kill):+.1f} ms from the kill')
+        rp = self.rpdos(t_last)
+        off = next((t for t, cw, _ in rp if not cw & 0x08), None)
+        slack = float(os.environ.get('PEER_VANISH_SLACK_MS', '20')) / 1000.0
+        bound = consumer + self.period
+        if off is None:
+            self.item(False, 'axis reaction on the bus', 'no RPDO1 with enable operation (bit 3) cleared after the '
+                      'peer vanished', around=t_last + consumer)
+        else:
+            d = off - t_hb
+            self.item(d <= bound + slack, 'axis reaction on the bus',
+                      f'servo off (controlword bit 3 = 0) {1e3 * d:.1f} ms after the last heartbeat; consumer time '
+                      f'{1e3 * consumer:.0f} ms + one cycle = {1e3 * bound:.0f} ms (+{1e3 * slack:.0f} ms VM allowance)',
+                      around=off)
+        m = re.search(r'heartbeat lost \(none for ([\d.]+) ms', self.log)
+        self.item(bool(m) and float(m.group(1)) <= 1e3 * (bound + slack), "canmotiond: 'heartbeat lost'",
+                  f'none for {m.group(1)} ms (bound {1e3 * bound:.0f} ms + {1e3 * slack:.0f})' if m
+                  else 'no heartbeat-lost message')
+        fault = self.printed('X.AxisFault')
+        jog = self.printed('X.JogStatus')
+        self.item(fault == ['1'] and jog[-1:] == ['0'], 'X.AxisFault = 1, jog stopped',
+                  f'AxisFault {fault}, ModuleFault {self.printed("X.ModuleFault")}, JogStatus {jog}')
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0],
+                                 epilog='Environment: CANMOTION_TRACE, CANMOTION_ARTIFACTS, CANMOTION_BUILD_DIR '
+                                        '(run-vcan-test); PEER_SYNC_MEAN_MAX (1.5), PEER_VANISH_SLACK_MS (20).')
+    ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish'))
+    ap.add_argument('--period-ms', type=float, default=10.0)
+    ap.add_argument('--node', type=int, default=5)
+    ap.add_argument('--start', type=int, default=123456, help='the peer\'s --position')
+    a = ap.parse_args()
+    c = Check(a)
+    print(f'vcan-peer-check: {a.scenario}: {len(c.t.frames)} frames in {c.trace_path}')
+    c.status()
+    t_start = c.boot()
+    if t_start is not None:
+        oe = c.enable(t_start)
+        if a.scenario == 'boot_enable_move':
+            c.sync_period(t_start)
+            if oe is not None:
+                c.move(a.start, 20000)
+        elif a.scenario == 'fault_recovery':
+            c.fault_recovery(t_start)
+        else:
+            c.vanish(t_start)
+    print(f"vcan-peer-check: {a.scenario}: {'FAIL (' + ', '.join(c.failed) + ')' if c.failed else 'PASS'}")
+    return 1 if c.failed else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
