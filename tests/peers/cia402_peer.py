@@ -27,8 +27,6 @@ import struct
 import sys
 import time
 
-import can
-
 # ============================================================================
 # CiA 301 numbers, written from the specification (not from fieldbus/)
 # ============================================================================
@@ -1083,6 +1081,7 @@ class Runner:
         self.sent = 0
 
     def send(self, frames):
+        import can   # here, not at the top: the trace checks import this module without python-can
         if self.silent:
             return
         for can_id, data in frames:
@@ -1259,6 +1258,7 @@ def main(argv=None) -> int:
             print(f'cia402_peer node {a.node} +{time.monotonic() - t0:.6f}: {msg}', flush=True)
 
     try:
+        import can
         bus = can.Bus(interface=a.bus_type, channel=a.interface)
     except Exception as e:   # python-can raises several types for a missing interface
         print(f'cia402_peer: cannot open {a.bus_type} bus {a.interface}: {e}', file=sys.stderr)

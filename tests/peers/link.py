@@ -15,8 +15,6 @@ import itertools
 import struct
 import time
 
-import can
-
 SDO_RX_BASE, SDO_TX_BASE, HEARTBEAT_BASE, EMCY_BASE = 0x600, 0x580, 0x700, 0x080
 
 
@@ -64,6 +62,7 @@ class VirtualLink(Link):
 
     def __init__(self, drive, t0=100.0):
         super().__init__()
+        import can
         import cia402_peer
         channel = f'peer-test-{next(self._channels)}'
         self.bus = can.Bus(interface='virtual', channel=channel)
@@ -78,6 +77,7 @@ class VirtualLink(Link):
         return self.t
 
     def send(self, can_id, data=b''):
+        import can
         self.bus.send(can.Message(arbitration_id=can_id, data=bytes(data), is_extended_id=False))
         self.runner.pump(self.t)
         self.poll()
@@ -116,12 +116,14 @@ class SocketLink(Link):
 
     def __init__(self, channel):
         super().__init__()
+        import can
         self.bus = can.Bus(interface='socketcan', channel=channel)
 
     def now(self):
         return time.monotonic()
 
     def send(self, can_id, data=b''):
+        import can
         self.bus.send(can.Message(arbitration_id=can_id, data=bytes(data), is_extended_id=False))
 
     def poll(self):

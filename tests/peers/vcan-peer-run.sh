@@ -4,9 +4,9 @@
 # processes.
 #   vcan-peer-run.sh SCENARIO CANMOTIOND [PEER_OPTION...]
 # SCENARIO is boot_enable_move, fault_recovery or vanish (scenarios/*.script).
-# 1. canmotiond --config vcan.yaml --script scenarios/SCENARIO.script --csv,
-#    real time; then the peer powers up (/usr/bin/python3 cia402_peer.py
-#    -i vcan0 -n 5 --position 123456 --control FIFO -v PEER_OPTION...);
+# 1. the peer powers up (/usr/bin/python3 cia402_peer.py -i vcan0 -n 5
+#    --position 123456 --control FIFO -v PEER_OPTION...), then canmotiond
+#    --config vcan.yaml --script scenarios/SCENARIO.script --csv, real time;
 # 2. fault_recovery: after canmotiond printed the `X.JogStatus` line, the
 #    peer gets `fault 0xFF00` on its control FIFO; vanish: the peer is
 #    killed with SIGKILL at that point (the kill time is logged);
@@ -25,8 +25,9 @@ fail() { echo "vcan-peer-run: $*" >&2; exit 1; }
 script="$here/scenarios/$scenario.script"
 [[ -f "$script" ]] || fail "no scenario '$scenario' ($script)"
 cp "$here/vcan.yaml" "$art/vcan.yaml"
-ctl="$art/peer.ctl"
-rm -f "$ctl" "$art/events.log"
+ctl_dir="$(mktemp -d)"            # a FIFO cannot live on the VM's shared build tree
+ctl="$ctl_dir/peer.ctl"
+rm -f "$art/events.log"
 mkfifo "$ctl"
 event() { echo "$(date +%s.%N) $*" >> "$art/events.log"; }
 
@@ -41,26 +42,33 @@ settle() {  # wait (bounded, 30 s) until the trace has not grown for 1 s
 }
 ppid_=""
 cleanup() {
-  [[ -n "$ppid_" ]] && kill -TERM "$ppid_" 2>/dev/null && wait "$ppid_" 2>/dev/null
+  if [[ -n "$ppid_" ]]; then kill -TERM "$ppid_" 2>/dev/null || true; wait "$ppid_" 2>/dev/null || true; fi
   ppid_=""
+  rm -rf "$ctl_dir"
   settle
 }
 trap cleanup EXIT
 
-timeout -s INT -k 30 120 stdbuf -oL "$daemon" --config "$art/vcan.yaml" --script "$script" --csv "$art/canmotiond.csv" \
-  > "$art/canmotiond.log" 2>&1 &
-dpid=$!
-for ((i = 0; i < 600; i++)); do   # the banner is printed after the bus is open
-  grep -q '^canmotiond: .* buses (real time)' "$art/canmotiond.log" && break
-  kill -0 "$dpid" 2>/dev/null || break
-  sleep 0.05
-done
-grep -q '^canmotiond: .* buses (real time)' "$art/canmotiond.log" || { cat "$art/canmotiond.log" >&2; fail "canmotiond did not start"; }
+# The peer powers up first: Python and python-can take about a minute to
+# start under the VM's emulation (measured: `import can` 48-64 s), far more
+# than canmotiond waits for a boot-up. canmotiond then finds it silent in
+# pre-operational, resets it (NMT reset node) after drives.timeouts.boot_ms
+# and configures it on its second boot-up.
 /usr/bin/python3 "$here/cia402_peer.py" -i vcan0 -n 5 --position 123456 --control "$ctl" -v "${peer_opts[@]}" \
   > "$art/peer.log" 2>&1 &
 ppid_=$!
+for ((i = 0; i < 2400; i++)); do
+  grep -q 'boot-up, NMT pre-operational' "$art/peer.log" && break
+  kill -0 "$ppid_" 2>/dev/null || break
+  sleep 0.1
+done
+grep -q 'boot-up, NMT pre-operational' "$art/peer.log" || { cat "$art/peer.log" >&2; fail "the peer did not start"; }
 event "peer started (pid $ppid_)"
-echo "vcan-peer-run: $scenario: canmotiond started, then the peer (node 5, position 123456) ${peer_opts[*]}"
+timeout -s INT -k 30 120 stdbuf -oL "$daemon" --config "$art/vcan.yaml" --script "$script" --csv "$art/canmotiond.csv" \
+  > "$art/canmotiond.log" 2>&1 &
+dpid=$!
+event "canmotiond started (pid $dpid)"
+echo "vcan-peer-run: $scenario: the peer (node 5, position 123456${peer_opts[*]:+, ${peer_opts[*]}}), then canmotiond"
 
 if [[ $scenario == fault_recovery || $scenario == vanish ]]; then
   for ((i = 0; i < 1200; i++)); do
