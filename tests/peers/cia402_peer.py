@@ -677,7 +677,7 @@ class Drive:
         self._raise_error(code, out)
         if self.state not in (FAULT_REACTION_ACTIVE, FAULT):
             self._go(13, FAULT_REACTION_ACTIVE)
-            self.reaction_deadline = self._now + 0.05
+            self.reaction_deadline = self._now + 0.5   # without SYNC; with SYNC it ends at the next one
         self.following = False
         self.demand = self.actual
 

@@ -5,7 +5,8 @@
 #   vcan-peer-run.sh SCENARIO CANMOTIOND [PEER_OPTION...]
 # SCENARIO is boot_enable_move, fault_recovery or vanish (scenarios/*.script).
 # 1. the peer powers up (/usr/bin/python3 cia402_peer.py -i vcan0 -n 5
-#    --position 123456 --control FIFO -v PEER_OPTION...), then canmotiond
+#    --position 123456 --heartbeat-ms 100 --control FIFO -v PEER_OPTION...),
+#    then canmotiond
 #    --config vcan.yaml --script scenarios/SCENARIO.script --csv, real time;
 # 2. fault_recovery: after canmotiond printed the `X.JogStatus` line, the
 #    peer gets `fault 0xFF00` on its control FIFO; vanish: the peer is
@@ -51,10 +52,11 @@ trap cleanup EXIT
 
 # The peer powers up first: Python and python-can take about a minute to
 # start under the VM's emulation (measured: `import can` 48-64 s), far more
-# than canmotiond waits for a boot-up. canmotiond then finds it silent in
-# pre-operational, resets it (NMT reset node) after drives.timeouts.boot_ms
-# and configures it on its second boot-up.
-/usr/bin/python3 "$here/cia402_peer.py" -i vcan0 -n 5 --position 123456 --control "$ctl" -v "${peer_opts[@]}" \
+# than canmotiond waits for a boot-up. It sends a heartbeat (0x1017 = 100 ms
+# until canmotiond writes its own), so canmotiond finds it in
+# pre-operational and configures it without waiting for a boot-up.
+/usr/bin/python3 "$here/cia402_peer.py" -i vcan0 -n 5 --position 123456 --heartbeat-ms 100 --control "$ctl" -v \
+  "${peer_opts[@]}" \
   > "$art/peer.log" 2>&1 &
 ppid_=$!
 for ((i = 0; i < 2400; i++)); do

@@ -120,15 +120,21 @@ class Check:
                       f'; 0x{i:04X}:{s:02X} := 0x{v:X}: abort 0x{c:08X} {ABORT_TEXT.get(c, "")}'
                       for _, i, s, v, c in aborts[:6]), around=aborts[0][0] if aborts else None)
         self.item(not unanswered, 'every SDO request answered', f'{len(unanswered)} without a response')
-        written = {(i, s): v for _, i, s, v, c in xs if c == 0}
+        starts = [f[0] for f in self.t.of(0x000) if f[2] in (bytes([1, self.a.node]), b'\x01\x00')]
+        if not self.item(bool(starts), 'NMT start', f'at +{starts[0] - boot[0][0]:.3f} s after the first boot-up'
+                         if starts else 'no NMT start'):
+            return None
+        t_boot = max((t for t, _, _ in boot if t < starts[0]), default=0.0)
+        cfg = [x for x in xs if t_boot < x[0] < starts[0] and x[4] == 0]   # the configuration of the last boot
+        written = {(i, s): v for _, i, s, v, c in cfg}
         self.item(written.get((0x6060, 0)) == 8, '0x6060 = 8 (CSP)', f'written {written.get((0x6060, 0))}')
         v, idx = written.get((0x60C2, 1)), written.get((0x60C2, 2))
-        ok = v is not None and idx is not None and abs(v * 10.0 ** (idx - 256 if idx > 127 else idx) - self.period) < 1e-12
-        self.item(ok, '0x60C2 = the period', f'value {v}, index {None if idx is None else (idx - 256 if idx > 127 else idx)}'
-                  f' (period {self.a.period_ms} ms)')
+        idx = None if idx is None else (idx - 256 if idx > 127 else idx)
+        ok = v is not None and idx is not None and abs(v * 10.0 ** idx - self.period) < 1e-12
+        self.item(ok, '0x60C2 = the period', f'value {v}, index {idx} (period {self.a.period_ms} ms)')
         for name, comm, mapi, cob, entries in (('RPDO1', 0x1400, 0x1600, self.RPDO, [0x60400010, 0x607A0020]),
                                                ('TPDO1', 0x1800, 0x1A00, self.TPDO, [0x60410010, 0x60640020])):
-            seq = [(i, s, v) for _, i, s, v, c in xs if c == 0 and i in (comm, mapi)]
+            seq = [(i, s, v) for _, i, s, v, c in cfg if i in (comm, mapi)]
             steps = [(comm, 1, cob | 1 << 31), (mapi, 0, 0)] + [(mapi, k + 1, e) for k, e in enumerate(entries)] + \
                     [(mapi, 0, len(entries))]
             pos, ok = 0, True
@@ -137,34 +143,32 @@ class Check:
                     pos += 1
                 ok = ok and pos < len(seq)
             ok = ok and bool(seq) and seq[-1] == (comm, 1, cob)
-            self.item(ok, f'{name} remap (CiA 301 procedure)',
+            self.item(ok, f'{name} remap (CiA 301 procedure) before NMT start',
                       ', '.join(f'0x{i:04X}:{s}=0x{v:X}' for i, s, v in seq))
-        self.item((0x1016, 1) not in {(i, s) for _, i, s, _, _ in xs}, '0x1016 not written',
-                  'master_heartbeat_timeout_ms: 0, and the peer has no 0x1016 (optional in CiA 301)')
-        last_cfg = max((x[0] for x in xs), default=0)
-        starts = [f[0] for f in self.t.of(0x000) if f[2] in (bytes([1, self.a.node]), b'\x01\x00')]
-        self.item(bool(starts) and starts[0] > last_cfg, 'NMT start after the configuration',
-                  f'NMT start at +{starts[0] - boot[0][0]:.3f} s after boot-up' if starts else 'no NMT start')
-        return starts[0] if starts else None
+        w1016 = [x for x in xs if x[1] == 0x1016]
+        self.item(not w1016, '0x1016 never written',
+                  'master_heartbeat_timeout_ms: 0, and the peer has no 0x1016 (optional in CiA 301)'
+                  + ''.join(f'; written at +{x[0] - boot[0][0]:.3f} s := 0x{x[3]:X}' for x in w1016))
+        return starts[0]
 
-    def enable(self, t_start):
+    def enable(self, t_start, hold_window):
+        """No jump at enable: until the first TPDO1 showing Operation enabled,
+        every RPDO1 target and TPDO1 position is the peer's start position;
+        with hold_window, for that long after it too (nothing moves then)."""
         tp = self.tpdos(t_start)
         oe = [t for t, sw, _ in tp if state_of(sw) == 'operation enabled']
-        if not self.item(bool(oe), 'enabled', f'first TPDO1 with Operation enabled at +{oe[0] - t_start:.3f} s' if oe
-                         else 'no TPDO1 shows Operation enabled'):
+        if not self.item(bool(oe), 'enabled', f'first TPDO1 with Operation enabled at +{oe[0] - t_start:.3f} s '
+                         'after NMT start' if oe else 'no TPDO1 shows Operation enabled'):
             return None
-        window_end = oe[0] + 0.4
-        pos = {p for _, _, p in self.tpdos(t_start, window_end)}
-        tgt = {p for _, _, p in self.rpdos(t_start, window_end)}
+        t_end = oe[0] + hold_window
+        pos = {p for _, _, p in self.tpdos(t_start, t_end)}
+        tgt = {p for _, _, p in self.rpdos(t_start, t_end)}
         self.item(pos == {self.a.start} and tgt <= {self.a.start}, 'enable without a jump',
-                  f'TPDO1 positions {sorted(pos)}, RPDO1 targets {sorted(tgt)} up to 0.4 s after enable '
-                  f'(start {self.a.start})', around=oe[0])
+                  f'TPDO1 positions {sorted(pos)[:6]}, RPDO1 targets {sorted(tgt)[:6]} from NMT start to '
+                  f'{1e3 * hold_window:.0f} ms after enable (start {self.a.start})', around=oe[0])
         m = re.search(r'operation enabled at position (-?\d+), first set-point (-?\d+)', self.peer_log)
-        self.item(bool(m) and m.group(1) == m.group(2) == str(self.a.start), "peer: first set-point = position",
+        self.item(bool(m) and m.group(1) == m.group(2) == str(self.a.start), 'peer: first set-point = position',
                   m.group(0) if m else 'no enable line in peer.log')
-        got = self.printed('X.ActualPosition')
-        want = f'{self.a.start / 1000:g}'
-        self.item(bool(got) and got[0] == want, 'X.ActualPosition after MSO', f'{got[:1]} (want {want})')
         return oe[0]
 
     def move(self, start, distance):
@@ -211,8 +215,9 @@ class Check:
             if not states or states[-1][1] != s:
                 states.append((t, s, p))
         names = [s for _, s, _ in states]
-        self.item(names[:2] == ['fault reaction active', 'fault'], 'statusword after the EMCY',
-                  ' -> '.join(names[:6]))
+        # Fault reaction active is transient: a TPDO shows it when a SYNC comes before the reaction ends.
+        self.item(names[:1] == ['fault'] or names[:2] == ['fault reaction active', 'fault'],
+                  'statusword after the EMCY', ' -> '.join(names[:6]))
         t_fault = next((t for t, s, _ in states if s == 'fault'), None)
         rp = self.rpdos(t_e)
         edge = next((t for (t0, c0, _), (t, c, _) in zip(rp, rp[1:]) if c & 0x80 and not c0 & 0x80), None)
@@ -286,8 +291,10 @@ def main():
     c.status()
     t_start = c.boot()
     if t_start is not None:
-        oe = c.enable(t_start)
+        oe = c.enable(t_start, 0.4 if a.scenario == 'boot_enable_move' else 0.0)
         if a.scenario == 'boot_enable_move':
+            got, want = c.printed('X.ActualPosition'), f'{a.start / 1000:g}'
+            c.item(got[:1] == [want], 'X.ActualPosition after MSO', f'{got[:1]} (want {want})')
             c.sync_period(t_start)
             if oe is not None:
                 c.move(a.start, 20000)
