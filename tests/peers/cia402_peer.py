@@ -1176,7 +1176,10 @@ class Runner:
                 except InterruptedError:
                     ready = []
             if bus_fd is not None and bus_fd in ready:
-                while True:
+                # A bounded batch, so that the timers (heartbeat) run even
+                # when frames come faster than this process handles them.
+                t_batch = self.clock() + 0.005
+                while self.clock() < t_batch:
                     msg = self.bus.recv(timeout=0)
                     if msg is None:
                         break

@@ -251,7 +251,8 @@ class Check:
         t_last = peer[-1][0]
         hb = [t for t, _, _ in self.t.of(self.HB) if t <= t_last]
         t_hb = hb[-1]
-        consumer = 3 * 0.050                        # drives.heartbeat_ms x 3
+        m = re.search(r'^  heartbeat_ms: (\d+)', self.read('vcan.yaml'), re.M)
+        consumer = 3 * int(m.group(1)) / 1000.0     # canmotiond's consumer time: 3 x drives.heartbeat_ms
         print(f'vcan-peer-check: info: last peer frame {1e3 * (t_last - t_kill):+.1f} ms, last heartbeat '
               f'{1e3 * (t_hb - t_kill):+.1f} ms from the kill')
         rp = self.rpdos(t_last)
