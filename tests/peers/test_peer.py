@@ -97,6 +97,14 @@ class Sdo(PeerCase):
             self.sdo.download(0x2000, 0, text)
             self.assertEqual(self.sdo.upload(0x2000, 0), text, f'{n} bytes')
 
+    def test_expedited_upload_frames(self):
+        # 4/2/1 bytes: 43h/4Bh/4Fh (n = unused bytes, e = s = 1), index and sub echoed.
+        self.make()
+        for (index, sub), want in (((0x1000, 0), '4300100092010200'), ((0x6041, 0), '4b41600050020000'),
+                                   ((0x1018, 0), '4f18100004000000')):
+            self.link.send(0x600 + NODE, struct.pack('<BHB4x', 0x40, index, sub))
+            self.assertEqual(self.frames(0x580 + NODE)[0][2].hex(), want)
+
     def test_segmented_upload_frames(self):
         # 0x1008 = 21 bytes: 41h + size 21, then 3 segments: 00h, 10h, then
         # 0x0B = toggle 0, n = 0 (7 bytes), c = 1 (CiA 301 upload segment).
@@ -377,6 +385,18 @@ class StateMachine(PeerCase):
         for cw in (0x0000, 0x0080):
             self.sdo.write(0x6040, 0, cw, '<H')
         self.assertEqual(self.drive.state, peer.SWITCH_ON_DISABLED)
+
+    def test_no_transition_16_with_option_0_to_4(self):
+        self.make()
+        self.sdo.write(0x6060, 0, 8, '<b')
+        for cw in (0x0006, 0x000F, 0x0002):
+            self.sdo.write(0x6040, 0, cw, '<H')
+        self.assertEqual(self.drive.state, peer.QUICK_STOP_ACTIVE)
+        self.sdo.write(0x6040, 0, 0x000F, '<H')                     # 0x605A = 2: no way back
+        self.assertEqual(self.drive.state, peer.QUICK_STOP_ACTIVE)
+        self.link.send(SYNC)
+        self.assertEqual(self.drive.state, peer.SWITCH_ON_DISABLED)
+        self.assertEqual(self.drive.transitions[-2:], [11, 12])
 
     def test_bit7_blocks_commands(self):
         self.make()
