@@ -137,6 +137,28 @@ MODE_NONE, MODE_CSP = 0, 8
 QUICK_STOP_OPTION_DEFAULT = 2  # 0x605A: quick-stop ramp, then Switch on disabled
 
 
+# The device control transitions (CiA 402 state machine): (state, command)
+# -> the transitions taken, in order. 13/14 (fault), 15 (fault reset edge)
+# and 12 (quick stop completed) happen outside this table.
+TRANSITIONS = {
+    (SWITCH_ON_DISABLED, 'shutdown'): ((2, READY_TO_SWITCH_ON),),
+    (READY_TO_SWITCH_ON, 'switch on'): ((3, SWITCHED_ON),),
+    (READY_TO_SWITCH_ON, 'enable operation'): ((3, SWITCHED_ON), (4, OPERATION_ENABLED)),
+    (READY_TO_SWITCH_ON, 'disable voltage'): ((7, SWITCH_ON_DISABLED),),
+    (READY_TO_SWITCH_ON, 'quick stop'): ((7, SWITCH_ON_DISABLED),),
+    (SWITCHED_ON, 'enable operation'): ((4, OPERATION_ENABLED),),
+    (SWITCHED_ON, 'shutdown'): ((6, READY_TO_SWITCH_ON),),
+    (SWITCHED_ON, 'disable voltage'): ((10, SWITCH_ON_DISABLED),),
+    (SWITCHED_ON, 'quick stop'): ((10, SWITCH_ON_DISABLED),),
+    (OPERATION_ENABLED, 'switch on'): ((5, SWITCHED_ON),),        # = disable operation
+    (OPERATION_ENABLED, 'shutdown'): ((8, READY_TO_SWITCH_ON),),
+    (OPERATION_ENABLED, 'disable voltage'): ((9, SWITCH_ON_DISABLED),),
+    (OPERATION_ENABLED, 'quick stop'): ((11, QUICK_STOP_ACTIVE),),
+    (QUICK_STOP_ACTIVE, 'disable voltage'): ((12, SWITCH_ON_DISABLED),),
+    (QUICK_STOP_ACTIVE, 'enable operation'): ((16, OPERATION_ENABLED),),   # 0x605A = 5..8 only
+}
+
+
 def decode_command(cw: int):
     """The device control command in a controlword (CiA 402 command table)."""
     if cw & 0x0082 == 0x0000:
@@ -635,39 +657,11 @@ class Drive:
             return
         if s == FAULT_REACTION_ACTIVE:
             return
-        cmd = decode_command(cw)
-        if s == SWITCH_ON_DISABLED:
-            if cmd == 'shutdown':
-                self._go(2, READY_TO_SWITCH_ON)
-        elif s == READY_TO_SWITCH_ON:
-            if cmd == 'switch on':
-                self._go(3, SWITCHED_ON)
-            elif cmd == 'enable operation':
-                self._go(3, SWITCHED_ON)
-                self._go(4, OPERATION_ENABLED)
-            elif cmd in ('disable voltage', 'quick stop'):
-                self._go(7, SWITCH_ON_DISABLED)
-        elif s == SWITCHED_ON:
-            if cmd == 'enable operation':
-                self._go(4, OPERATION_ENABLED)
-            elif cmd == 'shutdown':
-                self._go(6, READY_TO_SWITCH_ON)
-            elif cmd in ('disable voltage', 'quick stop'):
-                self._go(10, SWITCH_ON_DISABLED)
-        elif s == OPERATION_ENABLED:
-            if cmd == 'switch on':
-                self._go(5, SWITCHED_ON)
-            elif cmd == 'shutdown':
-                self._go(8, READY_TO_SWITCH_ON)
-            elif cmd == 'disable voltage':
-                self._go(9, SWITCH_ON_DISABLED)
-            elif cmd == 'quick stop':
-                self._go(11, QUICK_STOP_ACTIVE)
-        elif s == QUICK_STOP_ACTIVE:
-            if cmd == 'disable voltage':
-                self._go(12, SWITCH_ON_DISABLED)
-            elif cmd == 'enable operation' and 5 <= self.quick_stop_option <= 8:
-                self._go(16, OPERATION_ENABLED)
+        steps = TRANSITIONS.get((s, decode_command(cw)), ())
+        if steps and steps[0][0] == 16 and not 5 <= self.quick_stop_option <= 8:
+            return                        # 16 only when the quick stop option stays in Quick stop active
+        for number, to in steps:
+            self._go(number, to)
 
     def _fault(self, code: int, out: list, hold: bool = False):
         """A fault detected (transition 13): EMCY, 0x603F, fault reaction."""
@@ -886,13 +880,24 @@ class Drive:
     def _reply(self, data: bytes) -> list:
         return [(SDO_TX_BASE + self.node, data.ljust(8, b'\x00'))]
 
+    def _segment(self, direction: str, toggle: int, now: float):
+        """The transfer a segment request continues, and None; or None and
+        the abort (no such transfer: 0504 0001h; toggle not alternated: 0503 0000h)."""
+        t = self.sdo
+        if not t or t['dir'] != direction:
+            return None, self._abort(t['index'] if t else 0, t['sub'] if t else 0, ABORT_COMMAND)
+        if toggle != t['toggle']:
+            return None, self._abort(t['index'], t['sub'], ABORT_TOGGLE)
+        t['toggle'] ^= 1
+        t['deadline'] = now + self.sdo_timeout
+        return t, None
+
     def _on_sdo(self, data: bytes, now: float) -> list:
         if len(data) != 8:
             return []                     # not an SDO request (CiA 301: DLC 8)
         cmd = data[0]
         ccs = cmd >> 5
         index, sub = struct.unpack_from('<HB', data, 1)
-        t = self.sdo
         if ccs == 4:                      # abort from the client
             self.sdo = None
             return []
@@ -922,16 +927,13 @@ class Drive:
             self.sdo = {'dir': 'down', 'index': index, 'sub': sub, 'toggle': 0, 'buf': b'', 'size': size,
                         'deadline': now + self.sdo_timeout}
             return self._reply(struct.pack('<BHB', 0x60, index, sub))
+        toggle = (cmd >> 4) & 1
         if ccs == 0:                      # download segment
-            if not t or t['dir'] != 'down':
-                return self._abort(t['index'] if t else 0, t['sub'] if t else 0, ABORT_COMMAND)
-            toggle = (cmd >> 4) & 1
-            if toggle != t['toggle']:
-                return self._abort(t['index'], t['sub'], ABORT_TOGGLE)
+            t, refused = self._segment('down', toggle, now)
+            if refused:
+                return refused
             n, last = (cmd >> 1) & 0x07, cmd & 0x01
             t['buf'] += data[1:8 - n]
-            t['toggle'] ^= 1
-            t['deadline'] = now + self.sdo_timeout
             if t['size'] is not None and len(t['buf']) > t['size']:
                 return self._abort(t['index'], t['sub'], ABORT_LENGTH)
             if last:
@@ -953,15 +955,11 @@ class Drive:
                         'deadline': now + self.sdo_timeout}
             return self._reply(struct.pack('<BHBI', 0x41, index, sub, len(value)))
         if ccs == 3:                      # upload segment
-            if not t or t['dir'] != 'up':
-                return self._abort(t['index'] if t else 0, t['sub'] if t else 0, ABORT_COMMAND)
-            toggle = (cmd >> 4) & 1
-            if toggle != t['toggle']:
-                return self._abort(t['index'], t['sub'], ABORT_TOGGLE)
+            t, refused = self._segment('up', toggle, now)
+            if refused:
+                return refused
             chunk = t['buf'][t['pos']:t['pos'] + 7]
             t['pos'] += len(chunk)
-            t['toggle'] ^= 1
-            t['deadline'] = now + self.sdo_timeout
             last = t['pos'] >= len(t['buf'])
             if last:
                 self.sdo = None

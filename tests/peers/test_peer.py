@@ -19,7 +19,7 @@ sys.path.insert(0, HERE)
 
 import cia402_peer as peer  # noqa: E402
 import spec_checks  # noqa: E402
-from link import SdoAbort, SdoClient, VirtualLink  # noqa: E402
+from link import SdoClient, VirtualLink  # noqa: E402
 
 NODE = 5
 SYNC, EMCY, TPDO1, TPDO2, RPDO1, HB = 0x080, 0x080 + NODE, 0x180 + NODE, 0x280 + NODE, 0x200 + NODE, 0x700 + NODE

@@ -13,8 +13,8 @@
 #    killed with SIGKILL at that point (the kill time is logged);
 # 3. canmotiond's exit status goes to canmotiond.status (vcan_peer_check.py
 #    fails on anything but 0, after its analysis of the trace); then the
-#    peer is stopped (SIGTERM: it prints its summary) and the trace is left
-#    to settle. This script fails only when the processes cannot be run.
+#    peer is stopped (SIGTERM: it prints its summary); run-vcan-test lets
+#    the trace settle. This script fails only when the processes cannot be run.
 # Artefacts: vcan.yaml, canmotiond.log, canmotiond.csv, canmotiond.status,
 # peer.log, events.log.
 set -euo pipefail
@@ -32,21 +32,11 @@ rm -f "$art/events.log"
 mkfifo "$ctl"
 event() { echo "$EPOCHREALTIME $*" >> "$art/events.log"; }   # no fork: a `date` takes seconds in the VM
 
-settle() {  # wait (bounded, 30 s) until the trace has not grown for 1 s
-  local last=-1 n i same=0
-  for ((i = 0; i < 60 && same < 2; i++)); do
-    n=$(wc -l < "$trace")
-    if [[ $n == "$last" ]]; then same=$((same + 1)); else same=0; fi
-    last=$n
-    sleep 0.5
-  done
-}
 ppid_=""
 cleanup() {
   if [[ -n "$ppid_" ]]; then kill -TERM "$ppid_" 2>/dev/null || true; wait "$ppid_" 2>/dev/null || true; fi
   ppid_=""
   rm -rf "$ctl_dir"
-  settle
 }
 trap cleanup EXIT
 
