@@ -235,8 +235,11 @@ class Check:
         if oe2 is None:
             return
         pos = next(p for t, s, p in states if t == oe2)
-        tgt = {p for _, _, p in self.rpdos(oe2 - 0.1, oe2 + 0.3)}
-        self.item(tgt == {pos}, 're-enable without a jump', f'position {pos}, RPDO1 targets {sorted(tgt)}')
+        tgt = {p for _, _, p in self.rpdos(edge, oe2)}
+        enables = re.findall(r'operation enabled at position (-?\d+), first set-point (-?\d+)', self.peer_log)
+        self.item(tgt == {pos} and len(enables) == 2 and enables[1][0] == enables[1][1], 're-enable without a jump',
+                  f'position {pos}, RPDO1 targets {sorted(tgt)[:6]} from the fault reset to Operation enabled; '
+                  f'peer: {enables[1:]} (position, first set-point)')
         tp = self.tpdos()
         self.item(tp[-1][2] == pos + 10000, 'MAM after the recovery arrives exactly',
                   f'last TPDO1 position {tp[-1][2]} (want {pos} + 10000)')
