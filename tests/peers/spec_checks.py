@@ -466,15 +466,21 @@ def rpdo_length_error_emcy(c: Ctx):
         c.link.advance(c.period)
     emcy = [f[2] for f in c.link.queue if f[1] == 0x080 + c.node]
     assert emcy, 'no EMCY for RPDO1 with 2 of 6 bytes'
+    problems = []
     code, reg = struct.unpack_from('<HB', emcy[0])
-    assert code == 0x8210, f'EMCY 0x{code:04X}, want 0x8210'
-    assert reg & 0x11 == 0x11, f'error register 0x{reg:02X}: bits 0 (generic) and 4 (communication) not set'
-    assert len(emcy) == 1, f'{len(emcy)} EMCY for one error event (3 short RPDOs)'
+    if code != 0x8210:
+        problems.append(f'EMCY 0x{code:04X}, want 0x8210')
+    if reg & 0x11 != 0x11:
+        problems.append(f'error register 0x{reg:02X}: bits 0 (generic) and 4 (communication) not set')
+    if len(emcy) != 1:
+        problems.append(f'{len(emcy)} EMCY for one error event (3 short RPDOs)')
     c.link.clear()
     c.link.send(0x200 + c.node, struct.pack('<Hi', 0x0000, 0))
     c.link.advance(c.period)
     emcy = [f[2] for f in c.link.queue if f[1] == 0x080 + c.node]
-    assert emcy and emcy[0][:2] == b'\x00\x00', f'no EMCY 0000h after a correct RPDO1: {[e.hex() for e in emcy]}'
+    if not emcy or emcy[0][:2] != b'\x00\x00':
+        problems.append(f'no EMCY 0000h after a correct RPDO1 ({[e.hex() for e in emcy]})')
+    assert not problems, '; '.join(problems)
     return 'one 8210h, register 0x11; 0000h after'
 
 
