@@ -40,9 +40,15 @@ class Skip(Exception):
 
 
 class Ctx:
-    def __init__(self, link, node: int, period: float = 0.01):
+    def __init__(self, link, node: int, period: float = 0.01, patience: float = 2.0):
         self.link, self.node, self.period = link, node, period
-        self.sdo = SdoClient(link, node)
+        self.patience = patience      # how long to wait for an answer (VM: the device may stall)
+        self.sdo = SdoClient(link, node, timeout=patience)
+
+    def barrier(self):
+        """An SDO round trip: the device has handled every frame sent before it
+        and sent what they caused (one device answers in order)."""
+        self.sdo.read(0x1000)
 
     def nmt(self, cs: int):
         self.link.send(0x000, bytes([cs, self.node]))
@@ -126,8 +132,8 @@ def nmt_states_in_heartbeat(c: Ctx):
 
     def state_seen():
         c.link.clear()
-        f = c.link.wait_for(lambda i, d: i == node_hb, 0.5)
-        assert f is not None, 'no heartbeat within 0.5 s with 0x1017 = 20 ms'
+        f = c.link.wait_for(lambda i, d: i == node_hb, c.patience)
+        assert f is not None, f'no heartbeat within {c.patience} s with 0x1017 = 20 ms'
         assert len(f[2]) == 1, f'heartbeat must have 1 byte, got {f[2].hex()}'
         return f[2][0]
 
@@ -144,7 +150,7 @@ def nmt_states_in_heartbeat(c: Ctx):
     assert state_seen() == HB_PREOP, 'after NMT enter pre-operational: want 7Fh'
     c.sdo.read(0x1000)
     c.nmt(NMT_RESET_COMM)
-    boot = c.link.wait_for(lambda i, d: i == node_hb and d == b'\x00', 1.0)
+    boot = c.link.wait_for(lambda i, d: i == node_hb and d == b'\x00', c.patience)
     assert boot is not None, 'no boot-up after NMT reset communication'
     return 'pre-operational, operational, stopped (SDO silent), pre-operational, reset communication'
 
@@ -156,7 +162,7 @@ def heartbeat_period(c: Ctx):
     c.link.clear()
     times = []
     while len(times) < 11:
-        f = c.link.wait_for(lambda i, d: i == 0x700 + c.node, 0.5)
+        f = c.link.wait_for(lambda i, d: i == 0x700 + c.node, c.patience)
         assert f is not None, f'heartbeat {len(times)} missing (0x1017 = 50 ms)'
         times.append(f[0])
     ints = sorted(b - a for a, b in zip(times, times[1:]))
@@ -164,7 +170,7 @@ def heartbeat_period(c: Ctx):
     assert abs(median - 0.050) <= 0.005, (f'median heartbeat interval {1e3 * median:.2f} ms, want 50 ms '
                                           f'(intervals {", ".join(f"{1e3 * x:.1f}" for x in ints)} ms)')
     c.sdo.write(0x1017, 0, 0, '<H')
-    c.link.advance(0.1)
+    c.barrier()
     c.link.clear()
     assert c.link.wait_for(lambda i, d: i == 0x700 + c.node, 0.2) is None, 'heartbeat after 0x1017 = 0'
     return f'median interval {1e3 * median:.2f} ms of {len(ints)}'
@@ -398,7 +404,7 @@ def csp_target_at_sync(c: Ctx):
     for _ in range(20):
         c.link.send(0x080)
         syncs += 1
-        f = c.link.wait_for(lambda i, d: i == tpdo, c.period * 5)
+        f = c.link.wait_for(lambda i, d: i == tpdo, c.patience)
         assert f is not None, f'no TPDO1 after SYNC {syncs}'
         sw, p = struct.unpack('<Hi', f[2][:6])
         seen.append(p)
@@ -415,13 +421,16 @@ def tpdo_type_0_on_change(c: Ctx):
     c.remap(False, 1, [0x60410010], ttype=0)
     c.nmt(NMT_START)
     c.sync(2)
+    c.barrier()
     c.link.clear()
     c.sync(4)
+    c.barrier()
     n = sum(1 for f in c.link.queue if f[1] == 0x180 + c.node)
     assert n == 0, f'{n} TPDO1 in 4 SYNCs with unchanged data (type 0 sends only on a change)'
     c.sdo.write(0x6040, 0, 0x0006, '<H')
     c.link.clear()
     c.sync(3)
+    c.barrier()
     n = sum(1 for f in c.link.queue if f[1] == 0x180 + c.node)
     assert n == 1, f'{n} TPDO1 in 3 SYNCs after the statusword changed, want 1'
     return 'silent while unchanged, one TPDO at the SYNC after a change'
@@ -431,15 +440,16 @@ def tpdo_type_0_on_change(c: Ctx):
 def tpdo_event_driven(c: Ctx):
     c.remap(False, 1, [0x60410010], ttype=255)
     c.nmt(NMT_START)
-    c.link.advance(c.period)
+    c.barrier()
     c.link.clear()
     c.sync(4)
+    c.barrier()
     n = sum(1 for f in c.link.queue if f[1] == 0x180 + c.node)
     assert n == 0, f'{n} event-driven TPDO1 sent on 4 SYNCs with unchanged data'
     c.link.clear()
     c.sdo.write(0x6040, 0, 0x0006, '<H')
-    f = c.link.wait_for(lambda i, d: i == 0x180 + c.node, 0.2)
-    assert f is not None, 'no event-driven TPDO1 within 200 ms of a statusword change (no SYNC sent)'
+    f = c.link.wait_for(lambda i, d: i == 0x180 + c.node, c.patience)
+    assert f is not None, f'no event-driven TPDO1 within {c.patience} s of a statusword change (no SYNC sent)'
     return 'sent on the change without SYNC'
 
 
@@ -464,6 +474,7 @@ def rpdo_length_error_emcy(c: Ctx):
     for _ in range(3):
         c.link.send(0x200 + c.node, b'\x06\x00')
         c.link.advance(c.period)
+    c.barrier()
     emcy = [f[2] for f in c.link.queue if f[1] == 0x080 + c.node]
     assert emcy, 'no EMCY for RPDO1 with 2 of 6 bytes'
     problems = []
@@ -476,7 +487,7 @@ def rpdo_length_error_emcy(c: Ctx):
         problems.append(f'{len(emcy)} EMCY for one error event (3 short RPDOs)')
     c.link.clear()
     c.link.send(0x200 + c.node, struct.pack('<Hi', 0x0000, 0))
-    c.link.advance(c.period)
+    c.barrier()
     emcy = [f[2] for f in c.link.queue if f[1] == 0x080 + c.node]
     if not emcy or emcy[0][:2] != b'\x00\x00':
         problems.append(f'no EMCY 0000h after a correct RPDO1 ({[e.hex() for e in emcy]})')
