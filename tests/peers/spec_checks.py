@@ -97,6 +97,14 @@ class Ctx:
         self.sdo.write(comm, 1, cob)                         # 5. PDO valid
         return cob
 
+    def tpdo1_on_syncs(self, n: int) -> int:
+        """How many TPDO1 the device sends for n SYNCs (after what it owed before)."""
+        self.barrier()
+        self.link.clear()
+        self.sync(n)
+        self.barrier()
+        return sum(1 for f in self.link.queue if f[1] == 0x180 + self.node)
+
     def csp_pdos(self):
         """RPDO1 = controlword + target position, TPDO1 = statusword + position actual, SYNC every cycle."""
         r = self.remap(True, 1, [0x60400010, 0x607A0020])
@@ -421,17 +429,10 @@ def tpdo_type_0_on_change(c: Ctx):
     c.remap(False, 1, [0x60410010], ttype=0)
     c.nmt(NMT_START)
     c.sync(2)
-    c.barrier()
-    c.link.clear()
-    c.sync(4)
-    c.barrier()
-    n = sum(1 for f in c.link.queue if f[1] == 0x180 + c.node)
+    n = c.tpdo1_on_syncs(4)
     assert n == 0, f'{n} TPDO1 in 4 SYNCs with unchanged data (type 0 sends only on a change)'
     c.sdo.write(0x6040, 0, 0x0006, '<H')
-    c.link.clear()
-    c.sync(3)
-    c.barrier()
-    n = sum(1 for f in c.link.queue if f[1] == 0x180 + c.node)
+    n = c.tpdo1_on_syncs(3)
     assert n == 1, f'{n} TPDO1 in 3 SYNCs after the statusword changed, want 1'
     return 'silent while unchanged, one TPDO at the SYNC after a change'
 
@@ -440,11 +441,7 @@ def tpdo_type_0_on_change(c: Ctx):
 def tpdo_event_driven(c: Ctx):
     c.remap(False, 1, [0x60410010], ttype=255)
     c.nmt(NMT_START)
-    c.barrier()
-    c.link.clear()
-    c.sync(4)
-    c.barrier()
-    n = sum(1 for f in c.link.queue if f[1] == 0x180 + c.node)
+    n = c.tpdo1_on_syncs(4)
     assert n == 0, f'{n} event-driven TPDO1 sent on 4 SYNCs with unchanged data'
     c.link.clear()
     c.sdo.write(0x6040, 0, 0x0006, '<H')
