@@ -26,7 +26,7 @@ fail() { echo "vcan-peer-run: $*" >&2; exit 1; }
 script="$here/scenarios/$scenario.script"
 [[ -f "$script" ]] || fail "no scenario '$scenario' ($script)"
 cp "$here/vcan.yaml" "$art/vcan.yaml"
-ctl_dir="$(mktemp -d)"            # a FIFO cannot live on the VM's shared build tree
+ctl_dir="$(mktemp -d)"            # VM-local: a FIFO cannot live on the shared build tree, and a log polled there can be seen stale
 ctl="$ctl_dir/peer.ctl"
 rm -f "$art/events.log"
 mkfifo "$ctl"
@@ -57,18 +57,18 @@ done
 grep -q 'boot-up, NMT pre-operational' "$art/peer.log" || { cat "$art/peer.log" >&2; fail "the peer did not start"; }
 event "peer started (pid $ppid_)"
 timeout -s INT -k 30 120 stdbuf -oL "$daemon" --config "$art/vcan.yaml" --script "$script" --csv "$art/canmotiond.csv" \
-  > "$art/canmotiond.log" 2>&1 &
+  > "$ctl_dir/canmotiond.log" 2>&1 &
 dpid=$!
 event "canmotiond started (pid $dpid)"
 echo "vcan-peer-run: $scenario: the peer (node 5, position 123456${peer_opts[*]:+, ${peer_opts[*]}}), then canmotiond"
 
 if [[ $scenario == fault_recovery || $scenario == vanish ]]; then
   for ((i = 0; i < 1200; i++)); do
-    grep -q 'X.JogStatus=' "$art/canmotiond.log" && break
+    grep -q 'X.JogStatus=' "$ctl_dir/canmotiond.log" && break
     kill -0 "$dpid" 2>/dev/null || break
     sleep 0.05
   done
-  if grep -q 'X.JogStatus=' "$art/canmotiond.log"; then
+  if grep -q 'X.JogStatus=' "$ctl_dir/canmotiond.log"; then
     if [[ $scenario == fault_recovery ]]; then
       echo 'fault 0xFF00' > "$ctl"
       event "peer: fault 0xFF00 injected"
@@ -78,6 +78,8 @@ if [[ $scenario == fault_recovery || $scenario == vanish ]]; then
       wait "$ppid_" 2>/dev/null || true
       ppid_=""
     fi
+  else
+    event "no 'X.JogStatus=' line from canmotiond (it exited, or 1200 polls): nothing injected"
   fi
 fi
 
@@ -85,6 +87,7 @@ status=0
 wait "$dpid" || status=$?
 event "canmotiond exit $status"
 echo "vcan-peer-run: canmotiond exit $status"
+cp "$ctl_dir/canmotiond.log" "$art/canmotiond.log"
 cat "$art/canmotiond.log"
 cleanup
 trap - EXIT
