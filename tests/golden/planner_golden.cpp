@@ -1,9 +1,11 @@
 // Byte-identity of the planner (issue 13, the planner refactor): seeded
 // random instruction sequences over every executable instruction and many of
 // their operand values (valid and invalid), on virtual and CIP axes closed
-// through a small drive model with injected faults, lost nodes and drive
-// homing. Every cycle's outputs, axis tags, control tags and every execute()
-// result are hashed bit for bit (doubles by their bytes); the hash must equal
+// through a small drive model with injected faults, slow or failed fault
+// resets, lost nodes, drive homing and the drive link's states (issue 12:
+// booting, configuration refused, no module, transition timeouts). Every
+// cycle's outputs, axis tags, control tags and every execute() result are
+// hashed bit for bit (doubles by their bytes); the hash must equal
 // the one recorded on main before the refactor started.
 //
 // A deliberate change of planner behaviour changes the hash: then run
@@ -33,8 +35,9 @@ using namespace canmotion::motion;
 
 namespace {
 
-/// The hash of the whole run on main before the refactor (94e8130).
-constexpr std::uint64_t kExpected = 0xa59be6e40e5c199cull;
+/// The hash of the whole run on main before the refactor (6ff40ea, with the
+/// drives work of issue 12; first recorded on 94e8130 as 0xa59be6e40e5c199c).
+constexpr std::uint64_t kExpected = 0x717dc2ed1a35fc20ull;
 constexpr std::uint64_t kSeed = 13;
 constexpr int kRuns = 40;
 constexpr int kOpsPerRun = 90;
@@ -72,16 +75,36 @@ std::string num(double v) {
 
 /// A drive for the CIP axes: enables after 3 cycles, follows the target with
 /// a one-cycle delay and a first-order lag, runs CSV/CST, homes in 40 cycles,
-/// and faults when told to until a fault reset.
+/// and faults when told to until a fault reset, which it takes 0 to 5 cycles
+/// to act on (or ignores, 1 in 10). Its link to the runtime (issue 12) goes
+/// through boots (Configuring for some cycles), refused configurations and
+/// missing modules, which last until a fault reset retries the boot.
 struct Drive {
   double pos = 0, vel = 0, target = 0;
   DriveState state = DriveState::NotReady;
   int enable_count = 0;
   bool fault = false;
+  int leave_fault_in = -1;  ///< cycles until a reset fault clears, -1: none pending
   int homing_count = 0;
   bool attained = false;
-  void cycle(const AxisOutput& o, double T) {
-    if (o.fault_reset && fault) { fault = false; state = DriveState::NotReady; }
+  DriveLink link = DriveLink::Up;
+  int link_cycles = 0;  ///< Configuring: cycles until Up
+  void cycle(const AxisOutput& o, double T, Rng& g) {
+    if (o.fault_reset && (link == DriveLink::ConfigFailed || link == DriveLink::NoModule)) {
+      link = DriveLink::Configuring;  // the runtime retries the boot
+      link_cycles = 1 + g.pick(30);
+    }
+    if (link != DriveLink::Up) {
+      if (link == DriveLink::Configuring && --link_cycles <= 0)
+        link = g.coin(0.2) ? DriveLink::ConfigFailed : DriveLink::Up;
+      state = fault ? DriveState::Fault : DriveState::NotReady;
+      enable_count = 0;
+      vel = 0;
+      target = o.position;
+      return;
+    }
+    if (o.fault_reset && fault && leave_fault_in < 0 && !g.coin(0.1)) leave_fault_in = g.pick(6);
+    if (leave_fault_in >= 0 && leave_fault_in-- == 0) { fault = false; state = DriveState::NotReady; }
     if (fault) { state = DriveState::Fault; vel = 0; return; }
     if (o.enable) {
       if (state != DriveState::Enabled && ++enable_count >= 3) state = DriveState::Enabled;
@@ -191,7 +214,15 @@ struct World {
   void step(Rng& g, Hash& h, const std::vector<Request>& reqs) {
     // faults, lost nodes, bus-off on the CIP drives
     for (std::size_t i = 2; i <= 3; ++i) {
-      if (g.coin(0.0001)) drive[i].fault = true;
+      if (g.coin(0.0001)) { drive[i].fault = true; drive[i].leave_fault_in = -1; }
+      if (drive[i].link == DriveLink::Up && g.coin(0.0001)) {  // a reboot, a refused configuration, a missing module
+        static const std::array<DriveLink, 4> kLink{DriveLink::Configuring, DriveLink::Configuring,
+                                                    DriveLink::ConfigFailed, DriveLink::NoModule};
+        drive[i].link = kLink[static_cast<std::size_t>(g.pick(4))];
+        drive[i].link_cycles = 1 + g.pick(50);
+      }
+      fb[i].link = drive[i].link;
+      fb[i].transition_timeout = g.coin(0.0002);
       fb[i].position = drive[i].pos;
       fb[i].velocity = drive[i].vel;
       fb[i].drive = drive[i].state;
@@ -211,7 +242,7 @@ struct World {
     Output o{std::span<AxisOutput>(out.data(), out.size())};
     h.i(static_cast<int>(p->update(in, o)));
     for (std::size_t i = 0; i < kAxes.size(); ++i) {
-      if (i == 2 || i == 3) drive[i].cycle(out[i], p->period());
+      if (i == 2 || i == 3) drive[i].cycle(out[i], p->period(), g);
       const AxisOutput& x = out[i];
       h.f64(x.position); h.f64(x.velocity); h.f64(x.acceleration); h.f64(x.torque);
       h.i(static_cast<int>(x.mode)); h.i(x.enable); h.i(x.fault_reset); h.i(x.homing_start);
@@ -441,7 +472,7 @@ std::string random_call(Rng& g, Gen& st) {
 TEST(PlannerGolden, RandomSequencesHashAsOnMainBeforeTheRefactor) {
   Rng g{kSeed};
   Hash h;
-  int accepted = 0, rejected = 0, unparsed = 0;
+  int accepted = 0, rejected = 0, unparsed = 0, not_configured = 0;
   Gen st;
   for (int run = 0; run < kRuns; ++run) {
     World w;
@@ -465,6 +496,7 @@ TEST(PlannerGolden, RandomSequencesHashAsOnMainBeforeTheRefactor) {
           if (std::getenv("CANMOTION_GOLDEN_TRACE")) std::printf("EXEC %s %d\n", text.substr(0, text.find('(')).c_str(), static_cast<int>(e));
           h.i(static_cast<int>(e));
           (e == Err::None ? accepted : rejected)++;
+          if (e == Err::AxisNotConfigured) ++not_configured;  // every axis is configured: a failed drive link
         } else {
           reqs.push_back(q);  // executed inside update()
         }
@@ -482,12 +514,13 @@ TEST(PlannerGolden, RandomSequencesHashAsOnMainBeforeTheRefactor) {
     for (const cam::CamProfileElement& e : w.calc.elements()) { h.f64(e.master); h.f64(e.slave); h.f64(e.a3); }
   }
   if (std::getenv("CANMOTION_GOLDEN_PRINT"))
-    std::printf("planner golden hash 0x%016llx (accepted %d, rejected %d, unparsed %d)\n",
-                static_cast<unsigned long long>(h.h), accepted, rejected, unparsed);
+    std::printf("planner golden hash 0x%016llx (accepted %d, rejected %d, unparsed %d, ERR 11 %d)\n",
+                static_cast<unsigned long long>(h.h), accepted, rejected, unparsed, not_configured);
   // the sequences exercise the instructions, not only their errors
   EXPECT_GT(accepted, kRuns * kOpsPerRun / 4);
   EXPECT_GT(rejected, kRuns * 10);
   EXPECT_EQ(unparsed, 0);
+  EXPECT_GT(not_configured, 0);  // the drive link's failed states reach the planner
   char got[32], want[32];
   std::snprintf(got, sizeof got, "0x%016llx", static_cast<unsigned long long>(h.h));
   std::snprintf(want, sizeof want, "0x%016llx", static_cast<unsigned long long>(kExpected));
