@@ -58,14 +58,13 @@ inline bool is_md_jerk(int u) noexcept { return u == 4 || u == 6 || u == 7; }
 /// Generic access to any generator's state.
 struct GenRef {
   Kin* k = nullptr;
-  ControlId owner = kNoControl;
-  std::uint32_t owner_gen = 0;
+  OwnerRef owner{};
 };
 GenRef gen_ref(Generator& g) noexcept {
-  if (auto* p = std::get_if<ProfileGen>(&g)) return {&p->k, p->owner, p->owner_gen};
-  if (auto* q = std::get_if<GearGen>(&g)) return {&q->k, q->owner, q->owner_gen};
-  if (auto* c = std::get_if<CamGen>(&g)) return {&c->k, c->owner, c->owner_gen};
-  if (auto* pc = std::get_if<PosCamGen>(&g)) return {&pc->k, pc->owner, pc->owner_gen};
+  if (auto* p = std::get_if<ProfileGen>(&g)) return {&p->k, p->owner};
+  if (auto* q = std::get_if<GearGen>(&g)) return {&q->k, q->owner};
+  if (auto* c = std::get_if<CamGen>(&g)) return {&c->k, c->owner};
+  if (auto* pc = std::get_if<PosCamGen>(&g)) return {&pc->k, pc->owner};
   return {};
 }
 
@@ -185,37 +184,35 @@ Planner::Planner(double cycle_period) noexcept : T_(cycle_period > 0 ? cycle_per
 }
 
 bool Planner::begin_fault_reset(const Request& r, AxisRt& a) noexcept {
-  a.faulted = false;
+  a.servo.faulted = false;
   a.tag.exception_faults = 0;
   a.tag.motion_fault_status = 0;
   if (a.cfg.type != AxisType::CipDrive) return true;
-  a.fault_reset_pulse = true;
+  a.servo.fault_reset_pulse = true;
   const bool clear = a.fb.link == DriveLink::Up && a.fb.drive != DriveState::Fault && !a.fb.drive_fault && !a.fb.node_lost;
   if (clear) return true;
   // The drive acts on the reset this cycle (the pulse goes out with this
   // cycle's RPDO); DN when its feedback shows it left Fault.
-  if (a.reset != kNoControl && a.reset != r.control)
-    if (ControlTag* old = owner_tag(a.reset, a.reset_gen)) old->reject(Err::ServoMessageFailure, 16);
-  a.reset = r.control;
-  a.reset_gen = controls_[r.control].generation;
-  a.reset_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+  if (a.servo.reset.valid() && a.servo.reset.id != r.control)
+    if (ControlTag* old = tag(a.servo.reset)) old->reject(Err::ServoMessageFailure, 16);
+  a.servo.reset = OwnerRef{r.control, controls_[r.control].generation};
+  a.servo.reset_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
   return false;
 }
 
 void Planner::end_fault_reset(AxisRt& a, bool ok) noexcept {
-  const ControlId ctl = a.reset;
-  const std::uint32_t gen = a.reset_gen;
-  a.reset = kNoControl;
-  ControlTag* c = owner_tag(ctl, gen);
+  const OwnerRef owner = a.servo.reset;
+  a.servo.reset = {};
+  ControlTag* c = tag(owner);
   if (!c) return;
   if (!ok) {
     c->reject(Err::ServoMessageFailure, 16);  // device in wrong state
     for (std::size_t i = 0; i < axis_count_; ++i)  // MGSR: the other axes stop waiting
-      if (axes_[i].reset == ctl && axes_[i].reset_gen == gen) axes_[i].reset = kNoControl;
+      if (axes_[i].servo.reset == owner) axes_[i].servo.reset = {};
     return;
   }
   for (std::size_t i = 0; i < axis_count_; ++i)  // MGSR: DN with the last axis
-    if (axes_[i].reset == ctl && axes_[i].reset_gen == gen) return;
+    if (axes_[i].servo.reset == owner) return;
   c->set(flag::DN, true);
 }
 
@@ -236,10 +233,10 @@ bool Planner::configure_axis(AxisId id, const AxisConfig& cfg) noexcept {
 }
 
 // ------------------------------------------------------------------ helpers
-ControlTag* Planner::owner_tag(ControlId id, std::uint32_t gen) noexcept {
-  if (id >= kMaxControlTags) return nullptr;
-  ControlTag& c = controls_[id];
-  return c.generation == gen ? &c : nullptr;  // the tag was re-executed: not ours any more
+ControlTag* Planner::tag(OwnerRef o) noexcept {
+  if (o.id >= kMaxControlTags) return nullptr;
+  ControlTag& c = controls_[o.id];
+  return c.generation == o.gen ? &c : nullptr;  // the tag was re-executed: not ours any more
 }
 
 Kin Planner::slot_kin(const AxisRt& a, Slot s) const noexcept {
@@ -269,13 +266,13 @@ void Planner::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
   }
   if (auto* pc = std::get_if<PosCamGen>(&slot)) end_position_cam(a, *pc);  // MAPC (planner_mapc.cpp)
   if (const MasterFollow* f = follow_of(slot)) {  // master-driven move/jog/offset move or time cam
-    if (ControlTag* m = owner_tag(f->mdac, f->mdac_gen)) m->set(flag::AC, false);
+    if (ControlTag* m = tag(f->mdac)) m->set(flag::AC, false);
   }
   if (const GenRef g = gen_ref(slot); g.k) {
     if (s == Slot::MasterOffset) add_master_offset(a, g.k->p);  // shifts the cam's master, not the slave
     else a.base += g.k->p;
     if (clear_owner_ip) {
-      if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) {
+      if (ControlTag* c = tag(g.owner)) {
         c->set(flag::IP, false);
         c->set(flag::ACCEL, false);
         c->set(flag::DECEL, false);
@@ -302,26 +299,26 @@ void Planner::servo_off(AxisRt& a) noexcept {
   drop_pending_cam(a);
   drop_pending_pcam(a);
   end_direct(a, false);
-  a.servo = false;
-  a.enable_req = false;
-  if (a.homing) {
-    a.homing = false;
-    if (ControlTag* c = owner_tag(a.mah, a.mah_gen)) c->set(flag::IP, false);
+  a.servo.on = false;
+  a.servo.enable_req = false;
+  if (a.hs.homing) {
+    a.hs.homing = false;
+    if (ControlTag* c = tag(a.hs.mah)) c->set(flag::IP, false);
   }
 }
 
 void Planner::do_shutdown(AxisRt& a) noexcept {
   servo_off(a);
-  a.shutdown = true;
+  a.servo.shutdown = true;
   break_links(a);  // MASD/MGSD on a slave ...
   break_links_of_master(static_cast<AxisId>(&a - axes_.data()));  // ... and on a master
 }
 
 void Planner::break_links(AxisRt& a) noexcept {
-  for (auto* arr : {&a.mdac, &a.mdac_pending}) {
+  for (auto* arr : {&a.links.active, &a.links.pending}) {
     for (auto& l : *arr) {
       if (!l.valid()) continue;
-      if (ControlTag* c = owner_tag(l.ctl, l.gen)) {
+      if (ControlTag* c = tag(l.owner)) {
         c->set(flag::IP, false);
         c->set(flag::AC, false);
       }
@@ -333,22 +330,22 @@ void Planner::break_links(AxisRt& a) noexcept {
 void Planner::break_links_of_master(AxisId master) noexcept {
   for (std::size_t i = 0; i < axis_count_; ++i) {
     bool uses = false;
-    for (const auto& l : axes_[i].mdac) uses = uses || l.master == master;
-    for (const auto& l : axes_[i].mdac_pending) uses = uses || l.master == master;
+    for (const auto& l : axes_[i].links.active) uses = uses || l.master == master;
+    for (const auto& l : axes_[i].links.pending) uses = uses || l.master == master;
     if (uses) break_links(axes_[i]);
   }
 }
 
 void Planner::promote_pending(AxisRt& a, int ti) noexcept {
-  MdacLink& p = a.mdac_pending[static_cast<std::size_t>(ti)];
+  MdacLink& p = a.links.pending[static_cast<std::size_t>(ti)];
   if (!p.valid()) return;
-  MdacLink& l = a.mdac[static_cast<std::size_t>(ti)];
-  if (l.valid() && (l.ctl != p.ctl || l.gen != p.gen)) {
+  MdacLink& l = a.links.active[static_cast<std::size_t>(ti)];
+  if (l.valid() && (l.owner != p.owner)) {
     bool still_used = false;  // an "All" MDAC tag may still hold other motion types
-    for (std::size_t k = 0; k < a.mdac.size(); ++k)
-      if (static_cast<int>(k) != ti && a.mdac[k].ctl == l.ctl && a.mdac[k].gen == l.gen) still_used = true;
+    for (std::size_t k = 0; k < a.links.active.size(); ++k)
+      if (static_cast<int>(k) != ti && a.links.active[k].owner == l.owner) still_used = true;
     if (!still_used)
-      if (ControlTag* c = owner_tag(l.ctl, l.gen)) { c->set(flag::IP, false); c->set(flag::AC, false); }
+      if (ControlTag* c = tag(l.owner)) { c->set(flag::IP, false); c->set(flag::AC, false); }
   }
   l = p;
   p = MdacLink{};
@@ -357,7 +354,7 @@ void Planner::promote_pending(AxisRt& a, int ti) noexcept {
 Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, bool& ok) noexcept {
   ok = false;
   const std::size_t k = static_cast<std::size_t>(ti);
-  const MdacLink& l = a.mdac_pending[k].valid() ? a.mdac_pending[k] : a.mdac[k];
+  const MdacLink& l = a.links.pending[k].valid() ? a.links.pending[k] : a.links.active[k];
   if (!l.valid()) return Err::MdscNotActivated;
   const AxisRt& m = axes_[l.master];
   const double mp = l.use_actual ? m.fb_pos : m.cmd.p;
@@ -378,8 +375,7 @@ Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, b
   g.md.lock_pos -= m.frame_offset;  // LockPosition is a master position (user frame); mp is drive frame
   g.md.prev_mp = mp;
   g.md.u = 0;
-  g.md.mdac = l.ctl;
-  g.md.mdac_gen = l.gen;
+  g.md.mdac = l.owner;
   ok = true;
   return Err::None;
 }
@@ -388,42 +384,42 @@ Err Planner::master_driven_setup(AxisRt& a, int ti, ProfileGen& g, Kin& start, b
 Err Planner::start_mdac(const Request& r, const MdacParams& p, AxisRt& a, std::int8_t&) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
-  if (a.shutdown) return Err::ShutdownState;
+  if (a.servo.shutdown) return Err::ShutdownState;
   const AxisRt& m = axes_[p.master];
   if (!m.cfg.configured) return Err::AxisNotConfigured;
   if (m.cfg.inhibited) return Err::AxisIsInhibited;
   if (p.slave == p.master) return Err::MasterAxisConflict;
-  if (a.homing || m.homing) return Err::HomeInProcess;
+  if (a.hs.homing || m.hs.homing) return Err::HomeInProcess;
   // a virtual master always gives command, a feedback-only/CIP master follows the operand [seed 000]
   const bool use_actual = p.master_reference == MasterReference::Actual && m.cfg.type == AxisType::CipDrive;
   const bool all = p.motion_type == 0;
   const bool moving = a.cmd.v != 0 || a.cmd.a != 0;
   bool any_all = false, any_single = false;
-  for (const auto& l : a.mdac) {
+  for (const auto& l : a.links.active) {
     if (!l.valid()) continue;
     if (l.all) any_all = true; else any_single = true;
   }
   if ((all && any_single) || (!all && any_all)) return Err::MdscMdacAllConflict;  // [seed 000]
   const std::size_t first = all ? 0 : static_cast<std::size_t>(p.motion_type - 1);
-  const std::size_t last = all ? a.mdac.size() : first + 1;
+  const std::size_t last = all ? a.links.active.size() : first + 1;
   for (std::size_t k = first; k < last; ++k) {
-    const MdacLink& l = a.mdac[k];
+    const MdacLink& l = a.links.active[k];
     // changing the master reference of a moving slave errors; the original stays [seed 000]
     if (l.valid() && l.master == p.master && l.use_actual != use_actual && moving) return Err::MdscInvalidModeOrMasterChange;
   }
   ControlTag& c = controls_[r.control];
-  const MdacLink nl{p.master, use_actual, all, r.control, c.generation};
+  const MdacLink nl{p.master, use_actual, all, OwnerRef{r.control, c.generation}};
   for (std::size_t k = first; k < last; ++k) {
-    MdacLink& l = a.mdac[k];
+    MdacLink& l = a.links.active[k];
     if (l.valid() && (l.master != p.master || l.use_actual != use_actual)) {
       // the new master is queued: it takes over when the next single-axis motion goes IP [seed 000]
-      MdacLink& q = a.mdac_pending[k];
-      if (q.valid() && (q.ctl != r.control || q.gen != c.generation))
-        if (ControlTag* o = owner_tag(q.ctl, q.gen)) o->set(flag::IP, false);  // a newer pending MDAC overrides
+      MdacLink& q = a.links.pending[k];
+      if (q.valid() && (q.owner != OwnerRef{r.control, c.generation}))
+        if (ControlTag* o = tag(q.owner)) o->set(flag::IP, false);  // a newer pending MDAC overrides
       q = nl;
     } else {
-      if (l.valid() && (l.ctl != r.control || l.gen != c.generation))
-        if (ControlTag* o = owner_tag(l.ctl, l.gen)) { o->set(flag::IP, false); o->set(flag::AC, false); }
+      if (l.valid() && (l.owner != OwnerRef{r.control, c.generation}))
+        if (ControlTag* o = tag(l.owner)) { o->set(flag::IP, false); o->set(flag::AC, false); }
       l = nl;
     }
   }
@@ -453,8 +449,7 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
     if (!plan_stop(g.prof, Kin{0, tot.v, tot.a}, d, jd)) return false;
     g.t0_cycle = cycle_;
     g.k = Kin{0, tot.v, tot.a};
-    g.owner = owner;
-    g.owner_gen = gen_owner;
+    g.owner = OwnerRef{owner, gen_owner};
     g.post_stop = post_stop;
     g.scurve = !std::isinf(jd);
     set_slot(a, Slot::StopAll, g);
@@ -473,8 +468,7 @@ bool Planner::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Con
     if (!plan_stop(st.prof, Kin{0, k.v, k.a}, d, jd)) continue;
     st.t0_cycle = cycle_;
     st.k = Kin{0, k.v, k.a};
-    st.owner = owner;
-    st.owner_gen = gen_owner;
+    st.owner = OwnerRef{owner, gen_owner};
     st.post_stop = post_stop;
     st.scurve = !std::isinf(jd);
     set_slot(a, static_cast<Slot>(s), st);
@@ -490,10 +484,10 @@ Err Planner::common_checks(const AxisRt& a, bool need_servo) const noexcept {
   // is not configured (Logix Axis Configuration State not "configured").
   if (a.cfg.type == AxisType::CipDrive && (a.fb.link == DriveLink::ConfigFailed || a.fb.link == DriveLink::NoModule))
     return Err::AxisNotConfigured;
-  if (a.shutdown) return Err::ShutdownState;
-  if (a.faulted) return Err::AxisInFaultedState;
-  if (need_servo && !a.servo) return Err::ServoOffState;
-  if (need_servo && a.direct) return Err::NotAllowedWhileInDirectMotion;  // [RM002H p.578]
+  if (a.servo.shutdown) return Err::ShutdownState;
+  if (a.servo.faulted) return Err::AxisInFaultedState;
+  if (need_servo && !a.servo.on) return Err::ServoOffState;
+  if (need_servo && a.direct.status) return Err::NotAllowedWhileInDirectMotion;  // [RM002H p.578]
   return Err::None;
 }
 
@@ -576,12 +570,12 @@ Err Planner::execute(const Request& r) noexcept {
 Err Planner::start_mso(const Request& r, AxisRt& a) noexcept {
   if (Err e = common_checks(a, false); e != Err::None) return e;
   ControlTag& c = controls_[r.control];
-  if (a.direct) {  // MSO is the way out of direct control [RM002H p.578]
+  if (a.direct.status) {  // MSO is the way out of direct control [RM002H p.578]
     end_direct(a, false);
     a.base = a.fb_pos;
     a.cmd = Kin{a.fb_pos, 0, 0};
   }
-  if (a.servo) {
+  if (a.servo.on) {
     c.set(flag::DN, true);
     return Err::None;
   }
@@ -589,16 +583,15 @@ Err Planner::start_mso(const Request& r, AxisRt& a) noexcept {
   // faster than 0.1 % of max speed (at least 1e-6 units/s)
   if (a.cfg.type == AxisType::CipDrive && std::fabs(a.fb_vel) > std::max(1e-6, 1e-3 * a.cfg.max_speed))
     return Err::AxisInMotion;
-  a.enable_req = true;
+  a.servo.enable_req = true;
   if (a.cfg.type == AxisType::Virtual) {
-    a.servo = true;
+    a.servo.on = true;
     c.set(flag::DN, true);
     return Err::None;
   }
   // CIP: DN when the drive reports Operation Enabled (STATE 0 request, 1 waiting).
-  a.mso = r.control;
-  a.mso_gen = c.generation;
-  a.mso_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+  a.hs.mso = OwnerRef{r.control, c.generation};
+  a.hs.deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
   c.state = 0;
   return Err::None;
 }
@@ -606,20 +599,19 @@ Err Planner::start_mso(const Request& r, AxisRt& a) noexcept {
 Err Planner::start_msf(const Request& r, AxisRt& a) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
-  if (a.shutdown) return Err::ShutdownState;
+  if (a.servo.shutdown) return Err::ShutdownState;
   ControlTag& c = controls_[r.control];
   const bool was_enabled = a.cfg.type == AxisType::CipDrive && a.fb.drive == DriveState::Enabled;
   servo_off(a);
-  if (a.mso != kNoControl) {  // cancel a pending MSO
-    if (ControlTag* m = owner_tag(a.mso, a.mso_gen)) m->reject(Err::ServoMessageFailure, 15);
-    a.mso = kNoControl;
+  if (a.hs.mso.valid()) {  // cancel a pending MSO
+    if (ControlTag* m = tag(a.hs.mso)) m->reject(Err::ServoMessageFailure, 15);
+    a.hs.mso = {};
   }
   if (!was_enabled) {
     c.set(flag::DN, true);
   } else {
-    a.msf = r.control;
-    a.msf_gen = c.generation;
-    a.mso_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+    a.hs.msf = OwnerRef{r.control, c.generation};
+    a.hs.deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
   }
   return Err::None;
 }
@@ -635,7 +627,7 @@ Err Planner::start_masd(const Request& r, AxisRt& a) noexcept {
 Err Planner::start_masr(const Request& r, AxisRt& a) noexcept {
   // MASR = MAFR (clear the faults, pulse a drive fault reset) + leave Shutdown.
   const Err e = start_mafr(r, a);
-  if (e == Err::None) a.shutdown = false;
+  if (e == Err::None) a.servo.shutdown = false;
   return e;
 }
 
@@ -700,21 +692,20 @@ Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int
   ControlTag& c = controls_[r.control];
   c.set(flag::DN, true);
   if (type == StopType::All || type == StopType::Home) {
-    if (a.homing) {
-      a.homing = false;
-      if (ControlTag* h = owner_tag(a.mah, a.mah_gen)) h->set(flag::IP, false);
+    if (a.hs.homing) {
+      a.hs.homing = false;
+      if (ControlTag* h = tag(a.hs.mah)) h->set(flag::IP, false);
       if (a.cfg.type == AxisType::CipDrive) a.base = a.fb_pos;
     }
   }
-  const bool ramping = a.servo && mask != 0 && stop_slots(a, mask, d, jd, r.control, 0);
+  const bool ramping = a.servo.on && mask != 0 && stop_slots(a, mask, d, jd, r.control, 0);
   if (type == StopType::All) break_links(a);  // MAS All on the slave breaks its MDAC links
   if (type == StopType::All || type == StopType::TimeCam) drop_pending_cam(a);
   if (type == StopType::All || type == StopType::PositionCam) drop_pending_pcam(a);
-  if ((type == StopType::All || type == StopType::DirectControl) && a.direct_active) {
+  if ((type == StopType::All || type == StopType::DirectControl) && a.direct.active) {
     // direct command to zero; the drive ramps down; PC at standstill
     end_direct(a, true);
-    a.mds_stop = r.control;
-    a.mds_stop_gen = c.generation;
+    a.direct.stop = OwnerRef{r.control, c.generation};
     c.set(flag::IP, true);
     return Err::None;
   }
@@ -726,14 +717,14 @@ Err Planner::start_mas(const Request& r, const MasParams& p, AxisRt& a, std::int
 // --- MAH
 Err Planner::start_mah(const Request& r, AxisRt& a) noexcept {
   if (Err e = common_checks(a, false); e != Err::None) return e;
-  if (a.direct) return Err::NotAllowedWhileInDirectMotion;
-  if (a.homing) return Err::HomeInProcess;
+  if (a.direct.status) return Err::NotAllowedWhileInDirectMotion;
+  if (a.hs.homing) return Err::HomeInProcess;
   const HomingConfig& h = a.cfg.homing;
   if (a.cfg.rotary && (h.home_position < 0 || h.home_position >= a.cfg.unwind)) return Err::IllegalHomingConfig;
   if (h.mode == HomingConfig::Mode::Absolute && h.sequence != HomingConfig::Sequence::Immediate)
     return Err::IllegalHomingConfig;
-  if (h.mode == HomingConfig::Mode::Absolute && a.servo) return Err::ServoOnState;
-  if (h.mode == HomingConfig::Mode::Active && !a.servo) return Err::ServoOffState;
+  if (h.mode == HomingConfig::Mode::Absolute && a.servo.on) return Err::ServoOnState;
+  if (h.mode == HomingConfig::Mode::Active && !a.servo.on) return Err::ServoOffState;
   const bool immediate = h.sequence == HomingConfig::Sequence::Immediate || a.cfg.type == AxisType::Virtual;
   if (!immediate && h.mode == HomingConfig::Mode::Passive) return Err::IllegalHomingConfig;
   ControlTag& c = controls_[r.control];
@@ -743,16 +734,15 @@ Err Planner::start_mah(const Request& r, AxisRt& a) noexcept {
     const double ref = h.mode == HomingConfig::Mode::Active ? user_command(a) : a.fb_pos + a.frame_offset;
     const double delta = h.home_position - (a.cfg.rotary ? unwind_position(ref, a.cfg.unwind) : ref);
     a.frame_offset += delta;
-    a.homed = true;
+    a.hs.homed = true;
     c.set(flag::PC, true);
     return Err::None;
   }
   // CIP drive homing, CiA 402 mode 6 with 0x6098/0x6099/0x609A from configuration
-  a.homing = true;
-  a.homing_started = false;
-  a.homed = false;
-  a.mah = r.control;
-  a.mah_gen = c.generation;
+  a.hs.homing = true;
+  a.hs.homing_started = false;
+  a.hs.homed = false;
+  a.hs.mah = OwnerRef{r.control, c.generation};
   c.set(flag::IP, true);
   return Err::None;
 }
@@ -760,7 +750,7 @@ Err Planner::start_mah(const Request& r, AxisRt& a) noexcept {
 // --- MAJ
 Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
-  if (a.homing) return Err::HomeInProcess;
+  if (a.hs.homing) return Err::HomeInProcess;
   if (any_stopping(a)) return Err::NotAllowedWhileStopping;
   const Idx& I = idx();
   Dyn dy;
@@ -807,12 +797,11 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
   g.scurve = dy.scurve;
   g.speed = V;
   g.jog_velocity = dir * V;
-  g.owner = r.control;
-  g.owner_gen = c.generation;
+  g.owner = OwnerRef{r.control, c.generation};
   promote_pending(a, 1);
   if (g.master_driven) {
     c.set(flag::AC, true);
-    if (ControlTag* m = owner_tag(g.md.mdac, g.md.mdac_gen)) m->set(flag::AC, true);
+    if (ControlTag* m = tag(g.md.mdac)) m->set(flag::AC, true);
   }
   set_slot(a, Slot::Jog, g);
   if (V > 0) a.last_speed = V;
@@ -824,7 +813,7 @@ Err Planner::start_maj(const Request& r, const MajParams& p, AxisRt& a, std::int
 // --- MAM
 Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
-  if (a.homing) return Err::HomeInProcess;
+  if (a.hs.homing) return Err::HomeInProcess;
   if (any_stopping(a)) return Err::NotAllowedWhileStopping;
   const Idx& I = idx();
   const auto mt = p.move_type;
@@ -949,12 +938,11 @@ Err Planner::start_mam(const Request& r, const MamParams& p, AxisRt& a, std::int
   g.exact_target = mt == MoveType::Absolute && !a.cfg.rotary;
   g.move_type = mt;
   g.scurve = dy.scurve;
-  g.owner = r.control;
-  g.owner_gen = c.generation;
+  g.owner = OwnerRef{r.control, c.generation};
   promote_pending(a, link);
   if (g.master_driven) {
     c.set(flag::AC, true);
-    if (ControlTag* m = owner_tag(g.md.mdac, g.md.mdac_gen)) m->set(flag::AC, true);
+    if (ControlTag* m = tag(g.md.mdac)) m->set(flag::AC, true);
   }
   write_calculated_data(r, g, c);  // planner_mccp.cpp
   set_slot(a, slot, g);
@@ -1052,8 +1040,8 @@ Err Planner::start_mcd(const Request& r, const McdParams& p, AxisRt& a, std::int
 Err Planner::start_mrp(const Request& r, const MrpParams& prm, AxisRt& a) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
-  if (a.direct) return Err::NotAllowedWhileInDirectMotion;
-  if (a.homing) return Err::HomeInProcess;
+  if (a.direct.status) return Err::NotAllowedWhileInDirectMotion;
+  if (a.hs.homing) return Err::HomeInProcess;
   const bool relative = prm.relative;
   const bool command = prm.command;
   const double p = prm.position;
@@ -1080,7 +1068,7 @@ Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mo
       if (r.instr == Instr::MGSD) {
         do_shutdown(a);
       } else {
-        a.shutdown = false;
+        a.servo.shutdown = false;
         (void)begin_fault_reset(r, a);
       }
     }
@@ -1088,7 +1076,7 @@ Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mo
     // end_fault_reset sets it), at once if none has to.
     bool waiting = false;
     for (std::size_t i = 0; i < axis_count_; ++i)
-      waiting = waiting || (axes_[i].reset == r.control && axes_[i].reset_gen == c.generation);
+      waiting = waiting || axes_[i].servo.reset == OwnerRef{r.control, c.generation};
     if (!waiting) c.set(flag::DN, true);
     return Err::None;
   }
@@ -1099,9 +1087,9 @@ Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mo
     ProgrammedStopMode m = mode == GroupStopMode::FastStop      ? ProgrammedStopMode::FastStop
                            : mode == GroupStopMode::FastDisable ? ProgrammedStopMode::FastDisable
                                                                 : a.cfg.programmed_stop_mode;
-    if (a.homing) {
-      a.homing = false;
-      if (ControlTag* h = owner_tag(a.mah, a.mah_gen)) h->set(flag::IP, false);
+    if (a.hs.homing) {
+      a.hs.homing = false;
+      if (ControlTag* h = tag(a.hs.mah)) h->set(flag::IP, false);
     }
     break_links(a);  // MGS breaks the MDAC links of its slaves
     if (m == ProgrammedStopMode::HardDisable) { servo_off(a); continue; }
@@ -1112,7 +1100,7 @@ Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mo
       if (auto* p = std::get_if<ProfileGen>(&g)) scurve = scurve || p->scurve;
     const double d = a.cfg.max_decel > 0 ? a.cfg.max_decel : 1e12;
     const double jd = scurve && a.cfg.max_decel_jerk > 0 ? a.cfg.max_decel_jerk : kInf;
-    const bool r_ax = a.servo && stop_slots(a, (1u << kSlots) - 1u, d, jd, r.control, post);
+    const bool r_ax = a.servo.on && stop_slots(a, (1u << kSlots) - 1u, d, jd, r.control, post);
     ramping = ramping || r_ax;
     if (!r_ax) {
       if (post == 1) servo_off(a);
@@ -1122,7 +1110,7 @@ Err Planner::start_group(const Request& r, std::uint16_t group, GroupStopMode mo
   c.set(flag::DN, true);
   if (ramping) {
     c.set(flag::IP, true);
-    groups_[grp] = GroupOp{r.control, c.generation, grp, true};
+    groups_[grp] = GroupOp{OwnerRef{r.control, c.generation}, grp, true};
   } else {
     c.set(flag::PC, true);
   }
@@ -1141,98 +1129,98 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
   // pending fault reset (MAFR, MASR, MGSR), judged on feedback given after
   // the pulse went out (the runtime acts on it: clears its failure, retries
   // a failed boot)
-  if (a.reset != kNoControl && !a.fault_reset_pulse) {
-    if (!owner_tag(a.reset, a.reset_gen)) {
-      a.reset = kNoControl;
+  if (a.servo.reset.valid() && !a.servo.fault_reset_pulse) {
+    if (!tag(a.servo.reset)) {
+      a.servo.reset = {};
     } else if (a.fb.link == DriveLink::Up && a.fb.drive != DriveState::Fault && !a.fb.drive_fault && !a.fb.node_lost) {
       end_fault_reset(a, true);
-    } else if (link_failed || a.fb.transition_timeout || cycle_ >= a.reset_deadline) {
+    } else if (link_failed || a.fb.transition_timeout || cycle_ >= a.servo.reset_deadline) {
       end_fault_reset(a, false);
     }
   }
   // pending MSO
-  if (a.mso != kNoControl) {
-    ControlTag* c = owner_tag(a.mso, a.mso_gen);
+  if (a.hs.mso.valid()) {
+    ControlTag* c = tag(a.hs.mso);
     if (!c) {
-      a.mso = kNoControl;
+      a.hs.mso = {};
     } else if (a.fb.drive == DriveState::Enabled) {
-      a.servo = true;
+      a.servo.on = true;
       a.base = a.fb_pos;  // close the loop at the present position
       a.cmd = Kin{a.fb_pos, 0, 0};
       c->state = 1;
       c->set(flag::DN, true);
-      a.mso = kNoControl;
-    } else if ((a.fb.drive == DriveState::Fault && a.reset == kNoControl) || link_failed || a.fb.transition_timeout ||
-               cycle_ >= a.mso_deadline) {
+      a.hs.mso = {};
+    } else if ((a.fb.drive == DriveState::Fault && !a.servo.reset.valid()) || link_failed || a.fb.transition_timeout ||
+               cycle_ >= a.hs.deadline) {
       // (a drive still in Fault while a fault reset waits for it: wait too)
       c->reject(Err::ServoMessageFailure, 16);
-      a.enable_req = false;
-      a.mso = kNoControl;
+      a.servo.enable_req = false;
+      a.hs.mso = {};
     } else {
       c->state = 1;  // waiting for drive enable and servo action
     }
   }
-  if (a.msf != kNoControl) {
-    ControlTag* c = owner_tag(a.msf, a.msf_gen);
+  if (a.hs.msf.valid()) {
+    ControlTag* c = tag(a.hs.msf);
     if (!c) {
-      a.msf = kNoControl;
+      a.hs.msf = {};
     } else if (a.fb.drive != DriveState::Enabled) {
       c->set(flag::DN, true);
-      a.msf = kNoControl;
-    } else if (cycle_ >= a.mso_deadline) {
+      a.hs.msf = {};
+    } else if (cycle_ >= a.hs.deadline) {
       c->reject(Err::ServoMessageFailure, 16);
-      a.msf = kNoControl;
+      a.hs.msf = {};
     }
   }
   // MDS waiting for the drive enable
-  if (a.mds_waiting) {
-    ControlTag* c = owner_tag(a.mds, a.mds_gen);
+  if (a.direct.waiting) {
+    ControlTag* c = tag(a.direct.mds);
     if (a.fb.drive == DriveState::Enabled) {
-      a.servo = true;
-      a.mds_waiting = false;
+      a.servo.on = true;
+      a.direct.waiting = false;
       if (c) { c->state = 1; c->set(flag::DN, true); }
-    } else if (a.fb.drive == DriveState::Fault || link_failed || a.fb.transition_timeout || cycle_ >= a.mso_deadline) {
-      a.mds_waiting = false;
+    } else if (a.fb.drive == DriveState::Fault || link_failed || a.fb.transition_timeout || cycle_ >= a.hs.deadline) {
+      a.direct.waiting = false;
       end_direct(a, false);
-      a.enable_req = false;
+      a.servo.enable_req = false;
       if (c) c->reject(Err::ServoMessageFailure, 16);
     } else if (c) {
       c->state = 1;
     }
   }
-  if (a.mds_stop != kNoControl) {
-    ControlTag* c = owner_tag(a.mds_stop, a.mds_stop_gen);
-    if (!c || !a.direct) {
-      a.mds_stop = kNoControl;
+  if (a.direct.stop.valid()) {
+    ControlTag* c = tag(a.direct.stop);
+    if (!c || !a.direct.status) {
+      a.direct.stop = {};
     } else if (std::fabs(a.fb_vel) <= std::max(1e-6, 1e-3 * a.cfg.max_speed)) {
       c->set(flag::IP, false);
       c->set(flag::PC, true);
-      a.mds_stop = kNoControl;
+      a.direct.stop = {};
     }
   }
   // drive homing
-  if (a.homing) {
-    ControlTag* c = owner_tag(a.mah, a.mah_gen);
-    if (a.fb.homing_attained && a.homing_started) {
+  if (a.hs.homing) {
+    ControlTag* c = tag(a.hs.mah);
+    if (a.fb.homing_attained && a.hs.homing_started) {
       a.frame_offset = a.cfg.homing.home_position - a.fb_pos;
-      a.homed = true;
-      a.homing = false;
+      a.hs.homed = true;
+      a.hs.homing = false;
       a.base = a.fb_pos;
       a.cmd = Kin{a.fb_pos, 0, 0};
       if (c) { c->set(flag::IP, false); c->set(flag::PC, true); }
     } else if (a.fb.homing_error || link_failed) {
-      a.homing = false;
+      a.hs.homing = false;
       a.base = a.fb_pos;
       if (c) { c->set(flag::IP, false); c->reject(Err::ServoMessageFailure, 16); }
     }
   }
   // servo off or homing: the command follows the actual position
-  if (!a.servo || a.homing || a.direct) {
+  if (!a.servo.on || a.hs.homing || a.direct.status) {
     a.base = a.fb_pos;
-    a.cmd = Kin{a.fb_pos, a.direct ? a.fb_vel : 0.0, 0};
+    a.cmd = Kin{a.fb_pos, a.direct.status ? a.fb_vel : 0.0, 0};
   }
   // a drive that dropped out of Operation Enabled switches the servo off
-  if (a.servo && a.fb.drive != DriveState::Enabled && !a.mds_waiting) servo_off(a);
+  if (a.servo.on && a.fb.drive != DriveState::Enabled && !a.direct.waiting) servo_off(a);
 }
 
 // Called once per axis per cycle from update() only: inlined there.
@@ -1243,11 +1231,11 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
     const bool drive_fault = a.fb.drive_fault || a.fb.drive == DriveState::Fault;
     // while a fault reset waits for the drive to leave Fault (or to come
     // back), its conditions are not latched again; they are if it fails
-    const bool resetting = a.reset != kNoControl;
+    const bool resetting = a.servo.reset.valid();
     if (drive_fault && !resetting) active |= bit(ExceptionKind::DriveFault);
     if (a.fb.node_lost && !resetting) active |= bit(ExceptionKind::NodeLost);
     if (a.fb.bus_off) active |= bit(ExceptionKind::BusOff);
-    if (a.servo && a.cfg.position_error_tolerance > 0 &&
+    if (a.servo.on && a.cfg.position_error_tolerance > 0 &&
         std::fabs(a.cmd.p - a.fb_pos) > a.cfg.position_error_tolerance)
       active |= bit(ExceptionKind::PositionError);
   }
@@ -1290,7 +1278,7 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
   if (alarms & bit(ExceptionKind::SoftOvertravelNeg)) a.tag.motion_alarm_status |= 1u << motion_fault::SoftTravelLimitNegative;
   switch (worst) {
     case ExceptionAction::StopPlanner: {
-      if (a.servo) {
+      if (a.servo.on) {
         bool scurve = false;
         for (const auto& g : a.gen)
           if (auto* p = std::get_if<ProfileGen>(&g)) scurve = scurve || p->scurve;
@@ -1302,12 +1290,12 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
     }
     case ExceptionAction::StopDrive:
       servo_off(a);
-      a.faulted = true;
+      a.servo.faulted = true;
       break_links(a);  // an axis fault breaks the MDAC link
       break;
     case ExceptionAction::Shutdown:
       do_shutdown(a);
-      a.faulted = true;
+      a.servo.faulted = true;
       break;
     default:
       break;
@@ -1384,7 +1372,7 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
       g->k = g->prof.sample(t, g->hint);
       done = g->role != GenRole::Jog && g->prof.finite() && t >= g->prof.duration();
     }
-    ControlTag* c = owner_tag(g->owner, g->owner_gen);
+    ControlTag* c = tag(g->owner);
     if (done) {
       if (g->role == GenRole::Move) {
         const bool alone = (a.live & ~(1u << s)) == 0;  // no other live slot
@@ -1398,7 +1386,7 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
       // ramps of an MGS: the MGS gets PC when every axis of its group stopped
       bool group_owned = false;
       for (const auto& go : groups_)
-        if (go.active && go.ctl == g->owner && go.gen == g->owner_gen) group_owned = true;
+        if (go.active && go.owner == g->owner) group_owned = true;
       if (c && !group_owned) {
         c->set(flag::PC, true);
         c->set(flag::ACCEL, false);
@@ -1425,25 +1413,25 @@ void Planner::handle_feedback(AxisId, AxisRt& a, const AxisFeedback* fb) noexcep
     out->velocity = a.cmd.v;
     out->acceleration = a.cmd.a;
     out->torque = 0;
-    out->enable = a.enable_req && !a.shutdown;
-    out->shutdown = a.shutdown;
-    out->fault_reset = a.fault_reset_pulse;
-    out->mode = a.homing ? DriveMode::Homing : DriveMode::CyclicPosition;
-    if (a.direct) {  // MDS: CSV or CST following the axis configuration
+    out->enable = a.servo.enable_req && !a.servo.shutdown;
+    out->shutdown = a.servo.shutdown;
+    out->fault_reset = a.servo.fault_reset_pulse;
+    out->mode = a.hs.homing ? DriveMode::Homing : DriveMode::CyclicPosition;
+    if (a.direct.status) {  // MDS: CSV or CST following the axis configuration
       const bool torque = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
       out->mode = torque ? DriveMode::CyclicTorque : DriveMode::CyclicVelocity;
-      out->velocity = a.direct_active ? (torque ? a.direct_vel_cmd : a.direct_cmd) : 0.0;
-      out->torque = torque && a.direct_active ? a.direct_cmd : 0.0;
+      out->velocity = a.direct.active ? (torque ? a.direct.vel_cmd : a.direct.cmd) : 0.0;
+      out->torque = torque && a.direct.active ? a.direct.cmd : 0.0;
       out->acceleration = 0.0;
     }
-    out->homing_start = a.homing;
-    if (a.homing) {
+    out->homing_start = a.hs.homing;
+    if (a.hs.homing) {
       const HomingConfig& h = a.cfg.homing;
       out->homing = HomingRequest{h.cia_method, h.speed_search, h.speed_zero, h.accel};
-      a.homing_started = true;
+      a.hs.homing_started = true;
     }
   }
-  a.fault_reset_pulse = false;
+  a.servo.fault_reset_pulse = false;
 }
 
 void Planner::update_status(AxisRt& a) noexcept {
@@ -1457,46 +1445,46 @@ void Planner::update_status(AxisRt& a) noexcept {
   setb(JogStatus, jg && jg->role == GenRole::Jog);
   setb(MoveLockStatus, mv && mv->role == GenRole::Move && mv->master_driven && mv->md.locked && mv->md.following);
   setb(JogLockStatus, jg && jg->role == GenRole::Jog && jg->master_driven && jg->md.locked && jg->md.following);
-  static_assert(std::tuple_size_v<decltype(a.mdac)> == 4);
-  const bool linked = a.mdac[0].valid() || a.mdac[1].valid() || a.mdac[2].valid() || a.mdac[3].valid();
+  static_assert(std::tuple_size_v<decltype(a.links.active)> == 4);
+  const bool linked = a.links.active[0].valid() || a.links.active[1].valid() || a.links.active[2].valid() || a.links.active[3].valid();
   setb(CoordinatedMotionStatus, linked);
   const auto* gr = std::get_if<GearGen>(&a.gen[static_cast<std::size_t>(Slot::Gear)]);
   setb(GearingStatus, gr != nullptr);
   setb(GearingLockStatus, gr && gr->locked);
   const bool stopping = any_stopping(a);
   setb(StoppingStatus, stopping);
-  setb(HomingStatus, a.homing);
-  setb(AxisHomedStatus, a.homed);
+  setb(HomingStatus, a.hs.homing);
+  setb(AxisHomedStatus, a.hs.homed);
   setb(AccelStatus, a.cmd.v * a.cmd.a > 0 || (a.cmd.v == 0 && a.cmd.a != 0));
   setb(DecelStatus, a.cmd.v * a.cmd.a < 0);
   setb(TimeCamStatus, std::holds_alternative<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]));
-  setb(TimeCamPendingStatus, a.pending_cam.valid());
+  setb(TimeCamPendingStatus, a.cams.time.valid());
   position_cam_status(a, ms);
   const auto* tc = std::get_if<CamGen>(&a.gen[static_cast<std::size_t>(Slot::TimeCam)]);
   setb(TimeCamLockStatus, tc && tc->master_driven && tc->md.lock_status());
   const bool torque_mode = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
-  setb(DirectVelocityControlStatus, a.direct_active && !torque_mode);
-  setb(DirectTorqueControlStatus, a.direct_active && torque_mode);
+  setb(DirectVelocityControlStatus, a.direct.active && !torque_mode);
+  setb(DirectTorqueControlStatus, a.direct.active && torque_mode);
   setb(MaximumSpeedExceeded, a.cfg.max_speed > 0 && std::fabs(a.cmd.v) > a.cfg.max_speed * (1 + 1e-9));
   t.motion_status = ms;
   std::uint32_t as = 0;
-  if (a.servo) as |= (1u << axis_status::ServoActionStatus) | (1u << axis_status::DriveEnableStatus);
-  if (a.shutdown) as |= 1u << axis_status::ShutdownStatus;
+  if (a.servo.on) as |= (1u << axis_status::ServoActionStatus) | (1u << axis_status::DriveEnableStatus);
+  if (a.servo.shutdown) as |= 1u << axis_status::ShutdownStatus;
   if (a.cfg.inhibited) as |= 1u << axis_status::InhibitStatus;
-  if (a.direct) as |= 1u << axis_status::DirectControlStatus;
+  if (a.direct.status) as |= 1u << axis_status::DirectControlStatus;
   as |= 1u << axis_status::AxisUpdateStatus;
   t.axis_status = as;
   if (!a.cfg.configured) t.state = AxisState::Ungrouped;
   else if (a.cfg.inhibited) t.state = AxisState::Inhibited;
-  else if (a.shutdown) t.state = AxisState::Shutdown;
-  else if (a.faulted) t.state = AxisState::Faulted;
-  else if (a.servo) t.state = AxisState::ServoControl;
+  else if (a.servo.shutdown) t.state = AxisState::Shutdown;
+  else if (a.servo.faulted) t.state = AxisState::Faulted;
+  else if (a.servo.on) t.state = AxisState::ServoControl;
   else t.state = AxisState::Ready;
   if (a.cfg.inhibited) t.cip_state = CipAxisState::AxisInhibited;
-  else if (a.shutdown) t.cip_state = CipAxisState::Shutdown;
-  else if (a.faulted) t.cip_state = CipAxisState::MajorFaulted;
-  else if (a.servo) t.cip_state = stopping ? CipAxisState::Stopping : CipAxisState::Running;
-  else if (a.enable_req) t.cip_state = CipAxisState::Starting;
+  else if (a.servo.shutdown) t.cip_state = CipAxisState::Shutdown;
+  else if (a.servo.faulted) t.cip_state = CipAxisState::MajorFaulted;
+  else if (a.servo.on) t.cip_state = stopping ? CipAxisState::Stopping : CipAxisState::Running;
+  else if (a.servo.enable_req) t.cip_state = CipAxisState::Starting;
   else t.cip_state = CipAxisState::Stopped;
   // tags in the user frame
   const double act = a.cfg.type == AxisType::Virtual ? a.cmd.p : a.fb_pos;
@@ -1516,7 +1504,7 @@ void Planner::update_status(AxisRt& a) noexcept {
 // --- MAG
 Err Planner::start_mag(const Request& r, const MagParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
-  if (a.homing) return Err::HomeInProcess;
+  if (a.hs.homing) return Err::HomeInProcess;
   const AxisId slave_id = p.slave;
   const AxisId master_id = p.master;
   const AxisRt& m = axes_[master_id];
@@ -1570,8 +1558,7 @@ Err Planner::start_mag(const Request& r, const MagParams& p, AxisRt& a, std::int
   fold(a, Slot::Gear, true);
   ControlTag& ct = controls_[r.control];
   g.k = start;
-  g.owner = r.control;
-  g.owner_gen = ct.generation;
+  g.owner = OwnerRef{r.control, ct.generation};
   if (!clutch) {  // lock at once: the offset follows the master from here
     g.locked = true;
     g.master_ref = g.use_actual ? m.fb_pos : m.cmd.p;
@@ -1632,7 +1619,7 @@ void Planner::step_gear(GearGen& g) noexcept {
 Err Planner::start_mds(const Request& r, const MdsParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, false); e != Err::None) return e;
   if (a.cfg.type != AxisType::CipDrive) return Err::WrongAxisType;  // AXIS_CIP_DRIVE only [seed 002]
-  if (a.homing) return Err::HomeInProcess;
+  if (a.hs.homing) return Err::HomeInProcess;
   for (const auto& g : a.gen)
     if (!std::holds_alternative<std::monostate>(g)) return Err::NotAllowedWhilePlannerActive;
   const bool torque = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
@@ -1643,52 +1630,51 @@ Err Planner::start_mds(const Request& r, const MdsParams& p, AxisRt& a, std::int
     return Err::ParameterOutOfRange;
   }
   ControlTag& c = controls_[r.control];
-  if (a.mds != kNoControl && (a.mds != r.control || a.mds_gen != c.generation))
-    if (ControlTag* o = owner_tag(a.mds, a.mds_gen)) o->set(flag::IP, false);  // superseded by this MDS
-  a.direct = true;
-  a.direct_active = true;
-  a.direct_cmd = cmd;
-  if (a.mds == kNoControl) a.direct_vel_cmd = a.cfg.direct_velocity_command;  // kept by a superseding MDS
-  a.mds = r.control;
-  a.mds_gen = c.generation;
-  a.mds_stop = kNoControl;
+  if (a.direct.mds.valid() && a.direct.mds != OwnerRef{r.control, c.generation})
+    if (ControlTag* o = tag(a.direct.mds)) o->set(flag::IP, false);  // superseded by this MDS
+  a.direct.status = true;
+  a.direct.active = true;
+  a.direct.cmd = cmd;
+  if (!a.direct.mds.valid()) a.direct.vel_cmd = a.cfg.direct_velocity_command;  // kept by a superseding MDS
+  a.direct.mds = OwnerRef{r.control, c.generation};
+  a.direct.stop = {};
   c.set(flag::IP, true);
-  if (a.servo) {
+  if (a.servo.on) {
     c.set(flag::DN, true);
   } else {  // enable the drive first: STATE 0 request, 1 waiting [seed 002]
-    a.enable_req = true;
-    a.mds_waiting = true;
-    a.mso_deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
+    a.servo.enable_req = true;
+    a.direct.waiting = true;
+    a.hs.deadline = cycle_ + static_cast<std::uint64_t>(kDriveTimeout / T_);
     c.state = 0;
   }
   return Err::None;
 }
 
 void Planner::end_direct(AxisRt& a, bool keep_direct_status) noexcept {
-  if (!a.direct) return;
-  if (ControlTag* c = owner_tag(a.mds, a.mds_gen)) c->set(flag::IP, false);
-  a.direct_active = false;
-  a.direct_cmd = 0.0;
-  a.mds = kNoControl;
-  a.mds_waiting = false;
+  if (!a.direct.status) return;
+  if (ControlTag* c = tag(a.direct.mds)) c->set(flag::IP, false);
+  a.direct.active = false;
+  a.direct.cmd = 0.0;
+  a.direct.mds = {};
+  a.direct.waiting = false;
   if (!keep_direct_status) {
-    a.direct = false;
-    if (ControlTag* s = owner_tag(a.mds_stop, a.mds_stop_gen)) s->set(flag::IP, false);
-    a.mds_stop = kNoControl;
+    a.direct.status = false;
+    if (ControlTag* s = tag(a.direct.stop)) s->set(flag::IP, false);
+    a.direct.stop = {};
   }
 }
 
 bool Planner::set_direct_command(AxisId id, double value) noexcept {
-  if (id >= kMaxAxes || !axes_[id].direct_active || !std::isfinite(value)) return false;
-  axes_[id].direct_cmd = value;
+  if (id >= kMaxAxes || !axes_[id].direct.active || !std::isfinite(value)) return false;
+  axes_[id].direct.cmd = value;
   return true;
 }
 
 bool Planner::set_direct_velocity_command(AxisId id, double value) noexcept {
-  if (id >= kMaxAxes || !axes_[id].direct_active || !std::isfinite(value) ||
+  if (id >= kMaxAxes || !axes_[id].direct.active || !std::isfinite(value) ||
       axes_[id].cfg.direct_mode != AxisConfig::DirectMode::Torque)
     return false;
-  axes_[id].direct_vel_cmd = value;
+  axes_[id].direct.vel_cmd = value;
   return true;
 }
 
@@ -1700,14 +1686,14 @@ bool Planner::attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noe
 }
 
 void Planner::drop_pending_cam(AxisRt& a) noexcept {
-  if (!a.pending_cam.valid()) return;
-  if (ControlTag* c = owner_tag(a.pending_cam.owner, a.pending_cam.owner_gen)) c->set(flag::IP, false);
-  a.pending_cam = PendingCam{};
+  if (!a.cams.time.valid()) return;
+  if (ControlTag* c = tag(a.cams.time.owner)) c->set(flag::IP, false);
+  a.cams.time = PendingCam{};
 }
 
 Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::int8_t& exerr) noexcept {
   if (Err e = common_checks(a, true); e != Err::None) return e;
-  if (a.homing) return Err::HomeInProcess;
+  if (a.hs.homing) return Err::HomeInProcess;
   if (Err e = matc_mode_checks(a, p); e != Err::None) return e;  // lock direction, mode, MDAC (planner_md.cpp)
   cam::CamProfile* prof = p.cam_profile < kMaxCamProfiles ? cam_profiles_[p.cam_profile] : nullptr;
   if (!prof || !prof->calculated()) return Err::CamProfileNotCalculated;
@@ -1717,7 +1703,7 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
     exerr = static_cast<std::int8_t>(bad_slave ? idx().matc_dscale : idx().matc_tscale);
     return Err::ParameterOutOfRange;
   }
-  const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.cam_dir);
+  const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.cams.time_dir);
   cam::CamMotionConfig cfg;
   cfg.mode = p.execution_mode == 1 ? cam::ExecutionMode::Continuous : cam::ExecutionMode::Once;
   cfg.scaling = sc;
@@ -1726,8 +1712,8 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
   const bool active = std::holds_alternative<CamGen>(a.gen[static_cast<std::size_t>(Slot::TimeCam)]);
   if (p.execution_schedule == 1) {  // pending: takes over at the end of the current pass [seed 004]
     drop_pending_cam(a);             // a second pending MATC overlays the first
-    a.pending_cam = PendingCam{prof, cfg, r.control, c.generation};
-    a.cam_dir = dir;
+    a.cams.time = PendingCam{prof, cfg, OwnerRef{r.control, c.generation}};
+    a.cams.time_dir = dir;
     c.set(flag::DN, true);
     c.set(flag::IP, true);
     return Err::None;
@@ -1746,15 +1732,14 @@ Err Planner::start_matc(const Request& r, const MatcParams& p, AxisRt& a, std::i
   fold(a, Slot::TimeCam, true);
   g.profile = prof;
   g.t0_cycle = cycle_;
-  g.owner = r.control;
-  g.owner_gen = c.generation;
+  g.owner = OwnerRef{r.control, c.generation};
   promote_pending(a, 2);  // a queued MDAC master takes over as this MATC goes IP [seed 000]
   if (g.master_driven) {
     c.set(flag::AC, true);
-    if (ControlTag* m = owner_tag(g.md.mdac, g.md.mdac_gen)) m->set(flag::AC, true);
+    if (ControlTag* m = tag(g.md.mdac)) m->set(flag::AC, true);
   }
   set_slot(a, Slot::TimeCam, g);
-  a.cam_dir = dir;
+  a.cams.time_dir = dir;
   c.set(flag::DN, true);
   c.set(flag::IP, true);
   return Err::None;
@@ -1767,11 +1752,11 @@ void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
   const bool once = g.cm.config().mode == cam::ExecutionMode::Once;
   const std::int64_t pass_before = g.last_pass;
   g.last_pass = o.pass;
-  if (a.pending_cam.valid()) {
+  if (a.cams.time.valid()) {
     const double end = once ? g.cm.pass_end(0) : g.cm.pass_end(pass_before);
     if (once ? x >= end : o.pass > pass_before) {
       const cam::CamMotionOutput at_end = g.cm.step(end);
-      ControlTag* old = owner_tag(g.owner, g.owner_gen);
+      ControlTag* old = tag(g.owner);
       if (old) {
         old->set(flag::IP, false);
         old->set(flag::AC, false);
@@ -1783,26 +1768,25 @@ void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
       const CamGen md_from = g;  // the pending cam runs in this cam's mode, master and lock state [seed 000]
       g.k = Kin{at_end.position, 0, 0};
       fold(a, Slot::TimeCam, false);  // base += position at the pass end: no jump
-      PendingCam pc = a.pending_cam;
-      a.pending_cam = PendingCam{};
+      PendingCam pc = a.cams.time;
+      a.cams.time = PendingCam{};
       CamGen n;
       if (pc.profile->acquire() == cam::CamError::None && n.cm.start(*pc.profile, pc.cfg) == cam::CamError::None) {
         n.profile = pc.profile;
         n.t0_cycle = t0;
         n.x_offset = xo;
         n.owner = pc.owner;
-        n.owner_gen = pc.owner_gen;
         n.master_driven = md_from.master_driven;
         n.md = md_from.md;
         n.md_rate = md_from.md_rate;
         n.md_cycle = md_from.md_cycle;
         if (n.master_driven) {
-          if (ControlTag* nt = owner_tag(n.owner, n.owner_gen)) nt->set(flag::AC, true);
-          if (ControlTag* m = owner_tag(n.md.mdac, n.md.mdac_gen)) m->set(flag::AC, true);
+          if (ControlTag* nt = tag(n.owner)) nt->set(flag::AC, true);
+          if (ControlTag* m = tag(n.md.mdac)) m->set(flag::AC, true);
         }
         CamGen& ng = set_slot(a, Slot::TimeCam, n);
         step_cam(a, ng);
-      } else if (ControlTag* pt = owner_tag(pc.owner, pc.owner_gen)) {
+      } else if (ControlTag* pt = tag(pc.owner)) {
         pt->reject(Err::CamProfileNotCalculated);
       }
       return;
@@ -1810,7 +1794,7 @@ void Planner::step_cam(AxisRt& a, CamGen& g) noexcept {
   }
   cam_output(g, o);  // velocity x master rate when master driven; SEGMENT; TrackingMaster
   if (o.complete) {  // Once: PC, the axis holds the end position, TimeCamStatus cleared
-    if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) c->set(flag::PC, true);
+    if (ControlTag* c = tag(g.owner)) c->set(flag::PC, true);
     fold(a, Slot::TimeCam, true);
   }
 }
@@ -1935,9 +1919,9 @@ Result Planner::update(const Input& in, Output& out) noexcept {
     bool any = false;
     for (std::size_t i = 0; i < axis_count_ && !any; ++i)
       for (const auto& s : axes_[i].gen)
-        if (auto* p = std::get_if<ProfileGen>(&s); p && p->owner == g.ctl && p->owner_gen == g.gen) any = true;
+        if (auto* p = std::get_if<ProfileGen>(&s); p && p->owner == g.owner) any = true;
     if (!any) {
-      if (ControlTag* c = owner_tag(g.ctl, g.gen)) { c->set(flag::IP, false); c->set(flag::PC, true); }
+      if (ControlTag* c = tag(g.owner)) { c->set(flag::IP, false); c->set(flag::PC, true); }
       g.active = false;
     }
   }

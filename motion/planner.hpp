@@ -148,8 +148,7 @@ struct ProfileGen {
   bool seconds = false;        ///< programmed in seconds (MCD not allowed: ERR 23)
   double speed = 0.0;          ///< programmed speed (0 = paused until MCD)
   double jog_velocity = 0.0;   ///< jog: signed programmed velocity
-  ControlId owner = kNoControl;
-  std::uint32_t owner_gen = 0;
+  OwnerRef owner{};
   std::uint8_t post_stop = 0;  ///< stop ramps of MGS: 0 none, 1 disable, 2 shutdown
   // master driven (MDSC): the profile's abscissa is master travel md.u, not
   // time; md as for a master-driven MATC (motion/master_follow.hpp)
@@ -162,8 +161,7 @@ struct MdacLink {
   AxisId master = kNoAxis;
   bool use_actual = false;
   bool all = false;            ///< set by MDAC MotionType All
-  ControlId ctl = kNoControl;
-  std::uint32_t gen = 0;
+  OwnerRef owner{};            ///< the MDAC execution
   constexpr bool valid() const noexcept { return master != kNoAxis; }
 };
 
@@ -182,8 +180,7 @@ struct GearGen {
   std::int64_t master_ref_counts = 0;
   double offset_at_lock = 0.0;
   Kin k{};                     ///< offset of this generator, velocity, acceleration (gear ramps are trapezoidal)
-  ControlId owner = kNoControl;
-  std::uint32_t owner_gen = 0;
+  OwnerRef owner{};
 };
 
 /// State of a time-driven MATC: the cam engineer's CamMotion evaluated at cam
@@ -195,8 +192,7 @@ struct CamGen {
   double x_offset = 0.0;       ///< cam time = (cycle - t0_cycle) * T - x_offset (pending takeovers)
   std::int64_t last_pass = 0;  ///< pass of the last step (a pending cam waits for its end)
   Kin k{};
-  ControlId owner = kNoControl;
-  std::uint32_t owner_gen = 0;
+  OwnerRef owner{};
   /// master-driven MATC (InstructionMode masterdrivenmode): cam coordinate =
   /// master travel in the lock direction (md.u - x_offset) instead of time
   bool master_driven = false;
@@ -209,8 +205,7 @@ struct CamGen {
 struct PendingCam {
   cam::CamProfile* profile = nullptr;
   cam::CamMotionConfig cfg{};
-  ControlId owner = kNoControl;
-  std::uint32_t owner_gen = 0;
+  OwnerRef owner{};
   constexpr bool valid() const noexcept { return profile != nullptr; }
 };
 
@@ -236,8 +231,7 @@ struct PosCamGen {
   double x_shift = 0.0;         ///< cam coordinate of the takeover (pending cams)
   std::int64_t last_pass = 0;
   Kin k{};
-  ControlId owner = kNoControl;
-  std::uint32_t owner_gen = 0;
+  OwnerRef owner{};
 };
 
 /// A pending MAPC waiting for the end of the current pass (or for a non-pending cam).
@@ -247,8 +241,7 @@ struct PendingPosCam {
   AxisId master = kNoAxis;
   bool use_actual = false;
   std::uint8_t master_dir = 0;
-  ControlId owner = kNoControl;
-  std::uint32_t owner_gen = 0;
+  OwnerRef owner{};
   constexpr bool valid() const noexcept { return profile != nullptr; }
 };
 
@@ -288,6 +281,57 @@ inline AxisId master_of(const Generator& s) noexcept {
   if (const MasterFollow* f = follow_of(s)) return f->master;
   return kNoAxis;
 }
+
+/// Servo loop and fault state of an axis (MSO, MSF, MASD, MASR, MAFR, MGSD,
+/// MGSR, exceptions).
+struct ServoState {
+  bool on = false;            ///< servo loop active (ServoActionStatus)
+  bool enable_req = false;    ///< drive enable requested
+  bool shutdown = false;      ///< Logix Shutdown state
+  bool faulted = false;       ///< StopDrive/Shutdown fault latched: ERR 20 until MAFR/MASR
+  bool fault_reset_pulse = false;  ///< send a CiA 402 fault reset this cycle
+  /// MAFR/MASR/MGSR on a CIP drive: DN when the drive has left Fault and is
+  /// connected, ER on a transition timeout or kDriveTimeout. While it waits,
+  /// the drive fault and lost node conditions are not latched again.
+  OwnerRef reset{};
+  std::uint64_t reset_deadline = 0;
+};
+
+/// Instructions waiting for the drive (AXIS_CIP_DRIVE): the MSO/MSF enable
+/// handshakes and MAH drive homing (CiA 402 mode 6).
+struct Handshakes {
+  OwnerRef mso{}, msf{};       ///< MSO waiting for Operation Enabled, MSF for its end
+  std::uint64_t deadline = 0;  ///< cycle at which MSO/MSF/MDS stop waiting (ERR 12)
+  OwnerRef mah{};              ///< MAH homing on the drive
+  bool homing = false;         ///< drive homing (mode 6) in progress
+  bool homing_started = false; ///< the homing request was sent
+  bool homed = false;          ///< AxisHomedStatus
+};
+
+/// MDS direct velocity/torque control of an axis.
+struct DirectControl {
+  bool status = false;   ///< AxisStatus.DirectControlStatus (cleared only by MSO, shutdown, servo off)
+  bool active = false;   ///< DirectVelocity/TorqueControlStatus: the direct command is applied
+  double cmd = 0.0;      ///< velocity (units/s) or torque command
+  double vel_cmd = 0.0;  ///< torque mode: velocity command for SLAT (units/s)
+  OwnerRef mds{};        ///< the MDS in control
+  bool waiting = false;  ///< MDS waits for the drive enable (STATE 1)
+  OwnerRef stop{};       ///< MAS stopping direct motion (PC at standstill)
+};
+
+/// Cams waiting to take over (pending MATC / MAPC) and the last cam directions.
+struct PendingCams {
+  PendingCam time{};          ///< TimeCamPendingStatus
+  int time_dir = 0;           ///< last time-cam direction (+1/-1, 0 never cammed)
+  PendingPosCam position{};   ///< PositionCamPendingStatus (MAPC)
+  int position_dir = 0;       ///< last position-cam direction (+1/-1, 0 never cammed)
+};
+
+/// MDAC links of a slave per motion type (0 move, 1 jog, 2 time cam, 3
+/// master offset move) and the queued masters.
+struct MdacLinks {
+  std::array<MdacLink, 4> active{}, pending{};
+};
 
 // typed instruction parameters (motion/instructions.hpp)
 struct MasParams;
@@ -373,54 +417,21 @@ class Planner {
     Kin cmd{};                  ///< total command (drive frame)
     double fb_pos = 0.0, fb_vel = 0.0;
     AxisFeedback fb{};
-    bool servo = false;         ///< servo loop active
-    bool enable_req = false;    ///< drive enable requested
-    bool shutdown = false;
-    bool faulted = false;       ///< StopDrive/Shutdown fault latched: ERR 20 until MAFR/MASR
-    bool homed = false;
-    bool fault_reset_pulse = false;
-    /// MAFR/MASR/MGSR on a CIP drive: DN when the drive has left Fault and is
-    /// connected, ER on a transition timeout or kDriveTimeout. While it waits,
-    /// the drive fault and lost node conditions are not latched again.
-    ControlId reset = kNoControl;
-    std::uint32_t reset_gen = 0;
-    std::uint64_t reset_deadline = 0;
     std::array<Generator, kSlots> gen{};
     /// Bit per Slot: the slot holds a generator (not std::monostate). Kept by
     /// set_slot() and fold(), the only writers of `gen`, so that the cycle
     /// reads no empty slot; check_incremental_state() verifies it.
     std::uint8_t live = 0;
     double last_speed = 0.0;    ///< last non-zero programmed speed (zero-speed S-curve rule)
-    // multi-cycle state instructions
-    ControlId mso = kNoControl, msf = kNoControl;
-    std::uint32_t mso_gen = 0, msf_gen = 0;
-    std::uint64_t mso_deadline = 0;
-    ControlId mah = kNoControl;
-    std::uint32_t mah_gen = 0;
-    /// MDAC links per motion type (0 move, 1 jog, 2 time cam, 3 master offset move) and the queued masters
-    std::array<MdacLink, 4> mdac{}, mdac_pending{};
-    // MDS direct control
-    bool direct = false;          ///< AxisStatus.DirectControlStatus (cleared only by MSO, shutdown, servo off)
-    bool direct_active = false;   ///< DirectVelocity/TorqueControlStatus: the direct command is applied
-    double direct_cmd = 0.0;      ///< velocity (units/s) or torque command
-    double direct_vel_cmd = 0.0;  ///< torque mode: velocity command for SLAT (units/s)
-    ControlId mds = kNoControl;
-    std::uint32_t mds_gen = 0;
-    bool mds_waiting = false;     ///< MDS waits for the drive enable (STATE 1)
-    ControlId mds_stop = kNoControl;  ///< MAS stopping direct motion (PC at standstill)
-    std::uint32_t mds_stop_gen = 0;
-    PendingCam pending_cam{};     ///< TimeCamPendingStatus
-    int cam_dir = 0;              ///< last time-cam direction (+1/-1, 0 never cammed)
-    PendingPosCam pending_pcam{}; ///< PositionCamPendingStatus (MAPC)
-    int pcam_dir = 0;             ///< last position-cam direction (+1/-1, 0 never cammed)
     int gear_dir = 0;           ///< last gearing direction (+1 same, -1 opposite, 0 never geared)
-    bool homing = false;        ///< drive homing (mode 6) in progress
-    bool homing_started = false;
-    std::uint32_t exc_prev = 0;  ///< exceptions active last cycle
+    ServoState servo{};
+    Handshakes hs{};
+    DirectControl direct{};
+    PendingCams cams{};
+    MdacLinks links{};
   };
   struct GroupOp {  ///< MGS in progress
-    ControlId ctl = kNoControl;
-    std::uint32_t gen = 0;
+    OwnerRef owner{};
     std::uint8_t group = 0;
     bool active = false;
   };
@@ -499,7 +510,8 @@ class Planner {
   void update_status(AxisRt& a) noexcept;
   Kin slot_kin(const AxisRt& a, Slot s) const noexcept;
   double user_command(const AxisRt& a) const noexcept;
-  ControlTag* owner_tag(ControlId id, std::uint32_t gen) noexcept;
+  /// The control tag `o` names, or null when a newer execution reused it.
+  ControlTag* tag(OwnerRef o) noexcept;
   bool any_stopping(const AxisRt& a) const noexcept;
   bool any_scurve(const AxisRt& a) const noexcept;
 

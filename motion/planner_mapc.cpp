@@ -80,14 +80,14 @@ void Planner::end_position_cam(AxisRt& a, PosCamGen& g) noexcept {
     g.profile->release();  // CAM_PROFILE[0].Status: one user less
     g.profile = nullptr;
   }
-  if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) c->set(flag::AC, false);
+  if (ControlTag* c = tag(g.owner)) c->set(flag::AC, false);
   fold(a, Slot::MasterOffset, true);  // a master offset move needs the cam it offsets
 }
 
 void Planner::drop_pending_pcam(AxisRt& a) noexcept {
-  if (!a.pending_pcam.valid()) return;
-  if (ControlTag* c = owner_tag(a.pending_pcam.owner, a.pending_pcam.owner_gen)) c->set(flag::IP, false);
-  a.pending_pcam = PendingPosCam{};
+  if (!a.cams.position.valid()) return;
+  if (ControlTag* c = tag(a.cams.position.owner)) c->set(flag::IP, false);
+  a.cams.position = PendingPosCam{};
 }
 
 void Planner::position_cam_status(const AxisRt& a, std::uint32_t& ms) const noexcept {
@@ -96,7 +96,7 @@ void Planner::position_cam_status(const AxisRt& a, std::uint32_t& ms) const noex
   const auto* pc = std::get_if<PosCamGen>(&a.gen[kPosCam]);
   setb(PositionCamStatus, pc != nullptr);
   setb(PositionCamLockStatus, pc && pc->locked && pc->inside && !pc->slipping);
-  setb(PositionCamPendingStatus, a.pending_pcam.valid());
+  setb(PositionCamPendingStatus, a.cams.position.valid());
   const auto* o = std::get_if<ProfileGen>(&a.gen[kOffset]);
   setb(MasterOffsetMoveStatus, o != nullptr);
   setb(MasterOffsetMoveLockStatus, o && o->master_driven && o->md.locked && o->md.following);
@@ -128,7 +128,7 @@ Err Planner::start_mapc(const Request& r, const MapcParams& p, AxisRt& a, std::i
       }
     }
   }
-  if (a.homing || m.homing) return Err::HomeInProcess;
+  if (a.hs.homing || m.hs.homing) return Err::HomeInProcess;
   if (any_stopping(a)) return Err::NotAllowedWhileStopping;
   cam::CamProfile* prof = p.cam_profile < kMaxCamProfiles ? cam_profiles_[p.cam_profile] : nullptr;
   if (!prof || !prof->calculated()) return Err::CamProfileNotCalculated;
@@ -143,7 +143,7 @@ Err Planner::start_mapc(const Request& r, const MapcParams& p, AxisRt& a, std::i
     exerr = static_cast<std::int8_t>(kIdx.cam_lock);
     return Err::ParameterOutOfRange;
   }
-  const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.pcam_dir);
+  const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.cams.position_dir);
   cam::CamMotionConfig cfg;
   cfg.mode = static_cast<cam::ExecutionMode>(p.execution_mode);
   cfg.scaling = sc;
@@ -159,8 +159,8 @@ Err Planner::start_mapc(const Request& r, const MapcParams& p, AxisRt& a, std::i
     // continues the active cam's master coordinate, so it needs the same master
     if (active && (active->master != p.master || active->use_actual != use_actual)) return Err::MasterAxisConflict;
     drop_pending_pcam(a);  // a second pending MAPC overlays the first
-    a.pending_pcam = PendingPosCam{prof, cfg, p.master, use_actual, p.master_direction, r.control, c.generation};
-    a.pcam_dir = dir;
+    a.cams.position = PendingPosCam{prof, cfg, p.master, use_actual, p.master_direction, OwnerRef{r.control, c.generation}};
+    a.cams.position_dir = dir;
     c.set(flag::DN, true);
     c.set(flag::IP, true);
     return Err::None;
@@ -184,10 +184,9 @@ Err Planner::start_mapc(const Request& r, const MapcParams& p, AxisRt& a, std::i
   g.locked = p.execution_schedule == kImmediate;
   g.prev_mp = mp;
   g.lock_mp = mp;
-  g.owner = r.control;
-  g.owner_gen = c.generation;
+  g.owner = OwnerRef{r.control, c.generation};
   set_slot(a, Slot::PositionCam, g);
-  a.pcam_dir = dir;
+  a.cams.position_dir = dir;
   c.set(flag::DN, true);
   c.set(flag::IP, true);
   c.set(flag::AC, true);  // the active (not pending) position cam of the axis
@@ -232,8 +231,8 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
   const double x = g.travel + off - g.x_shift;
   const cam::CamMotionOutput o = g.cm.step(x);
   const bool continuous = g.cm.config().mode == cam::ExecutionMode::Continuous;
-  ControlTag* c = owner_tag(g.owner, g.owner_gen);
-  if (a.pending_pcam.valid()) {
+  ControlTag* c = tag(g.owner);
+  if (a.cams.position.valid()) {
     // the pending cam takes over where the master leaves the current pass
     // (its end, or its start when the master runs backwards) [RM002H p.180]
     bool take = false;
@@ -248,8 +247,8 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
     }
     if (take) {
       const cam::CamMotionOutput at_end = g.cm.step(end);
-      PendingPosCam pc = a.pending_pcam;
-      a.pending_pcam = PendingPosCam{};
+      PendingPosCam pc = a.cams.position;
+      a.cams.position = PendingPosCam{};
       PosCamGen n;
       if (pc.profile->acquire() == cam::CamError::None) {
         if (n.cm.start(*pc.profile, pc.cfg) != cam::CamError::None) {
@@ -264,7 +263,7 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
         if (!continuous) c->set(flag::PC, true);  // Once: PC; Continuous: IP cleared [seed 004]
       }
       if (!pc.profile) {  // the profile was invalidated while pending: the cam ends at the pass end
-        if (ControlTag* pt = owner_tag(pc.owner, pc.owner_gen)) pt->reject(Err::CamProfileNotCalculated);
+        if (ControlTag* pt = tag(pc.owner)) pt->reject(Err::CamProfileNotCalculated);
         g.k = Kin{at_end.position, 0, 0};
         fold(a, Slot::PositionCam, false);
         return;
@@ -291,8 +290,7 @@ void Planner::step_position_cam(AxisRt& a, PosCamGen& g) noexcept {
         n.x_shift = off;
       }
       n.owner = pc.owner;
-      n.owner_gen = pc.owner_gen;
-      if (ControlTag* nc = owner_tag(n.owner, n.owner_gen)) nc->set(flag::AC, true);
+      if (ControlTag* nc = tag(n.owner)) nc->set(flag::AC, true);
       PosCamGen& ng = set_slot(a, Slot::PositionCam, n);  // g is gone from here on
       step_position_cam(a, ng);
       return;

@@ -33,14 +33,14 @@ Err Planner::matc_mode_checks(const AxisRt& a, const MatcParams& p) const noexce
     return Err::None;
   }
   // master-driven mode needs an active MDAC link for Time Cam (or All) [seed 004 "Structure"]
-  if (p.master_driven && !a.mdac_pending[kTimeCamLink].valid() && !a.mdac[kTimeCamLink].valid())
+  if (p.master_driven && !a.links.pending[kTimeCamLink].valid() && !a.links.active[kTimeCamLink].valid())
     return Err::MdscNotActivated;
   return Err::None;
 }
 
 Err Planner::matc_md_setup(const AxisRt& a, const MatcParams& p, CamGen& g) const noexcept {
   // a queued master takes over when this MATC goes IP (start_matc promotes it) [seed 000]
-  const MdacLink& l = a.mdac_pending[kTimeCamLink].valid() ? a.mdac_pending[kTimeCamLink] : a.mdac[kTimeCamLink];
+  const MdacLink& l = a.links.pending[kTimeCamLink].valid() ? a.links.pending[kTimeCamLink] : a.links.active[kTimeCamLink];
   if (!l.valid()) return Err::MdscNotActivated;
   const AxisRt& m = axes_[l.master];
   g.master_driven = true;
@@ -54,8 +54,7 @@ Err Planner::matc_md_setup(const AxisRt& a, const MatcParams& p, CamGen& g) cons
   g.md.locked = p.lock_direction == LockDirection::None || lock_immediate(p.lock_direction);
   g.md.following = g.md.locked;
   g.md.prev_mp = l.use_actual ? m.fb_pos : m.cmd.p;
-  g.md.mdac = l.ctl;
-  g.md.mdac_gen = l.gen;
+  g.md.mdac = l.owner;
   return Err::None;
 }
 
@@ -74,7 +73,7 @@ void Planner::cam_output(CamGen& g, const cam::CamMotionOutput& o) noexcept {
   // d/dt = d/du * du/dt: slave velocity = cam slope x master velocity (lock direction)
   const double r = g.master_driven ? g.md_rate : 1.0;
   g.k = Kin{o.position, o.velocity * r, o.acceleration * r * r};
-  if (ControlTag* c = owner_tag(g.owner, g.owner_gen)) {
+  if (ControlTag* c = tag(g.owner)) {
     c->segment = static_cast<std::int32_t>(o.segment);
     // a cam has no accel/decel transition: it tracks the master while locked and following
     if (g.master_driven) c->set(flag::TrackingMaster, g.md.locked && g.md.following);
