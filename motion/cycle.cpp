@@ -14,6 +14,7 @@
 #include "motion/instr/servo.hpp"
 
 namespace canmotion::motion {
+
 // ---------------------------------------------------------------- feedback
 void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   if (a.cfg.type != AxisType::CipDrive) return;

@@ -91,7 +91,7 @@ struct AxisOutput {
   double position = 0.0;      ///< command position, drive frame, user units (x conversion constant = counts)
   double velocity = 0.0;      ///< command velocity, user units/s (feed-forward / CSV target)
   double acceleration = 0.0;
-  double torque = 0.0;        ///< CST target (MDS torque mode, issue 5)
+  double torque = 0.0;        ///< CST target (MDS torque mode)
   DriveMode mode = DriveMode::CyclicPosition;
   bool enable = false;        ///< the drive should be in Operation Enabled
   bool fault_reset = false;   ///< pulse a CiA 402 fault reset this cycle

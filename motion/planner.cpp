@@ -19,27 +19,24 @@ namespace {
 /// operand count (ERR 13, EXERR = the count given or expected), executable
 /// (ERR 75), axis and group operands exist (ERR 11), operand values against
 /// the signature table (ERR 13 with the operand index).
-Err check_request(const Core& c, const Request& r, std::int8_t& exerr) noexcept {
+Err check_request(Ctx& x) noexcept {
+  const Request& r = x.r;
   const InstrSig& sig = signature(r.instr);
   if (r.count != sig.operands.size()) {
-    exerr = static_cast<std::int8_t>(std::min<std::size_t>(r.count, sig.operands.size()));
+    x.exerr = static_cast<std::int8_t>(std::min<std::size_t>(r.count, sig.operands.size()));
     return Err::ParameterOutOfRange;
   }
   if (!sig.executable) return Err::InstructionNotSupported;
   for (std::size_t i = 0; i < sig.operands.size(); ++i) {
     const auto k = sig.operands[i].kind;
     const auto ref = r.op[i].ref;
-    if (k == OperandKind::Axis && (ref >= kMaxAxes || !c.axes[ref].present)) return Err::AxisNotConfigured;
+    if (k == OperandKind::Axis && (ref >= kMaxAxes || !x.c.axes[ref].present)) return Err::AxisNotConfigured;
     if (k == OperandKind::Group && ref >= kMaxGroups) return Err::AxisNotConfigured;
   }
   std::array<double, kMaxOperands> vals{};
   for (std::size_t i = 0; i < kMaxOperands; ++i) vals[i] = r.op[i].value;
   const OperandCheck oc = check_operands(r.instr, std::span<const double>(vals.data(), sig.operands.size()));
-  if (!oc.ok) {
-    exerr = static_cast<std::int8_t>(oc.index);
-    return Err::ParameterOutOfRange;
-  }
-  return Err::None;
+  return oc.ok ? Err::None : x.reject_operand(oc.index);
 }
 
 }  // namespace
@@ -58,7 +55,7 @@ Err Planner::execute(const Request& r) noexcept {
   ControlTag& tag = c_.controls[r.control];
   tag.begin_execution();
   Ctx x{c_, r, tag, OwnerRef{r.control, tag.generation}};
-  Err e = check_request(c_, r, x.exerr);
+  Err e = check_request(x);
   // the typed params (from the table-checked request) to the family's start()
   if (e == Err::None) e = std::visit([&x](const auto& p) noexcept { return start(x, p); }, decode(r));
   if (e != Err::None) tag.reject(e, x.exerr);

@@ -94,14 +94,14 @@ inline constexpr E kMergeCoord[] = {{"disabled", 0}, {"coordinatedmotion", 1}, {
 inline constexpr E kMergeSpeed[] = {{"programmed", 0}, {"current", 1}};
 // MATC seed spells "positionforward"/"positionreverse"; the reference "...only".
 inline constexpr E kLockDir[] = {{"none", 0}, {"immediateforwardonly", 1}, {"immediatereverseonly", 2}, {"positionforwardonly", 3},
-                          {"positionreverseonly", 4}, {"positionforward", 3}, {"positionreverse", 4}};
+                                 {"positionreverseonly", 4}, {"positionforward", 3}, {"positionreverse", 4}};
 inline constexpr E kMoveType[] = {{"absolute", 0}, {"incremental", 1}, {"rotaryshortestpath", 2}, {"rotarypositive", 3},
-                           {"rotarynegative", 4}, {"absolutemasteroffset", 5}, {"incrementalmasteroffset", 6}};
+                                  {"rotarynegative", 4}, {"absolutemasteroffset", 5}, {"incrementalmasteroffset", 6}};
 inline constexpr E kCoordMoveType[] = {{"absolute", 0}, {"incremental", 1}};
 inline constexpr E kJogDir[] = {{"forward", 0}, {"reverse", 1}};
 inline constexpr E kCamDir[] = {{"same", 0}, {"opposite", 1}, {"reverse", 2}, {"unchanged", 3}};
 inline constexpr E kStopType[] = {{"all", 0}, {"jog", 1}, {"move", 2}, {"gear", 3}, {"home", 4}, {"tune", 5}, {"test", 6},
-                           {"timecam", 7}, {"positioncam", 8}, {"masteroffsetmove", 9}, {"directcontrol", 10}};
+                                  {"timecam", 7}, {"positioncam", 8}, {"masteroffsetmove", 9}, {"directcontrol", 10}};
 inline constexpr E kMasterRef[] = {{"actual", 0}, {"command", 1}};
 inline constexpr E kRatioFormat[] = {{"real", 0}, {"fraction_slave_master_counts", 1}, {"fractionslavemastercounts", 1}};
 inline constexpr E kClutch[] = {{"enabled", 0}, {"disabled", 1}};
@@ -120,8 +120,8 @@ inline constexpr E kMdacType[] = {{"all", 0}, {"move", 1}, {"jog", 2}, {"timecam
 inline constexpr E kMdsUnits[] = {{"%ofmaximum", 0}, {"unitspersec", 1}};
 inline constexpr E kMgsMode[] = {{"programmed", 0}, {"faststop", 1}, {"fastdisable", 2}};
 inline constexpr E kTermType[] = {{"actualtolerance", 0}, {"nosettle", 1}, {"commandtolerance", 2}, {"nodecel", 3},
-                           {"followcontourvelocityconstrained", 4}, {"followcontourvelocityunconstrained", 5},
-                           {"commandtoleranceprogrammed", 6}};
+                                  {"followcontourvelocityconstrained", 4}, {"followcontourvelocityunconstrained", 5},
+                                  {"commandtoleranceprogrammed", 6}};
 inline constexpr E kCircleType[] = {{"via", 0}, {"center", 1}, {"radius", 2}, {"centerincremental", 3}};
 inline constexpr E kCircleDir[] = {{"clockwise", 0}, {"counterclockwise", 1}, {"clockwisefull", 2}, {"counterclockwisefull", 3}};
 inline constexpr E kMcsStop[] = {{"all", 0}, {"coordinatedmove", 2}, {"coordinatedtransform", 3}};
@@ -143,96 +143,96 @@ inline constexpr OperandSig kGroupCtl[] = {{"Group", K::Group}, ctl()};
 inline constexpr OperandSig kCsCtl[] = {{"CoordinateSystem", K::CoordSystem}, ctl()};
 
 inline constexpr OperandSig kMas[] = {ax("Axis"), ctl(), en("StopType", kStopType), en("ChangeDecel", kNoYes),
-                               real("DecelRate"), en("DecelUnits", kAccelUnits01), en("ChangeDecelJerk", kNoYes),
-                               real("DecelJerk"), en("JerkUnits", kJerkUnitsMas)};
+                                      real("DecelRate"), en("DecelUnits", kAccelUnits01), en("ChangeDecelJerk", kNoYes),
+                                      real("DecelJerk"), en("JerkUnits", kJerkUnitsMas)};
 
 inline constexpr OperandSig kMaj[] = {ax("Axis"), ctl(), ent("Direction", kJogDir), real("Speed", Range::NonNegative),
-                               en("SpeedUnits", kSpeedUnitsMaj), real("AccelRate", Range::Positive),
-                               en("AccelUnits", kAccelUnitsMaj), real("DecelRate", Range::Positive),
-                               en("DecelUnits", kAccelUnitsMaj), en("Profile", kProfile), real("AccelJerk"),
-                               real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj), en("Merge", kMerge),
-                               en("MergeSpeed", kMergeSpeed), real("LockPosition"), ent("LockDirection", kLockDir)};
+                                      en("SpeedUnits", kSpeedUnitsMaj), real("AccelRate", Range::Positive),
+                                      en("AccelUnits", kAccelUnitsMaj), real("DecelRate", Range::Positive),
+                                      en("DecelUnits", kAccelUnitsMaj), en("Profile", kProfile), real("AccelJerk"),
+                                      real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj), en("Merge", kMerge),
+                                      en("MergeSpeed", kMergeSpeed), real("LockPosition"), ent("LockDirection", kLockDir)};
 
 inline constexpr OperandSig kMam[] = {ax("Axis"), ctl(), ent("MoveType", kMoveType), real("Position"),
-                               real("Speed", Range::NonNegative), en("SpeedUnits", kSpeedUnitsMam),
-                               real("AccelRate", Range::Positive), en("AccelUnits", kAccelUnitsMam),
-                               real("DecelRate", Range::Positive), en("DecelUnits", kAccelUnitsMam),
-                               en("Profile", kProfile), real("AccelJerk"), real("DecelJerk"),
-                               en("JerkUnits", kJerkUnitsMam), en("Merge", kMerge), en("MergeSpeed", kMergeSpeed),
-                               real("LockPosition"), ent("LockDirection", kLockDir),
-                               {"EventDistance", K::RealArray}, {"CalculatedData", K::RealArray}};
+                                      real("Speed", Range::NonNegative), en("SpeedUnits", kSpeedUnitsMam),
+                                      real("AccelRate", Range::Positive), en("AccelUnits", kAccelUnitsMam),
+                                      real("DecelRate", Range::Positive), en("DecelUnits", kAccelUnitsMam),
+                                      en("Profile", kProfile), real("AccelJerk"), real("DecelJerk"),
+                                      en("JerkUnits", kJerkUnitsMam), en("Merge", kMerge), en("MergeSpeed", kMergeSpeed),
+                                      real("LockPosition"), ent("LockDirection", kLockDir),
+                                      {"EventDistance", K::RealArray}, {"CalculatedData", K::RealArray}};
 
 inline constexpr OperandSig kMag[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), ent("Direction", kCamDir), real("Ratio"),
-                               integer("SlaveCounts"), integer("MasterCounts"), en("MasterReference", kMasterRef),
-                               en("RatioFormat", kRatioFormat), en("Clutch", kClutch), real("AccelRate"),
-                               en("AccelUnits", kAccelUnits01)};
+                                      integer("SlaveCounts"), integer("MasterCounts"), en("MasterReference", kMasterRef),
+                                      en("RatioFormat", kRatioFormat), en("Clutch", kClutch), real("AccelRate"),
+                                      en("AccelUnits", kAccelUnits01)};
 
 inline constexpr OperandSig kMcd[] = {ax("Axis"), ctl(), en("MotionType", kMcdType), en("ChangeSpeed", kNoYes),
-                               real("Speed", Range::NonNegative), en("ChangeAccel", kNoYes), real("AccelRate"),
-                               en("ChangeDecel", kNoYes), real("DecelRate"), en("ChangeAccelJerk", kNoYes),
-                               real("AccelJerk"), en("ChangeDecelJerk", kNoYes), real("DecelJerk"),
-                               en("SpeedUnits", kSpeedUnitsMaj), en("AccelUnits", kAccelUnitsMaj),
-                               en("DecelUnits", kAccelUnitsMaj), en("JerkUnits", kJerkUnitsMaj)};
+                                      real("Speed", Range::NonNegative), en("ChangeAccel", kNoYes), real("AccelRate"),
+                                      en("ChangeDecel", kNoYes), real("DecelRate"), en("ChangeAccelJerk", kNoYes),
+                                      real("AccelJerk"), en("ChangeDecelJerk", kNoYes), real("DecelJerk"),
+                                      en("SpeedUnits", kSpeedUnitsMaj), en("AccelUnits", kAccelUnitsMaj),
+                                      en("DecelUnits", kAccelUnitsMaj), en("JerkUnits", kJerkUnitsMaj)};
 
 inline constexpr OperandSig kMrp[] = {ax("Axis"), ctl(), en("Type", kMrpType), en("PositionSelect", kMrpSelect), real("Position")};
 
 inline constexpr OperandSig kMccp[] = {ctl(), {"Cam", K::CamArray}, integer("Length"), real("StartSlope"), real("EndSlope"),
-                                {"CamProfile", K::CamProfile}};
+                                       {"CamProfile", K::CamProfile}};
 
 inline constexpr OperandSig kMapc[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), ent("Direction", kCamDir),
-                                {"CamProfile", K::CamProfile}, real("SlaveScaling"), real("MasterScaling"),
-                                en("ExecutionMode", kExecModeMapc), en("ExecutionSchedule", kExecSchedMapc),
-                                real("MasterLockPosition"), real("CamLockPosition"), en("MasterReference", kMasterRef),
-                                en("MasterDirection", kMasterDir)};
+                                       {"CamProfile", K::CamProfile}, real("SlaveScaling"), real("MasterScaling"),
+                                       en("ExecutionMode", kExecModeMapc), en("ExecutionSchedule", kExecSchedMapc),
+                                       real("MasterLockPosition"), real("CamLockPosition"), en("MasterReference", kMasterRef),
+                                       en("MasterDirection", kMasterDir)};
 
 inline constexpr OperandSig kMatc[] = {ax("Axis"), ctl(), ent("Direction", kCamDir), {"CamProfile", K::CamProfile},
-                                real("DistanceScaling"), real("TimeScaling"), en("ExecutionMode", kExecModeMatc),
-                                en("ExecutionSchedule", kExecSchedMatc), real("LockPosition"),
-                                ent("LockDirection", kLockDir), en("InstructionMode", kInstrMode)};
+                                       real("DistanceScaling"), real("TimeScaling"), en("ExecutionMode", kExecModeMatc),
+                                       en("ExecutionSchedule", kExecSchedMatc), real("LockPosition"),
+                                       ent("LockDirection", kLockDir), en("InstructionMode", kInstrMode)};
 
 inline constexpr OperandSig kMdac[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), ent("MotionType", kMdacType),
-                                en("MasterReference", kMasterRef)};
+                                       en("MasterReference", kMasterRef)};
 
 inline constexpr OperandSig kMds[] = {ax("Axis"), ctl(), real("Speed"), en("SpeedUnits", kMdsUnits)};
 
 inline constexpr OperandSig kMgs[] = {{"Group", K::Group}, ctl(), en("StopMode", kMgsMode)};
 
 inline constexpr OperandSig kMclm[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), ent("MoveType", kCoordMoveType),
-                                {"Position", K::RealArray}, real("Speed", Range::NonNegative),
-                                en("SpeedUnits", kCoordSpeedUnits), real("AccelRate", Range::Positive),
-                                en("AccelUnits", kAccelUnitsMaj), real("DecelRate", Range::Positive),
-                                en("DecelUnits", kAccelUnitsMaj), en("Profile", kProfile), real("AccelJerk"),
-                                real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj), ent("TerminationType", kTermType),
-                                en("Merge", kMergeCoord), en("MergeSpeed", kMergeSpeed), real("CommandTolerance"),
-                                real("LockPosition"), ent("LockDirection", kLockDir), {"EventDistance", K::RealArray},
-                                {"CalculatedData", K::RealArray}};
+                                       {"Position", K::RealArray}, real("Speed", Range::NonNegative),
+                                       en("SpeedUnits", kCoordSpeedUnits), real("AccelRate", Range::Positive),
+                                       en("AccelUnits", kAccelUnitsMaj), real("DecelRate", Range::Positive),
+                                       en("DecelUnits", kAccelUnitsMaj), en("Profile", kProfile), real("AccelJerk"),
+                                       real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj), ent("TerminationType", kTermType),
+                                       en("Merge", kMergeCoord), en("MergeSpeed", kMergeSpeed), real("CommandTolerance"),
+                                       real("LockPosition"), ent("LockDirection", kLockDir), {"EventDistance", K::RealArray},
+                                       {"CalculatedData", K::RealArray}};
 
 inline constexpr OperandSig kMccm[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), ent("MoveType", kCoordMoveType),
-                                {"Position", K::RealArray}, ent("CircleType", kCircleType),
-                                {"Via/Center/Radius", K::RealArray}, ent("Direction", kCircleDir),
-                                real("Speed", Range::NonNegative), en("SpeedUnits", kCoordSpeedUnits),
-                                real("AccelRate", Range::Positive), en("AccelUnits", kAccelUnitsMaj),
-                                real("DecelRate", Range::Positive), en("DecelUnits", kAccelUnitsMaj),
-                                en("Profile", kProfile), real("AccelJerk"), real("DecelJerk"),
-                                en("JerkUnits", kJerkUnitsMaj), ent("TerminationType", kTermType),
-                                en("Merge", kMergeCoord), en("MergeSpeed", kMergeSpeed), real("CommandTolerance"),
-                                real("LockPosition"), ent("LockDirection", kLockDir), {"EventDistance", K::RealArray},
-                                {"CalculatedData", K::RealArray}};
+                                       {"Position", K::RealArray}, ent("CircleType", kCircleType),
+                                       {"Via/Center/Radius", K::RealArray}, ent("Direction", kCircleDir),
+                                       real("Speed", Range::NonNegative), en("SpeedUnits", kCoordSpeedUnits),
+                                       real("AccelRate", Range::Positive), en("AccelUnits", kAccelUnitsMaj),
+                                       real("DecelRate", Range::Positive), en("DecelUnits", kAccelUnitsMaj),
+                                       en("Profile", kProfile), real("AccelJerk"), real("DecelJerk"),
+                                       en("JerkUnits", kJerkUnitsMaj), ent("TerminationType", kTermType),
+                                       en("Merge", kMergeCoord), en("MergeSpeed", kMergeSpeed), real("CommandTolerance"),
+                                       real("LockPosition"), ent("LockDirection", kLockDir), {"EventDistance", K::RealArray},
+                                       {"CalculatedData", K::RealArray}};
 
 inline constexpr OperandSig kMcs[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), en("StopType", kMcsStop),
-                               en("ChangeDecel", kNoYes), real("DecelRate"), en("DecelUnits", kAccelUnits01),
-                               en("ChangeDecelJerk", kNoYes), real("DecelJerk"), en("JerkUnits", kJerkUnitsMas)};
+                                      en("ChangeDecel", kNoYes), real("DecelRate"), en("DecelUnits", kAccelUnits01),
+                                      en("ChangeDecelJerk", kNoYes), real("DecelJerk"), en("JerkUnits", kJerkUnitsMas)};
 
 inline constexpr OperandSig kMccd[] = {{"CoordinateSystem", K::CoordSystem}, ctl(), en("MotionType", kMccdType),
-                                en("ChangeSpeed", kNoYes), real("Speed", Range::NonNegative),
-                                en("SpeedUnits", kCoordSpeedUnits), en("ChangeAccel", kNoYes), real("AccelRate"),
-                                en("AccelUnits", kAccelUnitsMaj), en("ChangeDecel", kNoYes), real("DecelRate"),
-                                en("DecelUnits", kAccelUnitsMaj), en("ChangeAccelJerk", kNoYes), real("AccelJerk"),
-                                en("ChangeDecelJerk", kNoYes), real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj),
-                                en("Scope", kMccdScope)};
+                                       en("ChangeSpeed", kNoYes), real("Speed", Range::NonNegative),
+                                       en("SpeedUnits", kCoordSpeedUnits), en("ChangeAccel", kNoYes), real("AccelRate"),
+                                       en("AccelUnits", kAccelUnitsMaj), en("ChangeDecel", kNoYes), real("DecelRate"),
+                                       en("DecelUnits", kAccelUnitsMaj), en("ChangeAccelJerk", kNoYes), real("AccelJerk"),
+                                       en("ChangeDecelJerk", kNoYes), real("DecelJerk"), en("JerkUnits", kJerkUnitsMaj),
+                                       en("Scope", kMccdScope)};
 
 inline constexpr OperandSig kMdcc[] = {{"SlaveSystem", K::CoordSystem}, ax("MasterAxis"), ctl(),
-                                en("MasterReference", kMasterRef), real("NominalMasterVelocity")};
+                                       en("MasterReference", kMasterRef), real("NominalMasterVelocity")};
 
 inline constexpr std::array<InstrSig, kInstrCount> kTable{{
     {Instr::MSO, "MSO", kAxisCtl, true},

@@ -214,8 +214,8 @@ constexpr bool operator==(JerkUnits u, int logix) noexcept { return static_cast<
 namespace schedule {
 inline constexpr std::uint8_t Immediate = 0, Pending = 1, ForwardOnly = 2, ReverseOnly = 3, Bidirectional = 4;
 }
-/// ExecutionMode numbers of MATC (0, 1) and MAPC (all): cam::ExecutionMode.
-/// MasterDirection numbers of MAPC [RM002H p.171].
+/// MasterDirection numbers of MAPC [RM002H p.171]. (ExecutionMode numbers:
+/// cam::ExecutionMode.)
 namespace master_direction {
 inline constexpr std::uint8_t Bidirectional = 0, ForwardOnly = 1, ReverseOnly = 2;
 }

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "motion/cam/cam_motion.hpp"
 #include "motion/instr/ctx.hpp"
 
 namespace canmotion::motion {
@@ -74,9 +75,9 @@ Err start(Ctx& x, const MagParams& p) noexcept {
   if (m.cfg.inhibited) return Err::AxisIsInhibited;
   if (p.master == p.slave || geared_to(x.c, p.master, p.slave)) return Err::MasterAxisConflict;
   // Direction: same/opposite, or reverse/unchanged relative to the last gearing
-  // direction (first use: reverse = opposite, unchanged = same) [seed 003].
-  const int d = static_cast<int>(p.direction);
-  const int dir = d == 0 ? 1 : d == 1 ? -1 : d == 2 ? (a.gear_dir == 0 ? -1 : -a.gear_dir) : (a.gear_dir == 0 ? 1 : a.gear_dir);
+  // direction (first use: reverse = opposite, unchanged = same) [seed 003]:
+  // the rule of the cams' Direction
+  const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.gear_dir);
   GearGen g;
   g.master_id = p.master;
   g.fractional = p.fractional;

@@ -112,7 +112,7 @@ Err start(Ctx& x, const MatcParams& p) noexcept {
     return x.reject_operand(bad_slave ? op<Instr::MATC>("DistanceScaling") : op<Instr::MATC>("TimeScaling"));
   const int dir = cam::resolve_direction(static_cast<std::int32_t>(p.direction), a.cams.time_dir);
   cam::CamMotionConfig cfg;
-  cfg.mode = p.execution_mode == 1 ? cam::ExecutionMode::Continuous : cam::ExecutionMode::Once;
+  cfg.mode = static_cast<cam::ExecutionMode>(p.execution_mode);  // once or continuous (the table checked it)
   cfg.scaling = sc;
   cfg.direction = dir;
   const bool active = std::holds_alternative<CamGen>(a.gen[index(Slot::TimeCam)]);
