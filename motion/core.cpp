@@ -40,27 +40,9 @@ bool Core::configure_axis(AxisId id, const AxisConfig& cfg) noexcept {
   return true;
 }
 
-ControlTag* Core::tag(OwnerRef o) noexcept {
-  if (o.id >= kMaxControlTags) return nullptr;
-  ControlTag& c = controls[o.id];
-  return c.generation == o.gen ? &c : nullptr;  // the tag was re-executed: not ours any more
-}
-
 Kin Core::slot_kin(const AxisRt& a, Slot s) const noexcept {
   const GenBase* g = gen_base(a.gen[index(s)]);
   return g ? g->k : Kin{};
-}
-
-bool Core::any_scurve(const AxisRt& a) const noexcept {
-  for (unsigned m = a.live; m != 0; m &= m - 1)  // live slots only
-    if (auto* p = std::get_if<ProfileGen>(&a.gen[std::countr_zero(m)]); p && p->scurve) return true;
-  return false;
-}
-
-bool Core::any_stopping(const AxisRt& a) const noexcept {
-  for (unsigned m = a.live; m != 0; m &= m - 1)  // live slots only
-    if (auto* p = std::get_if<ProfileGen>(&a.gen[std::countr_zero(m)]); p && p->role == GenRole::Stop) return true;
-  return false;
 }
 
 void Core::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {

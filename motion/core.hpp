@@ -12,6 +12,7 @@
 ///   planner.cpp       the public API, execute(): checks, decode, one std::visit to start()
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -153,7 +154,11 @@ struct Core {
 
   // ---- shared operations (core.cpp)
   /// The control tag `o` names, or null when a newer execution reused it.
-  ControlTag* tag(OwnerRef o) noexcept;
+  ControlTag* tag(OwnerRef o) noexcept {
+    if (o.id >= kMaxControlTags) return nullptr;
+    ControlTag& c = controls[o.id];
+    return c.generation == o.gen ? &c : nullptr;  // the tag was re-executed: not ours any more
+  }
   /// End the generator in slot `s`: its on_fold(), its offset into the base
   /// (a master offset move's into the position cam), its owner's IP, ACCEL,
   /// DECEL, TrackingMaster, AC cleared (if `clear_owner_ip`); the slot empty.
@@ -187,8 +192,18 @@ struct Core {
   Err common_checks(const AxisRt& a, bool need_servo) const noexcept;
   Kin slot_kin(const AxisRt& a, Slot s) const noexcept;
   double user_command(const AxisRt& a) const noexcept { return a.cmd.p + a.frame_offset; }
-  bool any_stopping(const AxisRt& a) const noexcept;
-  bool any_scurve(const AxisRt& a) const noexcept;
+  /// A stop ramp runs (StoppingStatus; MAM/MAJ/MAPC refused, ERR 78).
+  bool any_stopping(const AxisRt& a) const noexcept {
+    for (unsigned m = a.live; m != 0; m &= m - 1)  // live slots only
+      if (auto* p = std::get_if<ProfileGen>(&a.gen[std::countr_zero(m)]); p && p->role == GenRole::Stop) return true;
+    return false;
+  }
+  /// An S-curve profile runs (a merge continues its acceleration).
+  bool any_scurve(const AxisRt& a) const noexcept {
+    for (unsigned m = a.live; m != 0; m &= m - 1)  // live slots only
+      if (auto* p = std::get_if<ProfileGen>(&a.gen[std::countr_zero(m)]); p && p->scurve) return true;
+    return false;
+  }
   /// The cycle at which a handshake with the drive (MSO, MSF, MDS, a fault
   /// reset) times out.
   std::uint64_t drive_deadline() const noexcept;

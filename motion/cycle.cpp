@@ -10,6 +10,7 @@
 #include "motion/instr/direct.hpp"
 #include "motion/instr/home.hpp"
 #include "motion/instr/mdac.hpp"
+#include "motion/instr/move_step.hpp"
 #include "motion/instr/position_cam.hpp"
 #include "motion/instr/servo.hpp"
 

@@ -104,7 +104,7 @@ using Failure = std::optional<ParseError>;
 /// tag name with an optional [index]: operand `n` of instruction `iname`.
 Failure lex_operand(Lexer& lx, const std::string& iname, std::size_t n, StOperand& op) {
   const std::string_view text = lx.s;
-  const std::string where = iname + " operand " + std::to_string(n);
+  const auto where = [&] { return iname + " operand " + std::to_string(n); };  // built only for an error
   op.column = lx.col();
   if (lx.i >= text.size()) return ParseError{iname + ": unexpected end of text in operand " + std::to_string(n), lx.col()};
   const char c = text[lx.i];
@@ -127,7 +127,7 @@ Failure lex_operand(Lexer& lx, const std::string& iname, std::size_t n, StOperan
     double v = 0;
     const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), v);
     if (r.ec != std::errc() || r.ptr != digits.data() + digits.size() || !std::isfinite(v))
-      return ParseError{where + ": malformed number '" + lit + "'", op.column};
+      return ParseError{where() + ": malformed number '" + lit + "'", op.column};
     op.kind = StOperand::Kind::Number;
     op.number = v;
     op.integer = integer;
@@ -135,7 +135,7 @@ Failure lex_operand(Lexer& lx, const std::string& iname, std::size_t n, StOperan
     lx.i = j;
     return std::nullopt;
   }
-  if (!ident_start(c)) return ParseError{where + ": unexpected character '" + std::string(1, c) + "'", op.column};
+  if (!ident_start(c)) return ParseError{where() + ": unexpected character '" + std::string(1, c) + "'", op.column};
   std::size_t j = lx.i;
   while (j < text.size() && ident_char(text[j])) ++j;
   op.kind = StOperand::Kind::Tag;
@@ -147,13 +147,13 @@ Failure lex_operand(Lexer& lx, const std::string& iname, std::size_t n, StOperan
     lx.skip();
     std::size_t k = lx.i;
     while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
-    if (k == lx.i) return ParseError{where + ": expected an integer array index after '" + op.text + "['", lx.col()};
+    if (k == lx.i) return ParseError{where() + ": expected an integer array index after '" + op.text + "['", lx.col()};
     long idxv = 0;
     const auto r = std::from_chars(text.data() + lx.i, text.data() + k, idxv);
     if (r.ec != std::errc()) return ParseError{iname + ": array index out of range", lx.col()};
     op.index = idxv;
     lx.i = k;
-    if (!lx.eat(']')) return ParseError{where + ": expected ']'", lx.col()};
+    if (!lx.eat(']')) return ParseError{where() + ": expected ']'", lx.col()};
   }
   return std::nullopt;
 }

@@ -41,8 +41,12 @@ struct ProfileGen : GenBase {
 
   // generator interface (motion/generator.hpp)
   AxisId master() const noexcept { return master_driven ? md.master : kNoAxis; }
-  void step(Core& c, AxisRt& a, Slot s) noexcept;
+  /// Defined in motion/instr/move_step.hpp: inline in the cycle.
+  inline void step(Core& c, AxisRt& a, Slot s) noexcept;
   void on_fold(Core& c, AxisRt& a) noexcept;
+  /// The profile ended (step): PC, folded; a ramp of MGS FastDisable /
+  /// FastShutdown then switches the servo off / shuts the axis down.
+  void finish(Core& c, AxisRt& a, Slot s, ControlTag* t) noexcept;
 };
 
 /// Speed .. LockDirection, laid out identically in MAM and MAJ.
