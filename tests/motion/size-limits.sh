@@ -36,8 +36,8 @@ while IFS=$'\t' read -r n where name; do
   if (( n > max_fn )); then echo "size-limits: function $name at $where has $n lines (> $max_fn)" >&2; bad=1; fi
 done < <(functions "${files[@]}")
 echo "size-limits: ${#files[@]} files; largest:"
-wc -l "${files[@]}" | grep -v ' total$' | sort -rn | head -3 | sed "s#$dir/#motion/#; s/^/  /"
+wc -l "${files[@]}" | grep -v ' total$' | sort -rn | awk 'NR <= 3' | sed "s#$dir/#motion/#; s/^/  /"
 echo "size-limits: $(functions "${files[@]}" | wc -l) functions; longest:"
-functions "${files[@]}" | sort -t$'\t' -k1,1nr | head -5 | sed "s#$dir/#motion/#; s/^/  /"
+functions "${files[@]}" | sort -t$'\t' -k1,1nr | awk 'NR <= 5' | sed "s#$dir/#motion/#; s/^/  /"
 [[ $bad == 0 ]] || fail "limits: files <= $max_file lines, functions <= $max_fn lines"
 echo "size-limits: PASS"
