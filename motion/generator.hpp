@@ -48,6 +48,11 @@ inline constexpr std::uint32_t kAllSlots = (1u << kSlots) - 1u;
 /// sum) and the order in which the step-order walk visits masters.
 inline constexpr std::array<Slot, kSlots> kLegacySlotOrder{Slot::Move, Slot::Jog, Slot::Gear, Slot::TimeCam,
                                                            Slot::PositionCam, Slot::MasterOffset, Slot::StopAll};
+static_assert([] {
+  std::uint32_t seen = 0;
+  for (const Slot s : kLegacySlotOrder) seen |= slot_bit(s);
+  return seen == (1u << kSlots) - 1u;
+}(), "kLegacySlotOrder lists every slot once (a new slot goes into it too)");
 
 /// The closed set of generator states.
 using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen, PosCamGen>;
