@@ -72,4 +72,15 @@ using AxisId = std::uint16_t;
 inline constexpr ControlId kNoControl = 0xFFFF;
 inline constexpr AxisId kNoAxis = 0xFFFF;
 
+/// What the planner keeps of the execution that started something (a
+/// generator, a handshake, an MDAC link, a pending cam): the control tag and
+/// its generation at that execution. A newer execution of the same tag makes
+/// the reference stale: the planner then no longer writes the tag.
+struct OwnerRef {
+  ControlId id = kNoControl;
+  std::uint32_t gen = 0;
+  constexpr bool valid() const noexcept { return id != kNoControl; }
+  friend constexpr bool operator==(const OwnerRef&, const OwnerRef&) noexcept = default;
+};
+
 }  // namespace canmotion::motion

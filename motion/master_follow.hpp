@@ -72,8 +72,7 @@ struct MasterFollow {
   bool following = false;      ///< the master last moved in the lock direction
   double u = 0.0;              ///< driving coordinate: master travel counted so far
   double prev_mp = 0.0;        ///< master position last cycle
-  ControlId mdac = kNoControl; ///< the MDAC control whose AC bit this motion sets
-  std::uint32_t mdac_gen = 0;
+  OwnerRef mdac{};             ///< the MDAC control whose AC bit this motion sets
   /// Advance by one cycle with master position `mp`; returns du. Realtime-safe.
   constexpr double step(double mp) noexcept {
     const double du = master_follow_step(lock, lock_pos, mp, prev_mp, locked, following);

@@ -195,6 +195,46 @@ bool plan_velocity(Profile& out, const Kin& start, double velocity, const Limits
   return b.ok;
 }
 
+namespace {
+
+/// Decel, accel and both jerks scaled by k (MCD: stop exactly on target).
+Limits scaled(Limits l, double k) noexcept {
+  l.a *= k; l.d *= k; l.ja *= k; l.jd *= k;
+  return l;
+}
+
+/// The limits with decel d (a stop softer than lim.d).
+Limits with_decel(Limits l, double d) noexcept {
+  l.d = d;
+  return l;
+}
+
+/// Peak velocity of a move of length R from velocity v0 >= 0 at zero
+/// acceleration, in closed form when both ramps have a constant-acceleration
+/// phase (quadratic in vp) or, from rest, when both are triangular (vp^3/2);
+/// -1 for other shapes. Only peaks in [vlo, V] count.
+double closed_form_peak(double v0, const Limits& lim, double R, double vlo, double V) noexcept {
+  const double A = lim.a, D = lim.d;
+  const double ia = std::isinf(lim.ja) ? 0.0 : 1.0 / lim.ja, id = std::isinf(lim.jd) ? 0.0 : 1.0 / lim.jd;
+  double vp = -1;
+  {  // both trapezoidal
+    const double qa = 1 / (2 * A) + 1 / (2 * D), qb = A * ia / 2 + D * id / 2;
+    const double qc = -v0 * v0 / (2 * A) + v0 * A * ia / 2 - R;
+    const double disc = qb * qb - 4 * qa * qc;
+    if (disc >= 0) {
+      const double x = (-qb + std::sqrt(disc)) / (2 * qa);
+      if (x - v0 >= A * A * ia && x >= D * D * id && x >= vlo && x <= V) vp = x;
+    }
+  }
+  if (vp < 0 && v0 == 0 && ia > 0 && id > 0) {  // both triangular, from rest
+    const double x = std::cbrt(std::pow(R / (std::sqrt(ia) + std::sqrt(id)), 2.0));
+    if (x < A * A * ia && x < D * D * id && x <= V) vp = x;
+  }
+  return vp;
+}
+
+}  // namespace
+
 bool plan_move(Profile& out, const Kin& start, double distance, const Limits& lim, Overshoot policy) noexcept {
   if (!limits_valid(lim) || !kin_valid(start) || !std::isfinite(distance)) return false;
   ProfileBuilder b(out, start);
@@ -230,15 +270,10 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
       double lo = 0.0, hi = std::log(1e9);  // log k
       for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
         const double mid = (lo + hi) / 2;
-        const double k = std::exp(mid);
-        Limits l = lim;
-        l.a *= k; l.d *= k; l.ja *= k; l.jd *= k;
+        const Limits l = scaled(lim, std::exp(mid));
         if (reverses(l.jd) || stop_dist(l) > Rabs) lo = mid; else hi = mid;
       }
-      const double k = std::exp(hi);
-      Limits l = lim;
-      l.a *= k; l.d *= k; l.ja *= k; l.jd *= k;
-      vel_change_lim(b, 0.0, l, sg);
+      vel_change_lim(b, 0.0, scaled(lim, std::exp(hi)), sg);
       break;
     }
     auto f = [&](double vp) noexcept {
@@ -262,26 +297,9 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
     }
     if (vs_up <= V) {
       const double vlo = std::max(vs_up, 0.0);
-      // Closed form from zero acceleration when both ramps have a constant-
-      // acceleration phase (quadratic in vp) or, from rest, when both are
-      // triangular (vp^3/2); other shapes use the bounded solve below.
+      // Closed form from zero acceleration; other shapes use the bounded solve below.
       if (arel == 0 && vrel >= 0) {
-        const double v0 = vrel, A = lim.a, D = lim.d;
-        const double ia = std::isinf(lim.ja) ? 0.0 : 1.0 / lim.ja, id = std::isinf(lim.jd) ? 0.0 : 1.0 / lim.jd;
-        double vp = -1;
-        {  // both trapezoidal
-          const double qa = 1 / (2 * A) + 1 / (2 * D), qb = A * ia / 2 + D * id / 2;
-          const double qc = -v0 * v0 / (2 * A) + v0 * A * ia / 2 - Rabs;
-          const double disc = qb * qb - 4 * qa * qc;
-          if (disc >= 0) {
-            const double x = (-qb + std::sqrt(disc)) / (2 * qa);
-            if (x - v0 >= A * A * ia && x >= D * D * id && x >= vlo && x <= V) vp = x;
-          }
-        }
-        if (vp < 0 && v0 == 0 && ia > 0 && id > 0) {  // both triangular, from rest
-          const double x = std::cbrt(std::pow(Rabs / (std::sqrt(ia) + std::sqrt(id)), 2.0));
-          if (x < A * A * ia && x < D * D * id && x <= V) vp = x;
-        }
+        const double vp = closed_form_peak(vrel, lim, Rabs, vlo, V);
         if (vp > 0) {
           const double fvp = f(vp);
           if (std::fabs(fvp - Rabs) <= 1e-9 * std::max(Rabs, 1e-300)) {
@@ -306,13 +324,9 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
     double lo = std::log(1e-12), hi = 0.0;  // log(d'/d); stop distance decreases with d'
     for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
       const double mid = (lo + hi) / 2;
-      Limits l = lim;
-      l.d = lim.d * std::exp(mid);
-      if (stop_dist(l) > Rabs) lo = mid; else hi = mid;
+      if (stop_dist(with_decel(lim, lim.d * std::exp(mid))) > Rabs) lo = mid; else hi = mid;
     }
-    Limits l = lim;
-    l.d = lim.d * std::exp(hi);
-    vel_change_lim(b, 0.0, l, sg);
+    vel_change_lim(b, 0.0, with_decel(lim, lim.d * std::exp(hi)), sg);
     break;
   }
   b.finish(X);

@@ -96,10 +96,142 @@ bool Symbols::Less::operator()(const std::string& a, const std::string& b) const
   return a.size() < b.size();
 }
 
+namespace {
+
+using Failure = std::optional<ParseError>;
+
+/// A number literal (digits with '_' separators, fraction, exponent), or a
+/// tag name with an optional [index]: operand `n` of instruction `iname`.
+Failure lex_operand(Lexer& lx, const std::string& iname, std::size_t n, StOperand& op) {
+  const std::string_view text = lx.s;
+  const auto where = [&] { return iname + " operand " + std::to_string(n); };  // built only for an error
+  op.column = lx.col();
+  if (lx.i >= text.size()) return ParseError{iname + ": unexpected end of text in operand " + std::to_string(n), lx.col()};
+  const char c = text[lx.i];
+  if (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.') {
+    std::size_t j = lx.i;
+    if (text[j] == '-' || text[j] == '+') ++j;
+    bool integer = true;
+    while (j < text.size() && (std::isdigit(static_cast<unsigned char>(text[j])) || text[j] == '_')) ++j;
+    if (j < text.size() && text[j] == '.') { integer = false; ++j; while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j; }
+    if (j < text.size() && (text[j] == 'e' || text[j] == 'E')) {
+      integer = false;
+      ++j;
+      if (j < text.size() && (text[j] == '-' || text[j] == '+')) ++j;
+      while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+    }
+    std::string lit(text.substr(lx.i, j - lx.i));
+    std::string digits;
+    for (char ch : lit) if (ch != '_') digits += ch;
+    if (!digits.empty() && digits[0] == '+') digits.erase(0, 1);
+    double v = 0;
+    const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+    if (r.ec != std::errc() || r.ptr != digits.data() + digits.size() || !std::isfinite(v))
+      return ParseError{where() + ": malformed number '" + lit + "'", op.column};
+    op.kind = StOperand::Kind::Number;
+    op.number = v;
+    op.integer = integer;
+    op.text = lit;
+    lx.i = j;
+    return std::nullopt;
+  }
+  if (!ident_start(c)) return ParseError{where() + ": unexpected character '" + std::string(1, c) + "'", op.column};
+  std::size_t j = lx.i;
+  while (j < text.size() && ident_char(text[j])) ++j;
+  op.kind = StOperand::Kind::Tag;
+  op.text = std::string(text.substr(lx.i, j - lx.i));
+  lx.i = j;
+  lx.skip();
+  if (lx.i < text.size() && text[lx.i] == '[') {
+    ++lx.i;
+    lx.skip();
+    std::size_t k = lx.i;
+    while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+    if (k == lx.i) return ParseError{where() + ": expected an integer array index after '" + op.text + "['", lx.col()};
+    long idxv = 0;
+    const auto r = std::from_chars(text.data() + lx.i, text.data() + k, idxv);
+    if (r.ec != std::errc()) return ParseError{iname + ": array index out of range", lx.col()};
+    op.index = idxv;
+    lx.i = k;
+    if (!lx.eat(']')) return ParseError{where() + ": expected ']'", lx.col()};
+  }
+  return std::nullopt;
+}
+
+/// The operand tokens between '(' (already read) and ')'.
+Failure lex_operands(Lexer& lx, const std::string& iname, ParsedCall& call) {
+  lx.skip();
+  if (lx.i < lx.s.size() && lx.s[lx.i] == ')') {
+    ++lx.i;
+    return std::nullopt;
+  }
+  for (;;) {
+    lx.skip();
+    StOperand op;
+    if (Failure f = lex_operand(lx, iname, call.operands.size(), op)) return f;
+    call.operands.push_back(std::move(op));
+    if (lx.eat(',')) continue;
+    if (lx.eat(')')) return std::nullopt;
+    return ParseError{iname + ": expected ',' or ')' after operand " + std::to_string(call.operands.size() - 1), lx.col()};
+  }
+}
+
+/// Operand `k` against its signature `o`: the kind of token it may be, an
+/// integer, an enumeration keyword (then its number) or number.
+Failure check_operand(const std::string& iname, std::size_t k, const OperandSig& o, StOperand& op) {
+  const std::string where = iname + " operand " + std::to_string(k) + " (" + std::string(o.name) + "): ";
+  const auto expected = [&] { return ParseError{where + "expected " + kind_text(o.kind) + ", found " + found_text(op), op.column}; };
+  switch (o.kind) {
+    case OperandKind::Axis:
+    case OperandKind::Control:
+    case OperandKind::Group:
+    case OperandKind::CoordSystem:
+      if (op.kind != StOperand::Kind::Tag || op.index) return expected();
+      break;
+    case OperandKind::CamArray:
+      if (op.kind != StOperand::Kind::Tag) return expected();
+      if (!op.index) op.index = 0;  // no index: the first element
+      break;
+    case OperandKind::CamProfile:
+      if (op.kind != StOperand::Kind::Tag) return expected();
+      if (op.index && *op.index != 0)
+        return ParseError{where + "only element [0] of a CAM_PROFILE array is allowed, found " + found_text(op), op.column};
+      op.index = 0;
+      break;
+    case OperandKind::Real:
+      break;  // a literal, a numeric tag or a numeric array element tag
+    case OperandKind::Int:
+      if (op.kind == StOperand::Kind::Number && !op.integer)
+        return ParseError{where + "expected an integer, found " + found_text(op), op.column};
+      break;
+    case OperandKind::Enum:
+      if (op.kind == StOperand::Kind::Number) {
+        if (!op.integer || !enum_contains(o.enums, static_cast<std::int32_t>(op.number)) || std::fabs(op.number) > 1e9)
+          return ParseError{where + "value " + op.text + " is out of range; allowed: " + allowed_enum(o), op.column};
+      } else if (!op.index) {
+        if (const auto v = find_keyword(o.enums, op.text)) {
+          op.kind = StOperand::Kind::Keyword;
+          op.number = *v;
+        } else if (!o.tag_allowed) {
+          return ParseError{where + "unknown keyword '" + op.text + "'; allowed: " + allowed_enum(o), op.column};
+        }
+      } else if (!o.tag_allowed) {
+        return ParseError{where + "found " + found_text(op) + "; allowed: " + allowed_enum(o), op.column};
+      }
+      break;
+    case OperandKind::RealArray:
+      if (op.kind == StOperand::Kind::Number && op.number != 0) return expected();
+      break;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 ParseResult parse_st_call(std::string_view text) {
   ParseResult res;
-  auto fail = [&](std::string msg, std::size_t col) {
-    res.error = ParseError{std::move(msg), col};
+  auto fail = [&](ParseError e) {
+    res.error = std::move(e);
     return res;
   };
   Lexer lx{text};
@@ -108,150 +240,31 @@ ParseResult parse_st_call(std::string_view text) {
   std::size_t b = lx.i;
   while (lx.i < text.size() && (std::isalnum(static_cast<unsigned char>(text[lx.i])) || text[lx.i] == '_')) ++lx.i;
   const std::string_view name = text.substr(b, lx.i - b);
-  if (name.empty()) return fail("expected a motion instruction name at column " + std::to_string(name_col), name_col);
+  if (name.empty()) return fail({"expected a motion instruction name at column " + std::to_string(name_col), name_col});
   const auto instr = find_instruction(name);
   if (!instr) {
     std::string all;
     for (std::size_t k = 0; k < kInstrCount; ++k) all += (k ? ", " : "") + std::string(signature(static_cast<Instr>(k)).name);
-    return fail("unknown instruction '" + std::string(name) + "'; allowed: " + all, name_col);
+    return fail({"unknown instruction '" + std::string(name) + "'; allowed: " + all, name_col});
   }
   const InstrSig& sig = signature(*instr);
   const std::string iname(sig.name);
-  auto sig_text = [&] {
-    std::string t = iname + "(";
-    for (std::size_t k = 0; k < sig.operands.size(); ++k) t += (k ? ", " : "") + std::string(sig.operands[k].name);
-    return t + ")";
-  };
-  if (!lx.eat('(')) return fail(iname + ": expected '(' after the instruction name", lx.col());
-
-  // raw operand tokens
+  if (!lx.eat('(')) return fail({iname + ": expected '(' after the instruction name", lx.col()});
   ParsedCall call;
   call.instr = *instr;
-  lx.skip();
-  if (lx.i < text.size() && text[lx.i] == ')') {
-    ++lx.i;
-  } else {
-    for (;;) {
-      lx.skip();
-      StOperand op;
-      op.column = lx.col();
-      const std::size_t start = lx.i;
-      if (lx.i >= text.size()) return fail(iname + ": unexpected end of text in operand " + std::to_string(call.operands.size()), lx.col());
-      const char c = text[lx.i];
-      if (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.') {
-        std::size_t j = lx.i;
-        if (text[j] == '-' || text[j] == '+') ++j;
-        bool integer = true;
-        while (j < text.size() && (std::isdigit(static_cast<unsigned char>(text[j])) || text[j] == '_')) ++j;
-        if (j < text.size() && text[j] == '.') { integer = false; ++j; while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j; }
-        if (j < text.size() && (text[j] == 'e' || text[j] == 'E')) {
-          integer = false;
-          ++j;
-          if (j < text.size() && (text[j] == '-' || text[j] == '+')) ++j;
-          while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-        }
-        std::string lit(text.substr(lx.i, j - lx.i));
-        std::string digits;
-        for (char ch : lit) if (ch != '_') digits += ch;
-        if (!digits.empty() && digits[0] == '+') digits.erase(0, 1);
-        double v = 0;
-        const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), v);
-        if (r.ec != std::errc() || r.ptr != digits.data() + digits.size() || !std::isfinite(v))
-          return fail(iname + " operand " + std::to_string(call.operands.size()) + ": malformed number '" + lit + "'", op.column);
-        op.kind = StOperand::Kind::Number;
-        op.number = v;
-        op.integer = integer;
-        op.text = lit;
-        lx.i = j;
-      } else if (ident_start(c)) {
-        std::size_t j = lx.i;
-        while (j < text.size() && ident_char(text[j])) ++j;
-        op.kind = StOperand::Kind::Tag;
-        op.text = std::string(text.substr(lx.i, j - lx.i));
-        lx.i = j;
-        lx.skip();
-        if (lx.i < text.size() && text[lx.i] == '[') {
-          ++lx.i;
-          lx.skip();
-          std::size_t k = lx.i;
-          while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
-          if (k == lx.i) return fail(iname + " operand " + std::to_string(call.operands.size()) + ": expected an integer array index after '" + op.text + "['", lx.col());
-          long idxv = 0;
-          const auto r = std::from_chars(text.data() + lx.i, text.data() + k, idxv);
-          if (r.ec != std::errc()) return fail(iname + ": array index out of range", lx.col());
-          op.index = idxv;
-          lx.i = k;
-          if (!lx.eat(']')) return fail(iname + " operand " + std::to_string(call.operands.size()) + ": expected ']'", lx.col());
-        }
-      } else {
-        return fail(iname + " operand " + std::to_string(call.operands.size()) + ": unexpected character '" + std::string(1, c) + "'", op.column);
-      }
-      (void)start;
-      call.operands.push_back(std::move(op));
-      if (lx.eat(',')) continue;
-      if (lx.eat(')')) break;
-      return fail(iname + ": expected ',' or ')' after operand " + std::to_string(call.operands.size() - 1), lx.col());
-    }
-  }
+  if (Failure f = lex_operands(lx, iname, call)) return fail(std::move(*f));
   lx.eat(';');
   lx.skip();
-  if (lx.i < text.size()) return fail(iname + ": unexpected text after the call: '" + std::string(text.substr(lx.i)) + "'", lx.col());
+  if (lx.i < text.size()) return fail({iname + ": unexpected text after the call: '" + std::string(text.substr(lx.i)) + "'", lx.col()});
   if (call.operands.size() != sig.operands.size()) {
-    return fail(iname + " expects " + std::to_string(sig.operands.size()) + " operands, found " +
-                    std::to_string(call.operands.size()) + "; signature: " + sig_text(),
-                name_col);
+    std::string t = iname + "(";
+    for (std::size_t k = 0; k < sig.operands.size(); ++k) t += (k ? ", " : "") + std::string(sig.operands[k].name);
+    return fail({iname + " expects " + std::to_string(sig.operands.size()) + " operands, found " +
+                     std::to_string(call.operands.size()) + "; signature: " + t + ")",
+                 name_col});
   }
-  // operand kinds
-  for (std::size_t k = 0; k < sig.operands.size(); ++k) {
-    const OperandSig& o = sig.operands[k];
-    StOperand& op = call.operands[k];
-    const std::string where = iname + " operand " + std::to_string(k) + " (" + std::string(o.name) + "): ";
-    switch (o.kind) {
-      case OperandKind::Axis:
-      case OperandKind::Control:
-      case OperandKind::Group:
-      case OperandKind::CoordSystem:
-        if (op.kind != StOperand::Kind::Tag || op.index)
-          return fail(where + "expected " + kind_text(o.kind) + ", found " + found_text(op), op.column);
-        break;
-      case OperandKind::CamArray:
-        if (op.kind != StOperand::Kind::Tag) return fail(where + "expected " + kind_text(o.kind) + ", found " + found_text(op), op.column);
-        if (!op.index) op.index = 0;  // no index: the first element
-        break;
-      case OperandKind::CamProfile:
-        if (op.kind != StOperand::Kind::Tag) return fail(where + "expected " + kind_text(o.kind) + ", found " + found_text(op), op.column);
-        if (op.index && *op.index != 0)
-          return fail(where + "only element [0] of a CAM_PROFILE array is allowed, found " + found_text(op), op.column);
-        op.index = 0;
-        break;
-      case OperandKind::Real:
-        if (op.kind == StOperand::Kind::Tag && op.index) break;  // numeric array element tag
-        break;
-      case OperandKind::Int:
-        if (op.kind == StOperand::Kind::Number && !op.integer)
-          return fail(where + "expected an integer, found " + found_text(op), op.column);
-        break;
-      case OperandKind::Enum:
-        if (op.kind == StOperand::Kind::Number) {
-          if (!op.integer || !enum_contains(o.enums, static_cast<std::int32_t>(op.number)) || std::fabs(op.number) > 1e9)
-            return fail(where + "value " + op.text + " is out of range; allowed: " + allowed_enum(o), op.column);
-        } else if (!op.index) {
-          if (const auto v = find_keyword(o.enums, op.text)) {
-            op.kind = StOperand::Kind::Keyword;
-            op.number = *v;
-          } else if (!o.tag_allowed) {
-            return fail(where + "unknown keyword '" + op.text + "'; allowed: " + allowed_enum(o), op.column);
-          }
-        } else if (!o.tag_allowed) {
-          return fail(where + "found " + found_text(op) + "; allowed: " + allowed_enum(o), op.column);
-        }
-        break;
-      case OperandKind::RealArray:
-        if (op.kind == StOperand::Kind::Number && op.number != 0)
-          return fail(where + "expected " + kind_text(o.kind) + ", found " + found_text(op), op.column);
-        break;
-    }
-  }
+  for (std::size_t k = 0; k < sig.operands.size(); ++k)
+    if (Failure f = check_operand(iname, k, sig.operands[k], call.operands[k])) return fail(std::move(*f));
   res.call = std::move(call);
   return res;
 }

@@ -184,8 +184,41 @@ enum class MasterReference : std::uint8_t { Actual = 0, Command = 1 };
 enum class CamDirection : std::uint8_t { Same = 0, Opposite = 1, Reverse = 2, Unchanged = 3 };
 enum class GroupStopMode : std::uint8_t { Programmed = 0, FastStop = 1, FastDisable = 2 };
 
-/// Speed units are "master driven" when per-master-unit or master units.
-constexpr bool is_master_driven(std::uint8_t units) noexcept { return units == 4 || units == 7; }
+/// Master-driven units (MDSC: per master unit, or master units) [RM002H p.512].
+constexpr bool is_master_driven(SpeedUnits u) noexcept {
+  return u == SpeedUnits::UnitsPerMasterUnit || u == SpeedUnits::MasterUnits;
+}
+constexpr bool is_master_driven(AccelUnits u) noexcept {
+  return u == AccelUnits::UnitsPerMasterUnit2 || u == AccelUnits::MasterUnits;
+}
+constexpr bool is_master_driven(JerkUnits u) noexcept {
+  return u == JerkUnits::UnitsPerMasterUnit3 || u == JerkUnits::PercentOfTimeMasterDriven || u == JerkUnits::MasterUnits;
+}
+/// The units that give a move's extent instead of its rates (MAM): Seconds,
+/// or MasterUnits when master driven.
+template <class U>
+constexpr bool is_extent(U u, bool master_driven) noexcept {
+  return u == (master_driven ? U::MasterUnits : U::Seconds);
+}
+/// Jerk as a percentage of the acceleration time (time or master driven).
+constexpr bool is_percent_of_time(JerkUnits u) noexcept {
+  return u == JerkUnits::PercentOfTime || u == JerkUnits::PercentOfTimeMasterDriven;
+}
+/// A units operand compared with its Logix number (the reference tables and
+/// the tests state them as numbers).
+constexpr bool operator==(SpeedUnits u, int logix) noexcept { return static_cast<int>(u) == logix; }
+constexpr bool operator==(AccelUnits u, int logix) noexcept { return static_cast<int>(u) == logix; }
+constexpr bool operator==(JerkUnits u, int logix) noexcept { return static_cast<int>(u) == logix; }
+
+/// ExecutionSchedule numbers of MATC (0, 1) and MAPC (all) [RM002H p.171].
+namespace schedule {
+inline constexpr std::uint8_t Immediate = 0, Pending = 1, ForwardOnly = 2, ReverseOnly = 3, Bidirectional = 4;
+}
+/// MasterDirection numbers of MAPC [RM002H p.171]. (ExecutionMode numbers:
+/// cam::ExecutionMode.)
+namespace master_direction {
+inline constexpr std::uint8_t Bidirectional = 0, ForwardOnly = 1, ReverseOnly = 2;
+}
 
 // ------------------------------------------------------------- exceptions
 /// Exception actions, in increasing severity (the numeric order IS the severity

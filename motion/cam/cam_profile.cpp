@@ -133,12 +133,12 @@ MccpResult fail_length(CamError err, std::int64_t length, const char* reason) no
   return MccpResult{err, 0, -1, length, reason};
 }
 
-}  // namespace
-
-MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
+/// MCCP checks 1.-6. (the order of mccp()'s contract); ok() when the
+/// request may be calculated.
+MccpResult check_request(const MccpRequest& req, const CamProfile& profile) noexcept {
   using namespace mccp_operand;
   // 1. Profile state.
-  const std::int32_t status = profile.elems_[0].status;
+  const std::int32_t status = profile.status();
   if (status == profile_status::kCalculating) {
     return fail(CamError::CamProfileBeingCalculated, 0, -1, "the cam profile is being calculated (Status 1)");
   }
@@ -187,17 +187,13 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
       return fail(CamError::ParameterOutOfRange, kCam, index, "the master distance between two cam points overflows");
     }
   }
+  return MccpResult{};
+}
 
-  // Calculation. Status is 1 while it runs (visible to nobody else in this
-  // single-threaded design, but it keeps the Logix sequence).
-  auto& el = profile.elems_;
-  el[0].status = profile_status::kCalculating;
-  for (std::size_t i = 0; i < n; ++i) {
-    el[i].master = pts[i].master;
-    profile.masters_[i] = pts[i].master;
-    el[i].slave = pts[i].slave;
-    el[i].type = i + 1 < n ? pts[i].segment_type : kSegmentLinear;
-  }
+/// The knot slopes of the n points in `el` into r = scratch + 3 * cap (and the
+/// per-segment 1/h and chord slopes into scratch + 4 cap, + 5 cap).
+void knot_slopes(const MccpRequest& req, const CamProfileElement* el, std::size_t n, double* scratch,
+                 std::size_t cap) noexcept {
   // Knot slopes m_k from a tridiagonal system (see README "Spline rule"):
   //  * knot between two cubic segments: C2 row
   //      m_{k-1}/h_{k-1} + 2 (1/h_{k-1} + 1/h_k) m_k + m_{k+1}/h_k
@@ -207,8 +203,6 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
   //  * knot between a cubic and a linear segment: m_k = the linear segment's slope
   //  * knot between two linear segments: unused (m_k = 0)
   const auto nn = static_cast<Eigen::Index>(n);
-  double* scratch = profile.scratch_.data();
-  const std::size_t cap = profile.capacity();
   Eigen::Map<Eigen::VectorXd> lo(scratch, nn);            // sub-diagonal
   Eigen::Map<Eigen::VectorXd> di(scratch + cap, nn);      // diagonal (then its inverse)
   Eigen::Map<Eigen::VectorXd> up(scratch + 2 * cap, nn);  // super-diagonal
@@ -259,7 +253,14 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
   for (Eigen::Index k = nn - 2; k >= 0; --k) {
     r[k] = (r[k] - up[k] * r[k + 1]) * di[k];
   }
+}
 
+/// Segment polynomials from the knot slopes (knot_slopes' scratch).
+void coefficients(CamProfileElement* el, std::size_t n, const double* scratch, std::size_t cap) noexcept {
+  const auto nn = static_cast<Eigen::Index>(n);
+  Eigen::Map<const Eigen::VectorXd> r(scratch + 3 * cap, nn);
+  Eigen::Map<const Eigen::VectorXd> ih(scratch + 4 * cap, nn);
+  Eigen::Map<const Eigen::VectorXd> dd(scratch + 5 * cap, nn);
   for (Eigen::Index s = 0; s + 1 < nn; ++s) {
     CamProfileElement& e = el[static_cast<std::size_t>(s)];
     e.a0 = e.slave;
@@ -279,7 +280,26 @@ MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
   CamProfileElement& last = el[n - 1];
   last.a0 = last.slave;
   last.a1 = last.a2 = last.a3 = 0.0;
+}
 
+}  // namespace
+
+MccpResult mccp(const MccpRequest& req, CamProfile& profile) noexcept {
+  if (MccpResult bad = check_request(req, profile); !bad.ok()) return bad;
+  const auto n = static_cast<std::size_t>(req.length);
+  const CamPoint* pts = req.cam.data() + req.start_index;
+  // Calculation. Status is 1 while it runs (visible to nobody else in this
+  // single-threaded design, but it keeps the Logix sequence).
+  auto& el = profile.elems_;
+  el[0].status = profile_status::kCalculating;
+  for (std::size_t i = 0; i < n; ++i) {
+    el[i].master = pts[i].master;
+    profile.masters_[i] = pts[i].master;
+    el[i].slave = pts[i].slave;
+    el[i].type = i + 1 < n ? pts[i].segment_type : kSegmentLinear;
+  }
+  knot_slopes(req, el.data(), n, profile.scratch_.data(), profile.capacity());
+  coefficients(el.data(), n, profile.scratch_.data(), profile.capacity());
   profile.count_ = n;
   el[0].status = profile_status::kCalculated;
   return MccpResult{};
