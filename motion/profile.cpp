@@ -233,9 +233,59 @@ double closed_form_peak(double v0, const Limits& lim, double R, double vlo, doub
   return vp;
 }
 
-}  // namespace
+/// plan_move_to's end speed ve > 0 out of reach within Rabs (the stop to ve
+/// is longer): end at the reachable speed closest to ve and cover the rest at
+/// that speed. Too short to speed up to ve: the fastest reachable (from 0 up);
+/// unable to slow down to ve in time: the slowest reachable (from the speed
+/// after the present acceleration is ramped out, down) -- a faster hand-over,
+/// never a harder brake. The distance to a speed is monotone on either side:
+/// bounded bisection. False if it cannot even stop within Rabs (the caller
+/// then plans it as plan_move).
+bool fit_end_speed(ProfileBuilder& b, double ve, double Rabs, double sg, const Limits& lim) noexcept {
+  const double vrel = sg * b.v, arel = sg * b.a;
+  const double vs = ramp_vel(vrel, arel, arel >= 0 ? lim.ja : lim.jd);
+  auto dist = [&](double v1) noexcept {
+    Sim s = b.sim();
+    vel_change_lim(s, sg * v1, lim, sg);
+    return sg * (s.x - b.x);
+  };
+  const double v_fit = vs < ve ? 0.0 : vs;
+  if (dist(v_fit) > Rabs) return false;
+  double ok = v_fit, bad = ve;
+  for (int i = 0; i < kSolveIterations && std::fabs(bad - ok) > 1e-13 * std::max(ok, bad); ++i) {
+    const double mid = (ok + bad) / 2;
+    if (dist(mid) <= Rabs) ok = mid; else bad = mid;
+  }
+  const double x0 = b.x;
+  vel_change_lim(b, sg * ok, lim, sg);
+  const double rest = Rabs - sg * (b.x - x0);
+  if (ok > 0 && rest > 0) b.push(rest / ok, 0.0);
+  return true;
+}
 
-bool plan_move(Profile& out, const Kin& start, double distance, const Limits& lim, Overshoot policy) noexcept {
+/// dstop <= Rabs < the distance of any fuller profile: stop now with a softer
+/// deceleration d' in (0, d] (bounded bisection on log(d'/d); the stop
+/// distance decreases with d').
+void soft_stop(ProfileBuilder& b, double vend, const Limits& lim, double sg, double Rabs) noexcept {
+  auto stop_dist = [&](const Limits& l) noexcept {
+    Sim s = b.sim();
+    vel_change_lim(s, vend, l, sg);
+    return sg * (s.x - b.x);
+  };
+  double lo = std::log(1e-12), hi = 0.0;
+  for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
+    const double mid = (lo + hi) / 2;
+    if (stop_dist(with_decel(lim, lim.d * std::exp(mid))) > Rabs) lo = mid; else hi = mid;
+  }
+  vel_change_lim(b, vend, with_decel(lim, lim.d * std::exp(hi)), sg);
+}
+
+/// plan_move and plan_move_to: a move ending at `distance` with velocity
+/// `ve` (>= 0, towards the target; 0 = at rest). With ve == 0 every
+/// expression below reduces to the original plan_move arithmetic (vend is
+/// +0.0, the ve > 0 branches are skipped), so plan_move is unchanged.
+bool plan_move_impl(Profile& out, const Kin& start, double distance, double ve, const Limits& lim,
+                    Overshoot policy) noexcept {
   if (!limits_valid(lim) || !kin_valid(start) || !std::isfinite(distance)) return false;
   ProfileBuilder b(out, start);
   const double X = distance;
@@ -244,8 +294,8 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
     double sg = sgn(R);
     if (sg == 0) sg = b.v != 0 ? sgn(b.v) : sgn(b.a);
     if (sg == 0) break;  // on target, at rest
-    const double vrel = sg * b.v;
-    const double arel = sg * b.a;
+    const double vend = ve > 0 ? sg * ve : 0.0;  // end velocity (signed)
+    const double vrel = sg * b.v, arel = sg * b.a;
     if (vrel < 0 || (vrel == 0 && arel < 0)) {  // moving away: brake, then re-plan
       vel_change_lim(b, 0.0, lim, -sg);
       continue;
@@ -253,15 +303,22 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
     const double Rabs = std::fabs(R);
     auto stop_dist = [&](const Limits& l) noexcept {
       Sim s = b.sim();
-      vel_change_lim(s, 0.0, l, sg);
+      vel_change_lim(s, vend, l, sg);
       return sg * (s.x - b.x);
     };
     const double dstop = stop_dist(lim);
     // A braking acceleration that the jerk limit cannot ramp out before the
     // velocity reaches zero (possible after MCD lowered the decel jerk).
     auto reverses = [&](double jd) noexcept { return arel < 0 && vrel - arel * arel / (2 * jd) < 0; };
+    if (ve > 0 && dstop > Rabs) {
+      if (fit_end_speed(b, ve, Rabs, sg, lim)) break;
+      if (ramp_vel(vrel, arel, arel >= 0 ? lim.ja : lim.jd) < ve) {  // cannot even stop in time: as plan_move
+        ve = 0.0;
+        continue;
+      }
+    }
     if (dstop > Rabs || (policy == Overshoot::StopAtTarget && reverses(lim.jd))) {
-      if (policy == Overshoot::Reverse) {
+      if (policy == Overshoot::Reverse && ve == 0) {  // a move ending in motion never reverses
         vel_change_lim(b, 0.0, lim, sg);
         continue;
       }
@@ -273,20 +330,20 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
         const Limits l = scaled(lim, std::exp(mid));
         if (reverses(l.jd) || stop_dist(l) > Rabs) lo = mid; else hi = mid;
       }
-      vel_change_lim(b, 0.0, scaled(lim, std::exp(hi)), sg);
+      vel_change_lim(b, vend, scaled(lim, std::exp(hi)), sg);
       break;
     }
     auto f = [&](double vp) noexcept {
       Sim s = b.sim();
       vel_change_lim(s, sg * vp, lim, sg);
-      vel_change_lim(s, 0.0, lim, sg);
+      vel_change_lim(s, vend, lim, sg);
       return sg * (s.x - b.x);
     };
     auto build = [&](double vp, double fvp) noexcept {
       vel_change_lim(b, sg * vp, lim, sg);
       const double cruise = Rabs - fvp;
       if (vp > 0 && cruise > 0) b.push(cruise / vp, 0.0);
-      vel_change_lim(b, 0.0, lim, sg);
+      vel_change_lim(b, vend, lim, sg);
     };
     const double V = lim.v;
     const double vs_up = ramp_vel(vrel, arel, arel >= 0 ? lim.ja : lim.jd);
@@ -296,9 +353,9 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
       break;
     }
     if (vs_up <= V) {
-      const double vlo = std::max(vs_up, 0.0);
+      const double vlo = std::max(vs_up, ve > 0 ? ve : 0.0);
       // Closed form from zero acceleration; other shapes use the bounded solve below.
-      if (arel == 0 && vrel >= 0) {
+      if (ve == 0 && arel == 0 && vrel >= 0) {
         const double vp = closed_form_peak(vrel, lim, Rabs, vlo, V);
         if (vp > 0) {
           const double fvp = f(vp);
@@ -320,17 +377,24 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
         break;
       }
     }
-    // dstop <= R < f(...): stop now with a softer deceleration d' in (0, d].
-    double lo = std::log(1e-12), hi = 0.0;  // log(d'/d); stop distance decreases with d'
-    for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
-      const double mid = (lo + hi) / 2;
-      if (stop_dist(with_decel(lim, lim.d * std::exp(mid))) > Rabs) lo = mid; else hi = mid;
-    }
-    vel_change_lim(b, 0.0, with_decel(lim, lim.d * std::exp(hi)), sg);
+    soft_stop(b, vend, lim, sg, Rabs);  // dstop <= R < f(...)
     break;
   }
   b.finish(X);
   return b.ok;
+}
+
+}  // namespace
+
+bool plan_move(Profile& out, const Kin& start, double distance, const Limits& lim, Overshoot policy) noexcept {
+  return plan_move_impl(out, start, distance, 0.0, lim, policy);
+}
+
+bool plan_move_to(Profile& out, const Kin& start, double distance, double end_velocity, const Limits& lim,
+                  Overshoot policy) noexcept {
+  if (!(end_velocity >= 0) || !std::isfinite(end_velocity)) return false;
+  if (distance == 0) end_velocity = 0;
+  return plan_move_impl(out, start, distance, std::min(end_velocity, lim.v), lim, policy);
 }
 
 }  // namespace canmotion::motion

@@ -86,6 +86,20 @@ class Profile {
 bool plan_move(Profile& out, const Kin& start, double distance, const Limits& lim,
                Overshoot policy = Overshoot::Reverse) noexcept;
 
+/// Plan a move that reaches start.p + distance with speed `end_velocity`
+/// (>= 0, towards the target, clamped to lim.v) and a = 0: a path segment
+/// that hands over to the next one at speed (coordinated Follow Contour,
+/// motion/coord). end_velocity 0 is exactly plan_move. If the move is too
+/// short to speed up to end_velocity it ends at the fastest reachable speed,
+/// if it cannot slow down to it in time at the slowest reachable one (read
+/// the end speed from the last segment); a move ending in motion never
+/// reverses (a state that cannot even ramp out its acceleration in time is
+/// scaled as Overshoot::StopAtTarget does). After duration() `sample`
+/// reports v = 0: the caller hands over to the next profile at duration().
+/// Realtime-safe.
+bool plan_move_to(Profile& out, const Kin& start, double distance, double end_velocity, const Limits& lim,
+                  Overshoot policy = Overshoot::StopAtTarget) noexcept;
+
 /// Plan a velocity change to `velocity` (signed) and hold it forever (jog).
 /// Uses lim.a/lim.ja while |v| grows and lim.d/lim.jd while it shrinks. Realtime-safe.
 bool plan_velocity(Profile& out, const Kin& start, double velocity, const Limits& lim) noexcept;
