@@ -39,6 +39,13 @@ std::string_view err_name(Err e) noexcept {
     case Err::ProcessConflict: return "Process Conflict";
     case Err::DriveLocallyDisabled: return "Drive Locally Disabled";
     case Err::IllegalHomingConfig: return "Illegal Homing Config";
+    case Err::CoordinateSystemQueueFull: return "Coordinate System Queue Full";
+    case Err::CircularCollinearity: return "Circular Collinearity Error";
+    case Err::CircularStartEnd: return "Circular Start End Error";
+    case Err::CircularR1R2Mismatch: return "Circular R1 R2 Mismatch Error";
+    case Err::CircularInfiniteSolutions: return "Circular Infinite Solution Error";
+    case Err::CircularNoSolutions: return "Circular No Solutions Error";
+    case Err::CircularSmallR: return "Circular Small R Error";
     case Err::AxisIsInhibited: return "Axis Is Inhibited";
     case Err::ZeroMaxDecel: return "Zero Max Decel";
     case Err::InstructionNotSupported: return "Instruction Not Supported";

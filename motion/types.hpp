@@ -147,6 +147,13 @@ enum class Err : std::int16_t {
   ProcessConflict = 39,
   DriveLocallyDisabled = 40,
   IllegalHomingConfig = 41,
+  CoordinateSystemQueueFull = 43,  ///< a third MCLM/MCCM behind the active and the pending one (reference 2.19 ⚠)
+  CircularCollinearity = 44,       ///< MCCM: the defining points lie on one line
+  CircularStartEnd = 45,           ///< MCCM: start = end of a non-full circle
+  CircularR1R2Mismatch = 46,       ///< MCCM: the center is not equidistant from start and end
+  CircularInfiniteSolutions = 47,  ///< MCCM: the circle or its plane is not determined
+  CircularNoSolutions = 48,        ///< MCCM: no circle (zero radius)
+  CircularSmallR = 49,             ///< MCCM: |Radius| smaller than half the chord
   AxisIsInhibited = 53,
   ZeroMaxDecel = 54,
   InstructionNotSupported = 75,
@@ -247,6 +254,29 @@ enum class ExceptionKind : std::uint8_t {
 constexpr ExceptionAction most_severe(ExceptionAction a, ExceptionAction b) noexcept {
   return static_cast<std::uint8_t>(a) >= static_cast<std::uint8_t>(b) ? a : b;
 }
+
+/// CoordinateMotionStatus bit numbers of a COORDINATE_SYSTEM (ICS type tables;
+/// reference coordinated-motion.md).
+namespace coordinate_motion_status {
+inline constexpr unsigned AccelStatus = 0;
+inline constexpr unsigned DecelStatus = 1;
+inline constexpr unsigned ActualPosToleranceStatus = 2;
+inline constexpr unsigned CommandPosToleranceStatus = 3;
+inline constexpr unsigned StoppingStatus = 4;
+inline constexpr unsigned MoveStatus = 6;
+inline constexpr unsigned MoveTransitionStatus = 7;
+inline constexpr unsigned MovePendingStatus = 8;
+inline constexpr unsigned MovePendingQueueFullStatus = 9;
+inline constexpr unsigned CoordinateSystemLockStatus = 15;
+}  // namespace coordinate_motion_status
+
+/// CoordinateSystemStatus bit numbers [RM002H p.455; ICS].
+namespace coordinate_system_status {
+inline constexpr unsigned ShutdownStatus = 0;
+inline constexpr unsigned ReadyStatus = 1;
+inline constexpr unsigned MotionStatus = 2;
+inline constexpr unsigned AxisInhibitStatus = 3;
+}  // namespace coordinate_system_status
 
 /// Programmed Stop Mode of an axis (used by MGS programmed).
 enum class ProgrammedStopMode : std::uint8_t { FastStop = 0, FastDisable = 1, HardDisable = 2, FastShutdown = 3, HardShutdown = 4 };
