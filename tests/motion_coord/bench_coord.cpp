@@ -93,7 +93,7 @@ BENCHMARK(BM_StepLine);
 void BM_StepArc(benchmark::State& st) {
   PathGenerator g = make(3);
   Events ev;
-  check(g.submit(arc(1, v3(0, 200, 0), CircleType::Center, v3(0, 0, 50), CircleDirection::CounterClockwise), Present{},
+  check(g.submit(arc(1, v3(50, 0, 50), CircleType::Center, v3(50, 0, 0), CircleDirection::CounterClockwise), Present{},
                  ev));
   advance(g, 1000);
   run_steps(st, g, coordinate_motion_status::MoveStatus);
@@ -118,36 +118,22 @@ void BM_StepBlend(benchmark::State& st) {
 BENCHMARK(BM_StepBlend);
 
 // Planning: submit into an idle system (geometry + profile), then clear.
-void BM_PlanLine(benchmark::State& st) {
-  PathGenerator g = make(3);
+void plan(benchmark::State& st, int dim, const MoveRequest& m) {
+  PathGenerator g = make(dim);
   Events ev;
-  const MoveRequest m = line(1, v3(100, 200, 50));
   for (auto _ : st) {
     benchmark::DoNotOptimize(g.submit(m, Present{}, ev));
     g.clear(ev);
   }
 }
+void BM_PlanLine(benchmark::State& st) { plan(st, 3, line(1, v3(100, 200, 50))); }
 BENCHMARK(BM_PlanLine);
-
 void BM_PlanArcVia(benchmark::State& st) {
-  PathGenerator g = make(3);
-  Events ev;
-  const MoveRequest m = arc(1, v3(100, 0, 100), CircleType::Via, v3(40, 60, 20), CircleDirection::Clockwise);
-  for (auto _ : st) {
-    benchmark::DoNotOptimize(g.submit(m, Present{}, ev));
-    g.clear(ev);
-  }
+  plan(st, 3, arc(1, v3(100, 0, 100), CircleType::Via, v3(40, 60, 20), CircleDirection::Clockwise));
 }
 BENCHMARK(BM_PlanArcVia);
-
 void BM_PlanArcCenter(benchmark::State& st) {
-  PathGenerator g = make(2);
-  Events ev;
-  const MoveRequest m = arc(1, v3(100, 0), CircleType::Center, v3(50, 0), CircleDirection::CounterClockwise);
-  for (auto _ : st) {
-    benchmark::DoNotOptimize(g.submit(m, Present{}, ev));
-    g.clear(ev);
-  }
+  plan(st, 2, arc(1, v3(100, 0), CircleType::Center, v3(50, 0), CircleDirection::CounterClockwise));
 }
 BENCHMARK(BM_PlanArcCenter);
 

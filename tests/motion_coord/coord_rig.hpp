@@ -112,20 +112,6 @@ inline double dist_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
   return norm(p - (a + t * d));
 }
 
-inline Limits random_limits(Rng& r, bool scurve) {
-  Limits l;
-  l.v = r.logu(0.1, 1000);
-  l.a = r.logu(1, 1e5);
-  l.d = r.coin(0.3) ? l.a : r.logu(1, 1e5);
-  if (scurve) {
-    l.ja = r.logu(10, 1e7);
-    l.jd = r.coin(0.3) ? l.ja : r.logu(10, 1e7);
-  } else {
-    l.ja = l.jd = kInf;
-  }
-  return l;
-}
-
 /// Limits that make a move of length L last roughly 0.05 .. 1 s.
 inline Limits limits_for(Rng& r, double L, bool scurve) {
   Limits l;

@@ -48,6 +48,32 @@ double off_path(const Path& p, const Vec3& x) {
   return std::fabs(norm(x - p.center()) - p.radius());
 }
 
+/// A random segment started from rest in a fresh rig and stepped for 1 ..
+/// window/period cycles. False if it has already finished.
+struct Running {
+  Seg s;
+  Limits l;
+  bool scurve = false;
+  Rig rig;
+  int before = 0;
+};
+bool start_random_move(Rng& r, double window, Running& m) {
+  const int dim = 1 + r.pick(3);
+  m.scurve = r.coin();
+  m.s = random_segment(r, dim, 5, lim(1, 1, 1));
+  m.l = limits_for(r, m.s.path.length(), m.scurve);
+  m.s.rq.limits = m.l;
+  m.rig = Rig(dim, r.uni(2.5e-4, 2e-3));
+  m.rig.record = false;
+  m.rig.now.has_total = true;
+  m.rig.now.total = m.s.start;
+  EXPECT_EQ(m.rig.submit(m.s.rq), Err::None);
+  m.rig.now.has_total = false;
+  m.before = 1 + r.pick(static_cast<int>(window / m.rig.cfg.period) + 1);
+  for (int i = 0; i < m.before && !m.rig.g.idle(); ++i) m.rig.step();
+  return !m.rig.g.idle();
+}
+
 }  // namespace
 
 // MCS: the move ends (Cancelled) and the system stops on the path (1e-9)
@@ -58,22 +84,15 @@ TEST(CoordStop, StopsOnThePathProperty) {
   const std::uint64_t count = canmotion::motion::test::prop_count(100000) / 50 + 1;
   Rng r(seed);
   for (std::uint64_t n = 0; n < count; ++n) {
-    const int dim = 1 + r.pick(3);
-    const bool scurve = r.coin();
-    Seg s = random_segment(r, dim, 5, lim(1, 1, 1));
-    const Limits l = limits_for(r, s.path.length(), scurve);
-    s.rq.limits = l;
-    Rig rig(dim, r.uni(2.5e-4, 2e-3));
-    rig.record = false;
-    rig.now.has_total = true;
-    rig.now.total = s.start;
+    Running m;
+    const bool running = start_random_move(r, 0.2, m);
     const std::string ctx = "seed=" + std::to_string(seed) + " n=" + std::to_string(n);
-    ASSERT_EQ(rig.submit(s.rq), Err::None) << ctx;
-    rig.now.has_total = false;
-    const int before = r.pick(static_cast<int>(0.2 / rig.cfg.period) + 1);
-    for (int i = 0; i < before && !rig.g.idle(); ++i) rig.step();
-    if (rig.g.idle()) continue;
-    // A stop at least as strong as the move's own decel (so it fits before the end).
+    if (!running) continue;
+    Rig& rig = m.rig;
+    const Seg& s = m.s;
+    const Limits& l = m.l;
+    const bool scurve = m.scurve;
+    // A stop at least as strong as the move's own decel.
     const double d = l.d * r.uni(1, 3), jd = scurve ? l.jd * r.uni(1, 3) : kInf;
     Events ev;
     rig.g.stop(77, d, jd, ev);
@@ -140,21 +159,15 @@ TEST(CoordChangeDynamics, ReplanWithoutPositionStepProperty) {
   const std::uint64_t count = canmotion::motion::test::prop_count(100000) / 50 + 1;
   Rng r(seed);
   for (std::uint64_t n = 0; n < count; ++n) {
-    const int dim = 1 + r.pick(3);
-    const bool scurve = r.coin();
-    Seg s = random_segment(r, dim, 5, lim(1, 1, 1));
-    const Limits l = limits_for(r, s.path.length(), scurve);
-    s.rq.limits = l;
-    Rig rig(dim, r.uni(2.5e-4, 2e-3));
-    rig.record = false;
-    rig.now.has_total = true;
-    rig.now.total = s.start;
+    Running m;
+    const bool running = start_random_move(r, 0.3, m);
     std::string ctx = "seed=" + std::to_string(seed) + " n=" + std::to_string(n);
-    ASSERT_EQ(rig.submit(s.rq), Err::None) << ctx;
-    rig.now.has_total = false;
-    const int before = 1 + r.pick(static_cast<int>(0.3 / rig.cfg.period) + 1);  // rig.last is a real cycle
-    for (int i = 0; i < before && !rig.g.idle(); ++i) rig.step();
-    if (rig.g.idle()) continue;
+    if (!running) continue;
+    Rig& rig = m.rig;
+    const Seg& s = m.s;
+    const Limits& l = m.l;
+    const bool scurve = m.scurve;
+    const int before = m.before;
     DynamicsChange ch;
     ch.change_speed = r.coin(0.7);
     ch.change_accel = r.coin(0.5);

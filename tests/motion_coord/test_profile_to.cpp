@@ -42,11 +42,11 @@ TEST(ProfileTo, EndVelocityProperty) {
   Rng r(seed);
   for (std::uint64_t n = 0; n < count; ++n) {
     const bool scurve = r.coin();
-    const Limits l = random_limits(r, scurve);
+    double X = r.logu(1e-4, 1e3);
+    const Limits l = limits_for(r, X * r.logu(0.01, 100), scurve);  // moves short and long for these limits
     const double ve = l.v * r.uni(0, 1.2);
     const bool from_rest = r.coin();
     Kin k0{r.uni(-100, 100), 0, 0};
-    double X = r.logu(1e-4, 1e3);
     if (!from_rest) {
       // A state the path generator re-plans from: somewhere along a move
       // planned with the same limits (so it can still stop by its target).
@@ -109,9 +109,9 @@ TEST(ProfileTo, ZeroEndVelocityIsPlanMove) {
   Rng r(seed);
   for (std::uint64_t n = 0; n < count; ++n) {
     const bool scurve = r.coin();
-    const Limits l = random_limits(r, scurve);
-    const Kin k0{r.uni(-10, 10), l.v * r.uni(-1.5, 1.5), scurve ? r.uni(-l.d, l.a) : 0.0};
     const double X = (r.coin() ? 1 : -1) * r.logu(1e-5, 1e4);
+    const Limits l = limits_for(r, std::fabs(X) * r.logu(0.01, 100), scurve);
+    const Kin k0{r.uni(-10, 10), l.v * r.uni(-1.5, 1.5), scurve ? r.uni(-l.d, l.a) : 0.0};
     const Overshoot pol = r.coin() ? Overshoot::Reverse : Overshoot::StopAtTarget;
     Profile a, b;
     const bool ra = plan_move(a, k0, X, l, pol);
