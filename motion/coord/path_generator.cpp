@@ -656,7 +656,9 @@ void PathGenerator::stop(std::uint32_t stop_id, double decel, double decel_jerk,
 
 Err PathGenerator::change_dynamics(const DynamicsChange& ch, Events& /*ev*/) noexcept {
   if (stopping_) return Err::None;
-  const bool head_ok = has_head_ && !head_.pc;
+  // The active move, also past its PC while it still moves as the head (a
+  // TT2/3/6 move paused inside its tolerance must be able to resume).
+  const bool head_ok = has_head_;
   const bool pend_ok = ch.active_and_pending && has_pending_;
   auto apply = [&ch](Limits l) noexcept {
     if (ch.change_speed) l.v = ch.values.v;

@@ -238,6 +238,28 @@ TEST(CoordChangeDynamics, ScopeModeAndErrors) {
   EXPECT_NEAR(max2, 10.0, 1e-9);
 }
 
+// A TT2 move paused (MCCD speed 0) inside its tolerance: PC is given, and
+// it resumes and finishes exactly when a speed comes.
+TEST(CoordChangeDynamics, PausedInsideTheToleranceResumes) {
+  Rig rig(2, 0.001, 2.0);
+  ASSERT_EQ(rig.submit(line(1, v3(10, 0), lim(10, 100, 100), Termination::CommandTolerance)), Err::None);
+  while (norm(v3(10, 0) - rig.last.position) > 2.4) rig.step();  // halts within the tolerance (2)
+  DynamicsChange ch;
+  ch.change_speed = true;
+  ch.values.v = 0;
+  Events ev;
+  ASSERT_EQ(rig.g.change_dynamics(ch, ev), Err::None);
+  for (int i = 0; i < 2000; ++i) rig.step();
+  EXPECT_GE(rig.find(1, EventKind::Completed), 0);  // within 2 of the end
+  EXPECT_EQ(rig.last.speed, 0.0);
+  EXPECT_LT(rig.last.position[0], 10.0);
+  EXPECT_TRUE(rig.g.moving());
+  ch.values.v = 10;
+  ASSERT_EQ(rig.g.change_dynamics(ch, ev), Err::None);
+  rig.run();
+  EXPECT_TRUE(rig.last.position == v3(10, 0));
+}
+
 // Merge coordinated: the active and pending moves end (Cancelled), the new
 // one starts at once from the present velocity; MergeSpeed Current keeps the
 // present speed.
