@@ -130,6 +130,7 @@ void PathGenerator::start_track(const Slot& s, double u) noexcept {
   h.ve = 0.0;
   h.td = kInf;
   h.paused = false;
+  h.resume = false;
   h.mirror = false;
 }
 
@@ -141,6 +142,7 @@ void PathGenerator::plan_head(const Kin& from, double ve, double u0, Overshoot p
   h.u0 = u0;
   h.hint = 0;
   h.mirror = false;
+  h.resume = false;
   h.ve = 0.0;
   if (!(h.lim.v > 0)) {
     // Paused; a halt that would pass the end just ends the move there.
@@ -149,7 +151,19 @@ void PathGenerator::plan_head(const Kin& from, double ve, double u0, Overshoot p
     return;
   }
   h.paused = false;
-  plan_move_to(h.prof, from, h.path.length() - from.p, ve, h.lim, policy);
+  const double L = h.path.length();
+  if (policy == Overshoot::StopAtTarget && from.v > 0 && from.a < 0 && std::isfinite(h.lim.jd) &&
+      from.v - from.a * from.a / (2 * h.lim.jd) < 0 && from.p < L) {
+    // A braking acceleration the decel jerk cannot ramp out before the speed
+    // is 0 (MCCD lowered the jerk while braking): plan_move would stop short
+    // of the target with its StopAtTarget scaling. Stop without backing up
+    // first, then go on from rest (sample_head plans the second part).
+    h.ve = ve;
+    h.td = kInf;
+    h.resume = !plan_stop_before(h.prof, from, L, h.lim.d, h.lim.jd);
+    return;
+  }
+  plan_move_to(h.prof, from, L - from.p, ve, h.lim, policy);
   h.ve = ve;
   h.td = u0 + decel_start(h.prof);
 }
@@ -200,6 +214,10 @@ void PathGenerator::sample_head() noexcept {
     h.mirror = false;  // the tail has finished: the continuation profile takes over
   }
   h.k = h.prof.sample(h.u - h.u0, h.hint);
+  if (h.resume && done(h)) {  // the stop of plan_head has ended short of the target: on from rest
+    plan_head(Kin{h.prof.end_position(), 0.0, 0.0}, h.ve, h.u0 + h.prof.duration(), Overshoot::StopAtTarget);
+    h.k = h.prof.sample(h.u - h.u0, h.hint);
+  }
 }
 
 double PathGenerator::head_s_at(double u) const noexcept {
@@ -336,7 +354,7 @@ void PathGenerator::activate_blend(Events& ev) noexcept {
 // ------------------------------------------------------------- per cycle
 
 bool PathGenerator::pc_condition(const Present& now) const noexcept {
-  const bool fin = !ht_.paused && !ht_.mirror && done(ht_);
+  const bool fin = !ht_.paused && !ht_.mirror && !ht_.resume && done(ht_);
   switch (head_.rq.termination) {
     case Termination::ActualTolerance:
       return fin && now.following_error <= cfg_.actual_tolerance;
@@ -514,7 +532,7 @@ void PathGenerator::outputs(const Present& now, Output& out) noexcept {
   const bool head_decel = has_head_ && (hk.v >= 0 ? hk.a < 0 : hk.a > 0);
   set(cms::AccelStatus, head_accel);
   set(cms::DecelStatus, (head_decel && !has_tail_) || (!has_head_ && has_tail_ && tk.a < 0));
-  const bool at_target = !has_tail_ && (!has_head_ || (done(ht_) && !ht_.paused && !ht_.mirror));
+  const bool at_target = !has_tail_ && (!has_head_ || (done(ht_) && !ht_.paused && !ht_.mirror && !ht_.resume));
   set(cms::ActualPosToleranceStatus, at_target && now.following_error <= cfg_.actual_tolerance);
   const double to_go = has_head_ ? ht_.path.length() - ht_.k.p : (has_tail_ ? tt_.path.length() - tt_.k.p : 0.0);
   set(cms::CommandPosToleranceStatus, std::fabs(to_go) <= cfg_.command_tolerance);
@@ -628,6 +646,7 @@ void PathGenerator::stop(std::uint32_t stop_id, double decel, double decel_jerk,
     h.clock = Clock::Time;
     h.mirror = false;
     h.paused = false;
+    h.resume = false;
     h.u = 0.0;
     h.u0 = 0.0;
     h.hint = 0;
@@ -692,7 +711,7 @@ void PathGenerator::clear(Events& ev) noexcept {
 }
 
 bool PathGenerator::calculated_data(std::span<const double> ed, std::span<double> cd) const noexcept {
-  if (!has_head_ || head_.pc || ht_.paused || cd.size() < ed.size()) return false;
+  if (!has_head_ || head_.pc || ht_.paused || ht_.resume || cd.size() < ed.size()) return false;
   const double L = ht_.path.length();
   const double u_end = ht_.u0 + ht_.prof.duration();
   // First abscissa in [0, hi] where s reaches `target` (s is non-decreasing).

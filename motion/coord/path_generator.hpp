@@ -205,6 +205,7 @@ class PathGenerator {
     double ve = 0.0;  ///< planned end speed (Follow Contour junction)
     double td = 0.0;  ///< abscissa where the final deceleration starts (TT3)
     bool paused = false;
+    bool resume = false;  ///< `prof` is a stop short of the end; then on from rest (plan_head)
     // Mirror phase of a blended head [README "Blending"].
     bool mirror = false;
     double mk = 0.0;   ///< scale k

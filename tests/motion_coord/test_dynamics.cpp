@@ -201,7 +201,7 @@ TEST(CoordChangeDynamics, ReplanWithoutPositionStepProperty) {
           << ctx << " position step at cycle " << i;
       ASSERT_LE(off_path(s.path, o.position), 1e-9 * std::max(s.path.length(), s.path.radius())) << ctx;
       prev = o;
-      if (pause && i == 20000) {  // resume
+      if (pause && i == 200) {  // resume after a while at rest
         DynamicsChange go;
         go.change_speed = true;
         go.values.v = l.v;
@@ -236,6 +236,37 @@ TEST(CoordChangeDynamics, ScopeModeAndErrors) {
     (static_cast<long>(i) < a2 ? max1 : max2) = std::max(static_cast<long>(i) < a2 ? max1 : max2, rig.log[i].o.speed);
   EXPECT_NEAR(max1, 5.0, 1e-9);
   EXPECT_NEAR(max2, 10.0, 1e-9);
+}
+
+// MCCD lowers the decel jerk while the move brakes hard (for a lower
+// speed): the braking cannot be ramped out before the speed is 0, so the
+// move stops there without backing up, then goes on from rest to its target.
+TEST(CoordChangeDynamics, LowerDecelJerkWhileBrakingNeverJumps) {
+  Rig rig(2);
+  ASSERT_EQ(rig.submit(line(1, v3(100, 0), lim(10, 100, 100, 1000, 1000))), Err::None);
+  for (int i = 0; i < 2000; ++i) rig.step();
+  DynamicsChange slower;
+  slower.change_speed = true;
+  slower.values.v = 2;
+  Events ev;
+  ASSERT_EQ(rig.g.change_dynamics(slower, ev), Err::None);
+  for (int i = 0; i < 1000 && rig.last.acceleration[0] > -80; ++i) rig.step();  // braking, peak ~ -89
+  ASSERT_LE(rig.last.acceleration[0], -80);
+  DynamicsChange soft;
+  soft.change_decel_jerk = true;
+  soft.values.jd = 10;  // 0.01 s of ramp would need 10 s now
+  ASSERT_EQ(rig.g.change_dynamics(soft, ev), Err::None);
+  Output prev = rig.last;
+  double min_v = 1e9;
+  for (int i = 0; i < 1'000'000 && !rig.g.idle(); ++i) {
+    const Output& o = rig.step();
+    EXPECT_LE(std::fabs(o.position[0] - prev.position[0]), std::max(prev.speed, o.speed) * 0.001 + 1e-9);
+    min_v = std::min(min_v, o.velocity[0]);
+    prev = o;
+  }
+  EXPECT_GE(min_v, -1e-12);  // never backs up
+  EXPECT_TRUE(rig.g.idle());
+  EXPECT_TRUE(rig.last.position == v3(100, 0));
 }
 
 // A TT2 move paused (MCCD speed 0) inside its tolerance: PC is given, and
