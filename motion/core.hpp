@@ -134,6 +134,7 @@ struct Core {
   std::array<cam::CamProfile*, kMaxCamProfiles> cam_profiles{};
   std::array<std::span<cam::CamPoint>, kMaxCamArrays> cam_arrays{};
   std::array<std::span<double>, kMaxRealArrays> real_arrays{};
+  std::array<CoordSystemRt, kMaxCoordSystems> systems{};  ///< coordinate systems (motion/instr/coord.hpp)
   std::array<AxisId, kMaxAxes> order{};  ///< step order: masters before slaves
   std::size_t order_n = 0;
   bool order_dirty = true;  ///< a slot or an axis changed since `order` was computed

@@ -183,6 +183,7 @@ void Core::step(std::uint64_t new_cycle, Output& out) noexcept {
     step_axis(a, i < out.axes.size() ? &out.axes[i] : nullptr);
     update_status(a);
   }
+  coordsys::update_tags(*this);
 }
 
 // ------------------------------------------------------------------ status
@@ -199,7 +200,7 @@ void Core::update_status(AxisRt& a) noexcept {
   setb(JogLockStatus, jg && jg->role == GenRole::Jog && jg->master_driven && jg->md.locked && jg->md.following);
   static_assert(link::Count == 4);
   const bool linked = a.links.active[0].valid() || a.links.active[1].valid() || a.links.active[2].valid() || a.links.active[3].valid();
-  setb(CoordinatedMotionStatus, linked);
+  setb(CoordinatedMotionStatus, linked || (a.live & slot_bit(Slot::Coord)));  // MDAC link or a coordinated move
   const auto* gr = std::get_if<GearGen>(&a.gen[index(Slot::Gear)]);
   setb(GearingStatus, gr != nullptr);
   setb(GearingLockStatus, gr && gr->locked);

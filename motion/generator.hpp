@@ -20,6 +20,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "motion/instr/coord.hpp"
 #include "motion/instr/gear.hpp"
 #include "motion/instr/move.hpp"
 #include "motion/instr/position_cam.hpp"
@@ -32,8 +33,9 @@ namespace canmotion::motion {
 /// (master units, it shifts the position cam's master) steps before the
 /// position cam and is not part of the sum. Bound: one slot per kind of
 /// motion Logix can run at the same time on one axis (move, jog, gear, time
-/// cam, master offset move, position cam) plus one for a stop of all motion.
-enum class Slot : std::uint8_t { Move = 0, Jog, Gear, TimeCam, MasterOffset, PositionCam, StopAll, Count };
+/// cam, master offset move, position cam) plus one for a stop of all motion,
+/// and one for the member's share of a coordinate system's path (issue 14).
+enum class Slot : std::uint8_t { Move = 0, Jog, Gear, TimeCam, MasterOffset, PositionCam, StopAll, Coord, Count };
 inline constexpr std::size_t kSlots = static_cast<std::size_t>(Slot::Count);
 constexpr std::size_t index(Slot s) noexcept { return static_cast<std::size_t>(s); }
 /// Bit of a slot in AxisRt::live and in stop masks.
@@ -47,7 +49,8 @@ inline constexpr std::uint32_t kAllSlots = (1u << kSlots) - 1u;
 /// results stay as they were: the speed an MAS stops from (a floating-point
 /// sum) and the order in which the step-order walk visits masters.
 inline constexpr std::array<Slot, kSlots> kLegacySlotOrder{Slot::Move, Slot::Jog, Slot::Gear, Slot::TimeCam,
-                                                           Slot::PositionCam, Slot::MasterOffset, Slot::StopAll};
+                                                           Slot::PositionCam, Slot::MasterOffset, Slot::StopAll,
+                                                           Slot::Coord};
 static_assert([] {
   std::uint32_t seen = 0;
   for (const Slot s : kLegacySlotOrder) seen |= slot_bit(s);
@@ -55,7 +58,7 @@ static_assert([] {
 }(), "kLegacySlotOrder lists every slot once (a new slot goes into it too)");
 
 /// The closed set of generator states.
-using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen, PosCamGen>;
+using Generator = std::variant<std::monostate, ProfileGen, GearGen, CamGen, PosCamGen, CoordGen>;
 
 /// Call f(generator) with the generator `g` holds (nothing for an empty slot).
 template <class F>

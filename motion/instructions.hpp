@@ -11,6 +11,7 @@
 
 #include <variant>
 
+#include "motion/instr/coord.hpp"
 #include "motion/instr/direct.hpp"
 #include "motion/instr/gear.hpp"
 #include "motion/instr/home.hpp"
@@ -47,7 +48,7 @@ struct ParamsOf<TypeList<A...>, TypeList<B...>, R...> : ParamsOf<TypeList<A..., 
 /// The closed set of instruction parameters: every family's list.
 using Params = detail::ParamsOf<ServoInstructions, HomeInstructions, MoveInstructions, StopInstructions,
                                 GearInstructions, TimeCamInstructions, PositionCamInstructions, MdacInstructions,
-                                DirectInstructions, MccpInstructions>::type;
+                                DirectInstructions, MccpInstructions, CoordInstructions>::type;
 
 /// Decode a request (operand count and values already checked against the
 /// signature table). Realtime-safe.

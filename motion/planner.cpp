@@ -32,6 +32,8 @@ Err check_request(Ctx& x) noexcept {
     const auto ref = r.op[i].ref;
     if (k == OperandKind::Axis && (ref >= kMaxAxes || !x.c.axes[ref].present)) return Err::AxisNotConfigured;
     if (k == OperandKind::Group && ref >= kMaxGroups) return Err::AxisNotConfigured;
+    if (k == OperandKind::CoordSystem && (ref >= kMaxCoordSystems || !x.c.systems[ref].present))
+      return Err::AxisNotConfigured;
   }
   std::array<double, kMaxOperands> vals{};
   for (std::size_t i = 0; i < kMaxOperands; ++i) vals[i] = r.op[i].value;
@@ -64,6 +66,10 @@ Err Planner::execute(const Request& r) noexcept {
   for (std::size_t i = 0; i < ops.size() && i < r.count; ++i) {
     if (ops[i].kind == OperandKind::Axis && r.op[i].ref < kMaxAxes && c_.axes[r.op[i].ref].present)
       c_.update_status(c_.axes[r.op[i].ref]);
+    if (ops[i].kind == OperandKind::CoordSystem && r.op[i].ref < kMaxCoordSystems && c_.systems[r.op[i].ref].present) {
+      const CoordSystemRt& s = c_.systems[r.op[i].ref];
+      for (int m = 0; m < s.cfg.dim; ++m) c_.update_status(c_.axes[s.cfg.axes[static_cast<std::size_t>(m)]]);
+    }
     if (ops[i].kind == OperandKind::Group)
       for (std::size_t k = 0; k < c_.axis_count; ++k)
         if (c_.axes[k].present) c_.update_status(c_.axes[k]);
@@ -75,6 +81,10 @@ bool Planner::set_direct_command(AxisId id, double value) noexcept { return dire
 
 bool Planner::set_direct_velocity_command(AxisId id, double value) noexcept {
   return direct::set_velocity_command(c_, id, value);
+}
+
+bool Planner::configure_coordinate_system(CoordSystemId id, const CoordSystemConfig& cfg) noexcept {
+  return coordsys::configure(c_, id, cfg);
 }
 
 bool Planner::attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noexcept {

@@ -56,6 +56,14 @@ class Planner {
   /// axis is not under an active MDS in torque mode. Realtime-safe.
   bool set_direct_velocity_command(AxisId id, double value) noexcept;
 
+  /// Configure the COORDINATE_SYSTEM `id` (the binder's coordinate_systems
+  /// id) after its member axes. Not realtime. False for an invalid
+  /// configuration (dimension 1..3, members configured and distinct,
+  /// ratios > 0, max speed/accel/decel > 0).
+  bool configure_coordinate_system(CoordSystemId id, const CoordSystemConfig& cfg) noexcept;
+  /// The tag of coordinate system `id` (CS.* status words and positions). Realtime-safe.
+  const CoordSystemTag& coordinate_system(CoordSystemId id) const noexcept { return c_.systems[id].tag; }
+
   /// Register the CAM_PROFILE array tag `id` (the binder's cam_profiles id).
   /// The profile must outlive the planner. Not realtime (configuration).
   bool attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noexcept;

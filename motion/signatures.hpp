@@ -255,12 +255,12 @@ inline constexpr std::array<InstrSig, kInstrCount> kTable{{
     {Instr::MGS, "MGS", kMgs, true},
     {Instr::MGSD, "MGSD", kGroupCtl, true},
     {Instr::MGSR, "MGSR", kGroupCtl, true},
-    {Instr::MCLM, "MCLM", kMclm, false},
-    {Instr::MCCM, "MCCM", kMccm, false},
-    {Instr::MCS, "MCS", kMcs, false},
-    {Instr::MCSD, "MCSD", kCsCtl, false},
-    {Instr::MCCD, "MCCD", kMccd, false},
-    {Instr::MDCC, "MDCC", kMdcc, false},
+    {Instr::MCLM, "MCLM", kMclm, true},
+    {Instr::MCCM, "MCCM", kMccm, true},
+    {Instr::MCS, "MCS", kMcs, true},
+    {Instr::MCSD, "MCSD", kCsCtl, true},
+    {Instr::MCCD, "MCCD", kMccd, true},
+    {Instr::MDCC, "MDCC", kMdcc, true},
 }};
 
 static_assert([] {

@@ -64,6 +64,7 @@ std::string_view err_name(Err e) noexcept {
     case Err::FeatureNotSupported: return "Feature Not Supported";
     case Err::AxisNotAtRest: return "Axis Not At Rest";
     case Err::CalculatedDataArraySize: return "Calculated Data Array Size Error";
+    case Err::MdscInvalidSlaveSpeedReduction: return "MDSC Invalid Slave Speed Reduction";
   }
   return "Unknown Error";
 }

@@ -171,6 +171,7 @@ enum class Err : std::int16_t {
   FeatureNotSupported = 99,
   AxisNotAtRest = 100,
   CalculatedDataArraySize = 101,  ///< MAM CalculatedData shorter than EventDistance (reference 3.3)
+  MdscInvalidSlaveSpeedReduction = 103,  ///< seed 001: a master change leaves < 10 % of the slave system's speed (number ⚠)
   MdscInvalidModeOrMasterChange = 105,
 };
 

@@ -234,7 +234,10 @@ double PathGenerator::head_s_at(double u) const noexcept {
 // --------------------------------------------------------------- activation
 
 void PathGenerator::activate_from_rest(const Present& now, double excess, bool chained, Events& ev) noexcept {
-  Vec3 S = now.has_total ? now.total : rest_;
+  // total is the system's command when the path was at pos_ (its last
+  // output): a move that follows inside a step starts where the path ended
+  // plus what the other motion added (superposed moves shift the rest).
+  Vec3 S = now.has_total ? now.total + (rest_ - pos_) : rest_;
   for (int i = cfg_.dim; i < kMaxDim; ++i) S[i] = 0.0;
   if (!(S == pending_.path.start())) {  // a new Motion Start Point: rebuild from it
     Path p;

@@ -68,7 +68,9 @@ struct Present {
   /// The coordinate system's present total command position (coordination
   /// units; members' command positions x ratio, superposed motion included).
   /// A move that starts from rest with nothing else moving starts here (the
-  /// Motion Start Point). Without it the path continues from its own end.
+  /// Motion Start Point), moved by what the path itself travelled since its
+  /// last output (position()): inside a step, where the path ended plus the
+  /// superposed motion. Without it the path continues from its own end.
   bool has_total = false;
   Vec3 total;
   /// MDCC master this cycle (position and velocity, master units).
@@ -171,6 +173,11 @@ class PathGenerator {
   /// Fold: origin = position (the slot's offset becomes 0; the caller has
   /// moved it into the axes' base). Realtime-safe.
   void fold() noexcept { origin_ = pos_; }
+
+  /// MDCC changed the master (seed 001): the next step takes the new
+  /// master's position as its reference (no travel is counted for the
+  /// switch). Realtime-safe.
+  void master_changed() noexcept { have_mp_ = false; }
 
   bool idle() const noexcept { return !has_head_ && !has_tail_ && !has_pending_; }
   bool moving() const noexcept { return has_head_ || has_tail_; }

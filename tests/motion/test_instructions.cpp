@@ -649,12 +649,12 @@ TEST(Group, FastDisableAndShutdownReset) {
 }
 
 // ------------------------------------------------------------------- model rules
-TEST(Model, InstructionsNotYetExecutableGiveErr75) {
+TEST(Model, CoordinatedInstructionOnAnUnconfiguredSystemGivesErr11) {
   Rig r = servo_rig();
   r.add_axis("M", virt());
   r.sym.coordinate_systems["cs"] = 0;
-  EXPECT_EQ(r.exec("MCSD(cs, t);"), Err::InstructionNotSupported);
-  EXPECT_EQ(r.tag("t").err, 75);
+  EXPECT_EQ(r.exec("MCSD(cs, t);"), Err::AxisNotConfigured);
+  EXPECT_EQ(r.tag("t").err, 11);
 }
 
 TEST(Model, EachExecutionIsARisingEdge) {

@@ -160,18 +160,25 @@ TEST(MdsAudit, MasdMgsdAndMsfCancelAndClearDirectControl) {
   }
 }
 
-TEST(MdsAudit, McsdIsNotSupportedHereAndLeavesMdsRunning) {
-  // Coordinated motion (MCS/MCSD) is parsed but not executed by this planner:
-  // ERR 75, and the MDS keeps running.
+TEST(MdsAudit, McsdCancelsMdsOnAMember) {
+  // Coordinated motion (issue 14): MCSD shuts every member of the coordinate
+  // system down (MASD on each), which cancels an MDS on a member.
   Rig r;
   running(r);
+  CoordSystemConfig c;
+  c.dim = 1;
+  c.axes = {r.sym.axes.at("D"), kNoAxis, kNoAxis};
+  c.max_speed = c.max_accel = c.max_decel = 100;
+  ASSERT_TRUE(r.p->configure_coordinate_system(0, c));
   r.sym.coordinate_systems["cs"] = 0;
-  EXPECT_EQ(r.exec("MCSD(cs, csd);"), Err::InstructionNotSupported);
-  EXPECT_EQ(r.tag("csd").err, 75);
+  EXPECT_EQ(r.exec("MCSD(cs, csd);"), Err::None);
+  EXPECT_TRUE(r.tag("csd").dn());
+  EXPECT_FALSE(r.tag("csd").ip());  // the shutdown instructions never go IP
+  EXPECT_FALSE(r.tag("m").ip());
   r.step();
-  EXPECT_TRUE(r.tag("m").ip());
-  EXPECT_TRUE(vel_status(r));
-  EXPECT_DOUBLE_EQ(r.out[0].velocity, 10.0);
+  EXPECT_FALSE(vel_status(r));
+  EXPECT_FALSE(direct_status(r));
+  EXPECT_TRUE(r.out[0].shutdown);
 }
 
 TEST(MdsAudit, DriveFaultPerExceptionAction) {

@@ -1,0 +1,384 @@
+// Coordinated family (motion/instr/coord.hpp): MCLM, MCCM, MCS, MCSD, MCCD
+// and MDCC on a coordinate system (seed 001, reference coordinated-motion.md).
+// The path is motion/coord/PathGenerator; this file turns operands into its
+// requests and its answers into control tag bits. Realtime-safe.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+
+#include "motion/instr/coord.hpp"
+#include "motion/instr/ctx.hpp"
+
+namespace canmotion::motion {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Seed 001: a master change that leaves the slave system less than 10 % of
+/// its speed is refused (ERR 103).
+constexpr double kMinSpeedRatioOnMasterChange = 0.10;
+
+/// Elements of a REAL array operand from its start index to the array's end
+/// (empty for "none" or an index past the end).
+std::span<const double> array_from(const Core& c, std::uint16_t ref, double start) noexcept {
+  if (ref >= kMaxRealArrays) return {};
+  const std::span<const double> a = c.real_arrays[ref];
+  if (!(start >= 0) || start >= static_cast<double>(a.size())) return {};
+  return a.subspan(static_cast<std::size_t>(start));
+}
+
+// Speed .. JerkUnits, the same positions in MCLM/MCCM and MCCD's value operands.
+template <Instr I>
+CoordDynamics decode_dynamics(const Operands& q) noexcept {
+  CoordDynamics y;
+  y.speed = q.real(op<I>("Speed"));
+  y.speed_units = q.enumeration<SpeedUnits>(op<I>("SpeedUnits"));
+  y.accel = q.real(op<I>("AccelRate"));
+  y.accel_units = q.enumeration<AccelUnits>(op<I>("AccelUnits"));
+  y.decel = q.real(op<I>("DecelRate"));
+  y.decel_units = q.enumeration<AccelUnits>(op<I>("DecelUnits"));
+  y.accel_jerk = q.real(op<I>("AccelJerk"));
+  y.decel_jerk = q.real(op<I>("DecelJerk"));
+  y.jerk_units = q.enumeration<JerkUnits>(op<I>("JerkUnits"));
+  return y;
+}
+
+template <Instr I, class P>
+P decode_move(const Operands& q) noexcept {
+  P p;
+  p.cs = q.ref(op<I>("CoordinateSystem"));
+  p.incremental = q.number(op<I>("MoveType")) == 1;
+  p.position = q.ref(op<I>("Position"));
+  p.position_start = q.real(op<I>("Position"));
+  p.dyn = decode_dynamics<I>(q);
+  p.dyn.profile = q.enumeration<ProfileType>(op<I>("Profile"));
+  p.termination = q.number(op<I>("TerminationType"));
+  p.merge = q.number(op<I>("Merge"));
+  p.merge_speed = q.enumeration<MergeSpeed>(op<I>("MergeSpeed"));
+  p.command_tolerance = q.real(op<I>("CommandTolerance"));
+  p.lock_position = q.real(op<I>("LockPosition"));
+  p.lock_direction = q.enumeration<LockDirection>(op<I>("LockDirection"));
+  p.event_distance = q.ref(op<I>("EventDistance"));
+  p.event_distance_start = q.real(op<I>("EventDistance"));
+  p.calculated_data = q.ref(op<I>("CalculatedData"));
+  p.calculated_data_start = q.real(op<I>("CalculatedData"));
+  p.first_dyn_operand = op<I>("Speed");
+  return p;
+}
+
+/// The coordinate system of an execution, or null (ERR 11 then).
+CoordSystemRt* system(Core& c, CoordSystemId id) noexcept {
+  return id < kMaxCoordSystems && c.systems[id].present ? &c.systems[id] : nullptr;
+}
+
+/// The checks of a move on every member: ERR 11, 53, 7, 20, 5, 87; 39 when
+/// a member runs a move of another coordinate system (an axis may belong to
+/// several systems, moved by one at a time).
+Err member_checks(const Core& c, const CoordSystemRt& s) noexcept {
+  for (int i = 0; i < s.cfg.dim; ++i) {
+    const AxisRt& a = c.axes[s.cfg.axes[static_cast<std::size_t>(i)]];
+    if (Err e = c.common_checks(a, true); e != Err::None) return e;
+    const auto* g = std::get_if<CoordGen>(&a.gen[index(Slot::Coord)]);
+    if (g && &c.systems[g->cs] != &s) return Err::ProcessConflict;
+  }
+  return Err::None;
+}
+
+/// Vector limits of a move or MCCD in coordination units (per second, or
+/// per master unit when master-driven). ERR 94 mixed modes, 13 out of range.
+Err convert_dynamics(Ctx& x, const CoordDynamics& y, const CoordSystemConfig& cfg, bool scurve, int first,
+                     Limits& lim, bool& md) noexcept {
+  md = is_master_driven(y.speed_units);
+  if (is_master_driven(y.accel_units) != md || is_master_driven(y.decel_units) != md ||
+      (scurve && is_master_driven(y.jerk_units) != md))
+    return Err::MdscUnitsConflict;  // seed 001: Accel, Decel and Jerk in the Speed's units
+  lim.v = units::rate(y.speed, y.speed_units, cfg.max_speed);
+  if (Err e = x.take(units::positive_rate(y.accel, y.accel_units, cfg.max_accel, first + 2), lim.a); e != Err::None)
+    return e;
+  if (Err e = x.take(units::positive_rate(y.decel, y.decel_units, cfg.max_decel, first + 4), lim.d); e != Err::None)
+    return e;
+  lim.ja = lim.jd = kInf;
+  if (!scurve) return Err::None;
+  if (!units::is_jerk_rate(y.jerk_units)) return x.reject_operand(first + 9);
+  const double v = lim.v > 0 ? lim.v : cfg.max_speed;
+  if (Err e = x.take(units::jerk(y.accel_jerk, y.jerk_units, lim.a, v, cfg.max_accel_jerk, first + 7), lim.ja);
+      e != Err::None)
+    return e;
+  return x.take(units::jerk(y.decel_jerk, y.jerk_units, lim.d, v, cfg.max_decel_jerk, first + 8), lim.jd);
+}
+
+/// Seed 001, master change: the pending MDCC's master takes over when this
+/// move goes IP. ERR 97 when the system moves and the new master is idle,
+/// 103 when the new effective speed is below 10 % of the present one.
+Err check_master_change(const Core& c, const CoordSystemRt& s, bool md, double speed) noexcept {
+  if (!s.pending.valid() || !md || !s.path.moving()) return Err::None;
+  coord::Present m;
+  coordsys::master_state(c, s.pending, m);
+  const double mv = std::fabs(m.master_velocity);
+  if (!(mv > 0)) return Err::MdscIdleMasterSlaveMoving;
+  if (mv * speed < kMinSpeedRatioOnMasterChange * s.path.speed()) return Err::MdscInvalidSlaveSpeedReduction;
+  return Err::None;
+}
+
+/// The path request of an MCLM/MCCM, its REAL array operands read.
+Err build_request(Ctx& x, const CoordMoveParams& p, const CoordSystemRt& s, coord::MoveRequest& rq) noexcept {
+  const Instr in = p.circle ? Instr::MCCM : Instr::MCLM;
+  const auto dim = static_cast<std::size_t>(s.cfg.dim);
+  const std::span<const double> pos = array_from(x.c, p.position, p.position_start);
+  if (pos.size() < dim) return x.reject_operand(operand_index(in, "Position"));
+  rq.path.kind = p.circle ? coord::PathKind::Circle : coord::PathKind::Line;
+  rq.path.incremental = p.incremental;
+  for (std::size_t i = 0; i < dim; ++i) rq.path.position.c[i] = pos[i];
+  if (p.circle) {
+    const std::span<const double> aux = array_from(x.c, p.aux, p.aux_start);
+    const std::size_t need = p.circle_type == 2 ? 1 : dim;
+    if (aux.size() < need) return x.reject_operand(operand_index(in, "Via/Center/Radius"));
+    for (std::size_t i = 0; i < need; ++i) rq.path.aux.c[i] = aux[i];
+    rq.path.circle_type = static_cast<coord::CircleType>(p.circle_type);
+    rq.path.direction = static_cast<coord::CircleDirection>(p.direction);
+  }
+  bool md = false;
+  const bool scurve = p.dyn.profile == ProfileType::SCurve;
+  if (Err e = convert_dynamics(x, p.dyn, s.cfg, scurve, p.first_dyn_operand, rq.limits, md); e != Err::None) return e;
+  if (md == (p.lock_direction == LockDirection::None)) return Err::MdscLockDirConflict;
+  if (md && !s.link.valid() && !s.pending.valid()) return Err::MdscNotActivated;
+  if (p.termination == 6 && !(p.command_tolerance >= 0))
+    return x.reject_operand(operand_index(in, "CommandTolerance"));
+  rq.termination = static_cast<coord::Termination>(p.termination);
+  rq.command_tolerance = p.command_tolerance;
+  rq.merge = static_cast<coord::CoordMerge>(p.merge);
+  rq.merge_speed = p.merge_speed;
+  rq.master_driven = md;
+  rq.lock_direction = p.lock_direction;
+  rq.lock_position = p.lock_position;
+  return Err::None;
+}
+
+Err start_move(Ctx& x, const CoordMoveParams& p) noexcept {
+  CoordSystemRt* sp = system(x.c, p.cs);
+  if (!sp) return Err::AxisNotConfigured;
+  CoordSystemRt& s = *sp;
+  if (Err e = member_checks(x.c, s); e != Err::None) return e;
+  coord::MoveRequest rq;
+  if (Err e = build_request(x, p, s, rq); e != Err::None) return e;
+  if (Err e = check_master_change(x.c, s, rq.master_driven, rq.limits.v); e != Err::None) return e;
+  if (s.fold_due && !s.path.moving()) coordsys::settle(x.c, s);
+  const MdccLink& link = s.pending.valid() ? s.pending : s.link;
+  // an owner entry for the move (a free one always exists: the path holds at most 3 ids)
+  auto it = std::find_if(s.owners.begin(), s.owners.end(), [](const auto& o) { return o.id == 0; });
+  if (it == s.owners.end()) return Err::CoordinateSystemQueueFull;
+  rq.id = s.next_id;
+  coord::Events ev;
+  if (Err e = s.path.submit(rq, coordsys::present(x.c, s, link), ev); e != Err::None) return e;
+  if (s.pending.valid()) s.path.master_changed();  // the next step references the new master
+  s.next_id = s.next_id == 0xFFFFFFFFu ? 1 : s.next_id + 1;
+  *it = CoordSystemRt::Owner{rq.id, x.self, rq.master_driven, p.calculated_data, p.event_distance,
+                             p.calculated_data_start, p.event_distance_start};
+  if (s.pending.valid()) coordsys::take_pending_link(x.c, s);  // seed 001: the switch happens as this move goes IP
+  x.tag.set(flag::DN, true);
+  x.tag.set(flag::IP, true);
+  coordsys::join_members(x.c, s);
+  coordsys::apply_events(x.c, s, ev);
+  return Err::None;
+}
+
+}  // namespace
+
+MclmParams MclmParams::decode(const Operands& q) noexcept {
+  MclmParams p;
+  static_cast<CoordMoveParams&>(p) = decode_move<kInstr, CoordMoveParams>(q);
+  return p;
+}
+
+MccmParams MccmParams::decode(const Operands& q) noexcept {
+  MccmParams p;
+  static_cast<CoordMoveParams&>(p) = decode_move<kInstr, CoordMoveParams>(q);
+  p.circle = true;
+  p.circle_type = q.number(op<kInstr>("CircleType"));
+  p.aux = q.ref(op<kInstr>("Via/Center/Radius"));
+  p.aux_start = q.real(op<kInstr>("Via/Center/Radius"));
+  p.direction = q.number(op<kInstr>("Direction"));
+  return p;
+}
+
+Err start(Ctx& x, const MclmParams& p) noexcept { return start_move(x, p); }
+Err start(Ctx& x, const MccmParams& p) noexcept { return start_move(x, p); }
+
+McsParams McsParams::decode(const Operands& q) noexcept {
+  constexpr Instr I = kInstr;
+  McsParams p;
+  p.cs = q.ref(op<I>("CoordinateSystem"));
+  p.stop_type = q.number(op<I>("StopType"));
+  p.change_decel = q.yes(op<I>("ChangeDecel"));
+  p.decel = q.real(op<I>("DecelRate"));
+  p.decel_units = q.enumeration<AccelUnits>(op<I>("DecelUnits"));
+  p.change_decel_jerk = q.yes(op<I>("ChangeDecelJerk"));
+  p.decel_jerk = q.real(op<I>("DecelJerk"));
+  p.jerk_units = q.enumeration<JerkUnits>(op<I>("JerkUnits"));
+  return p;
+}
+
+Err start(Ctx& x, const McsParams& p) noexcept {
+  constexpr Instr I = Instr::MCS;
+  CoordSystemRt* sp = system(x.c, p.cs);
+  if (!sp) return Err::AxisNotConfigured;
+  CoordSystemRt& s = *sp;
+  // the system's max decel; trapezoidal unless ChangeDecelJerk gives a jerk (README choices)
+  double d = s.cfg.max_decel, jd = kInf;
+  if (p.change_decel &&
+      x.take(units::positive_rate(p.decel, p.decel_units, s.cfg.max_decel, op<I>("DecelRate")), d) != Err::None)
+    return Err::ParameterOutOfRange;
+  if (p.change_decel_jerk &&
+      x.take(units::jerk(p.decel_jerk, p.jerk_units, d, std::max(s.path.speed(), 1e-9), s.cfg.max_decel_jerk,
+                         op<I>("DecelJerk")), jd) != Err::None)
+    return Err::ParameterOutOfRange;
+  x.tag.set(flag::DN, true);
+  if (p.stop_type == 3) {  // coordinated transform: this project has no transforms
+    x.tag.set(flag::PC, true);
+    return Err::None;
+  }
+  if (p.stop_type == 0) {  // All: the members' single-axis motion too, and the MDCC links
+    coordsys::break_links(x.c, s);
+    for (int i = 0; i < s.cfg.dim; ++i) {
+      AxisRt& a = x.c.axes[s.cfg.axes[static_cast<std::size_t>(i)]];
+      const std::uint32_t others = kAllSlots & ~slot_bit(Slot::Coord);
+      if (a.servo.on) x.c.stop_slots(a, others, a.cfg.max_decel > 0 ? a.cfg.max_decel : 1e12, kInf, kNoControl, 0);
+    }
+  }
+  auto it = std::find_if(s.owners.begin(), s.owners.end(), [](const auto& o) { return o.id == 0; });
+  if (it == s.owners.end()) return Err::CoordinateSystemQueueFull;
+  coord::Events ev;
+  if (s.fold_due && !s.path.moving()) coordsys::settle(x.c, s);
+  const std::uint32_t id = s.next_id;
+  s.next_id = s.next_id == 0xFFFFFFFFu ? 1 : s.next_id + 1;
+  *it = CoordSystemRt::Owner{id, x.self};
+  x.tag.set(flag::IP, true);
+  s.path.stop(id, d, jd, ev);
+  coordsys::apply_events(x.c, s, ev);
+  return Err::None;
+}
+
+McsdParams McsdParams::decode(const Operands& q) noexcept {
+  McsdParams p;
+  p.cs = q.ref(op<kInstr>("CoordinateSystem"));
+  return p;
+}
+
+Err start(Ctx& x, const McsdParams& p) noexcept {
+  CoordSystemRt* sp = system(x.c, p.cs);
+  if (!sp) return Err::AxisNotConfigured;
+  CoordSystemRt& s = *sp;
+  coordsys::drop(x.c, s);          // queue cleared, the moves' IP cleared
+  coordsys::break_links(x.c, s);   // MDCC links broken
+  for (int i = 0; i < s.cfg.dim; ++i) {
+    AxisRt& a = x.c.axes[s.cfg.axes[static_cast<std::size_t>(i)]];
+    x.c.do_shutdown(a);  // MASD on every member (MDS cancelled, MDAC links broken)
+  }
+  x.tag.set(flag::DN, true);
+  return Err::None;
+}
+
+MccdParams MccdParams::decode(const Operands& q) noexcept {
+  constexpr Instr I = kInstr;
+  MccdParams p;
+  p.cs = q.ref(op<I>("CoordinateSystem"));
+  p.change_speed = q.yes(op<I>("ChangeSpeed"));
+  p.change_accel = q.yes(op<I>("ChangeAccel"));
+  p.change_decel = q.yes(op<I>("ChangeDecel"));
+  p.change_accel_jerk = q.yes(op<I>("ChangeAccelJerk"));
+  p.change_decel_jerk = q.yes(op<I>("ChangeDecelJerk"));
+  p.dyn = decode_dynamics<I>(q);
+  p.active_and_pending = q.number(op<I>("Scope")) == 1;
+  return p;
+}
+
+Err start(Ctx& x, const MccdParams& p) noexcept {
+  constexpr Instr I = Instr::MCCD;
+  CoordSystemRt* sp = system(x.c, p.cs);
+  if (!sp) return Err::AxisNotConfigured;
+  CoordSystemRt& s = *sp;
+  // the units of the changed values: all of one mode (94); the other mode than the move's: 105 (seed 001)
+  const bool md = (p.change_speed && is_master_driven(p.dyn.speed_units)) ||
+                  (p.change_accel && is_master_driven(p.dyn.accel_units)) ||
+                  (p.change_decel && is_master_driven(p.dyn.decel_units)) ||
+                  ((p.change_accel_jerk || p.change_decel_jerk) && is_master_driven(p.dyn.jerk_units));
+  const bool td = (p.change_speed && !is_master_driven(p.dyn.speed_units)) ||
+                  (p.change_accel && !is_master_driven(p.dyn.accel_units)) ||
+                  (p.change_decel && !is_master_driven(p.dyn.decel_units)) ||
+                  ((p.change_accel_jerk || p.change_decel_jerk) && !is_master_driven(p.dyn.jerk_units));
+  if (md && td) return Err::MdscUnitsConflict;
+  coord::DynamicsChange ch;
+  ch.change_speed = p.change_speed;
+  ch.change_accel = p.change_accel;
+  ch.change_decel = p.change_decel;
+  ch.change_accel_jerk = p.change_accel_jerk;
+  ch.change_decel_jerk = p.change_decel_jerk;
+  ch.master_driven = md;
+  ch.active_and_pending = p.active_and_pending;
+  const CoordSystemConfig& cfg = s.cfg;
+  const int first = op<I>("Speed");
+  if (p.change_speed) {
+    if (!(p.dyn.speed >= 0)) return x.reject_operand(first);
+    ch.values.v = units::rate(p.dyn.speed, p.dyn.speed_units, cfg.max_speed);
+  }
+  if (p.change_accel && x.take(units::positive_rate(p.dyn.accel, p.dyn.accel_units, cfg.max_accel,
+                                                    op<I>("AccelRate")), ch.values.a) != Err::None)
+    return Err::ParameterOutOfRange;
+  if (p.change_decel && x.take(units::positive_rate(p.dyn.decel, p.dyn.decel_units, cfg.max_decel,
+                                                    op<I>("DecelRate")), ch.values.d) != Err::None)
+    return Err::ParameterOutOfRange;
+  const double v = std::max(s.path.speed(), cfg.max_speed);
+  if (p.change_accel_jerk && x.take(units::jerk(p.dyn.accel_jerk, p.dyn.jerk_units, cfg.max_accel, v,
+                                                cfg.max_accel_jerk, op<I>("AccelJerk")), ch.values.ja) != Err::None)
+    return Err::ParameterOutOfRange;
+  if (p.change_decel_jerk && x.take(units::jerk(p.dyn.decel_jerk, p.dyn.jerk_units, cfg.max_decel, v,
+                                                cfg.max_decel_jerk, op<I>("DecelJerk")), ch.values.jd) != Err::None)
+    return Err::ParameterOutOfRange;
+  coord::Events ev;
+  if (Err e = s.path.change_dynamics(ch, ev); e != Err::None) return e;
+  x.tag.set(flag::DN, true);
+  coordsys::apply_events(x.c, s, ev);
+  return Err::None;
+}
+
+MdccParams MdccParams::decode(const Operands& q) noexcept {
+  constexpr Instr I = kInstr;
+  MdccParams p;
+  p.cs = q.ref(op<I>("SlaveSystem"));
+  p.master = q.ref(op<I>("MasterAxis"));
+  p.master_reference = q.enumeration<MasterReference>(op<I>("MasterReference"));
+  p.nominal_master_velocity = q.real(op<I>("NominalMasterVelocity"));
+  return p;
+}
+
+Err start(Ctx& x, const MdccParams& p) noexcept {
+  CoordSystemRt* sp = system(x.c, p.cs);
+  if (!sp) return Err::AxisNotConfigured;
+  CoordSystemRt& s = *sp;
+  for (int i = 0; i < s.cfg.dim; ++i)
+    if (s.cfg.axes[static_cast<std::size_t>(i)] == p.master) return Err::MasterAxisConflict;  // master in the slave system
+  const AxisRt& m = x.c.axes[p.master];
+  if (Err e = x.c.common_checks(m, false); e != Err::None && e != Err::AxisInFaultedState) return e;
+  if (m.hs.homing) return Err::HomeInProcess;
+  // a virtual master always gives its command position
+  const MdccLink l{p.master, p.master_reference == MasterReference::Actual && m.cfg.type == AxisType::CipDrive,
+                   x.self};
+  x.tag.set(flag::DN, true);
+  x.tag.set(flag::IP, true);
+  if (s.link.valid() && s.link.master != p.master && s.path.moving()) {
+    // seed 001: another master while the system runs a move: pending until the next MCLM/MCCM goes IP
+    if (ControlTag* old = x.c.tag(s.pending.owner); old && !(s.pending.owner == x.self)) old->set(flag::IP, false);
+    s.pending = l;
+    return Err::None;
+  }
+  if (ControlTag* old = x.c.tag(s.link.owner); old && !(s.link.owner == x.self)) {
+    old->set(flag::IP, false);
+    old->set(flag::AC, false);
+  }
+  if (s.link.valid() && s.link.master != p.master) s.path.master_changed();
+  s.link = l;
+  coordsys::refresh_link_master(x.c, s);
+  return Err::None;
+}
+
+}  // namespace canmotion::motion
