@@ -163,6 +163,22 @@ struct ArraySettings {
   Location where;
 };
 
+/// One `coordinate_systems:` entry: a COORDINATE_SYSTEM tag (issue 14,
+/// motion/instr/coord.hpp). Members are axis names, in order (1..3, distinct);
+/// an axis may be a member of several systems, but only one of them may move
+/// it at a time (ERR 39 at run time).
+struct CoordinateSystemSettings {
+  std::string name;
+  std::vector<std::string> axes;
+  std::vector<Location> axes_where;       ///< where each member name is
+  std::vector<double> conversion_ratios;  ///< coordination units per axis unit, per member (default 1)
+  std::string units = "units";            ///< coordination units name (display only)
+  double max_speed = 0.0, max_accel = 0.0, max_decel = 0.0;  ///< required, > 0
+  double max_accel_jerk = 0.0, max_decel_jerk = 0.0;        ///< optional (0: %ofMaximum jerk refused)
+  double actual_position_tolerance = 0.0, command_position_tolerance = 0.0;
+  Location where;
+};
+
 /// A whole, validated configuration.
 struct Config {
   std::string path;
@@ -171,6 +187,7 @@ struct Config {
   std::vector<AxisSettings> axes;
   std::vector<CamSettings> cams;
   std::vector<ArraySettings> arrays;  ///< `arrays:` (CAM, CAM_PROFILE and REAL array tags)
+  std::vector<CoordinateSystemSettings> coordinate_systems;  ///< `coordinate_systems:`
   std::vector<Diagnostic> warnings;  ///< e.g. bus load over 70 %
 
   [[nodiscard]] const BusSettings* find_bus(std::string_view name) const noexcept;

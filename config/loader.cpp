@@ -622,6 +622,81 @@ class Loader {
     return a;
   }
 
+  /// One `coordinate_systems:` entry.
+  CoordinateSystemSettings coordinate_system(const YAML::Node& n, const std::string& path) {
+    CoordinateSystemSettings c;
+    c.where = loc(n);
+    if (!check_map(n, path, {"name", "axes", "conversion_ratios", "units", "max_speed", "max_accel", "max_decel",
+                             "max_accel_jerk", "max_decel_jerk", "actual_position_tolerance",
+                             "command_position_tolerance"}))
+      return c;
+    if (required(n, path, "name", "every coordinate system needs a name")) string(n, path, "name", c.name);
+    if (required(n, path, "axes", "the member axes in order, 1 to 3 axis names")) {
+      const YAML::Node a = n["axes"];
+      if (!a.IsSequence() || a.size() < 1 || a.size() > 3) {
+        error(a, path + ".axes", "must be a list of 1 to 3 axis names");
+      } else {
+        for (std::size_t i = 0; i < a.size(); ++i) {
+          if (!a[i].IsScalar() || a[i].Scalar().empty()) error(a[i], fmt::format("{}.axes[{}]", path, i), "must be an axis name");
+          else {
+            c.axes.push_back(a[i].Scalar());
+            c.axes_where.push_back(loc(a[i]));
+          }
+        }
+      }
+    }
+    if (const YAML::Node r = n["conversion_ratios"]) {
+      if (!r.IsSequence() || r.size() != c.axes.size()) {
+        error(r, path + ".conversion_ratios", fmt::format("must be a list of {} numbers > 0, one per member axis", c.axes.size()));
+      } else {
+        for (std::size_t i = 0; i < r.size(); ++i) {
+          double x = 0;
+          const std::string k = fmt::format("{}.conversion_ratios[{}]", path, i);
+          if (finite_number(r[i], k, "", x) && !(x > 0)) error(r[i], k, fmt::format("must be > 0, got {}", x));
+          c.conversion_ratios.push_back(x);
+        }
+      }
+    }
+    string(n, path, "units", c.units);
+    constexpr double kBig = 1e12;
+    for (auto [key, out] : {std::pair<std::string_view, double*>{"max_speed", &c.max_speed}, {"max_accel", &c.max_accel},
+                            {"max_decel", &c.max_decel}}) {
+      if (required(n, path, key, "> 0, coordination units per second (squared)")) scalar(n, path, key, *out, 1e-12, kBig);
+    }
+    scalar(n, path, "max_accel_jerk", c.max_accel_jerk, 0.0, kBig);
+    scalar(n, path, "max_decel_jerk", c.max_decel_jerk, 0.0, kBig);
+    scalar(n, path, "actual_position_tolerance", c.actual_position_tolerance, 0.0, kBig);
+    scalar(n, path, "command_position_tolerance", c.command_position_tolerance, 0.0, kBig);
+    return c;
+  }
+
+  /// `coordinate_systems:` members name configured axes, once each; the
+  /// capacity motion::kMaxCoordSystems.
+  template <class Unique>
+  void coordinate_system_checks(const Config& cfg, Unique& unique) {
+    std::vector<std::string_view> axis_names;
+    for (const auto& a : cfg.axes) axis_names.push_back(a.name);
+    for (std::size_t i = 0; i < cfg.coordinate_systems.size(); ++i) {
+      const CoordinateSystemSettings& c = cfg.coordinate_systems[i];
+      const std::string key = fmt::format("coordinate_systems[{}]", i);
+      unique(c.name, c.where, key + ".name", "tag");
+      tag_name_check(c.name, c.where, key + ".name");
+      if (i == motion::kMaxCoordSystems) error_at(c.where, key, fmt::format("at most {} coordinate systems", motion::kMaxCoordSystems));
+      for (std::size_t k = 0; k < c.axes.size(); ++k) {
+        const std::string ak = fmt::format("{}.axes[{}]", key, k);
+        if (!cfg.find_axis(c.axes[k])) {
+          std::string msg = fmt::format("no axis named '{}'", c.axes[k]);
+          if (auto s = nearest(c.axes[k], axis_names)) msg += fmt::format("; did you mean '{}'?", *s);
+          else msg += fmt::format("; axes: {}", fmt::join(axis_names, ", "));
+          error_at(c.axes_where[k], ak, msg);
+        }
+        for (std::size_t j = 0; j < k; ++j)
+          if (c.axes[j] == c.axes[k])
+            error_at(c.axes_where[k], ak, fmt::format("axis '{}' is already member {}", c.axes[k], j));
+      }
+    }
+  }
+
   Config document(const YAML::Node& root) {
     Config cfg;
     cfg.path = file_;
@@ -629,7 +704,7 @@ class Loader {
       error_at({1, 1}, "", "the file is empty; it needs at least `axes:`");
       return cfg;
     }
-    if (!check_map(root, "", {"controller", "buses", "drives", "axes", "cams", "arrays"})) return cfg;
+    if (!check_map(root, "", {"controller", "buses", "drives", "axes", "cams", "arrays", "coordinate_systems"})) return cfg;
     if (root["controller"]) cfg.controller = controller(root["controller"]);
     if (const YAML::Node b = root["buses"]) {
       if (!b.IsSequence()) error(b, "buses", "must be a list of buses");
@@ -654,6 +729,12 @@ class Loader {
       if (!a.IsSequence()) error(a, "arrays", "must be a list of {name, type, size, values}");
       else
         for (std::size_t i = 0; i < a.size(); ++i) cfg.arrays.push_back(array(a[i], fmt::format("arrays[{}]", i)));
+    }
+    if (const YAML::Node c = root["coordinate_systems"]) {
+      if (!c.IsSequence()) error(c, "coordinate_systems", "must be a list of {name, axes, max_speed, max_accel, max_decel, ...}");
+      else
+        for (std::size_t i = 0; i < c.size(); ++i)
+          cfg.coordinate_systems.push_back(coordinate_system(c[i], fmt::format("coordinate_systems[{}]", i)));
     }
     return cfg;
   }
@@ -710,6 +791,7 @@ class Loader {
       tag_name_check(c.name, c.where, fmt::format("cams[{}].name", i));
     }
     array_checks(cfg, unique);
+    coordinate_system_checks(cfg, unique);
 
     const auto ip = interpolation_period(cfg.controller.period_s);
     if (!ip)

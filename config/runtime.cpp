@@ -203,6 +203,25 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
     as.real_values = a.real_values;
     spec.arrays.push_back(std::move(as));
   }
+  for (const CoordinateSystemSettings& c : cfg.coordinate_systems) {
+    rt::CoordSystemSpec cs;
+    cs.name = c.name;
+    motion::CoordSystemConfig& m = cs.config;
+    m.dim = static_cast<int>(c.axes.size());
+    for (std::size_t k = 0; k < c.axes.size(); ++k) {
+      for (std::size_t a = 0; a < spec.axes.size(); ++a)
+        if (spec.axes[a].name == c.axes[k]) m.axes[k] = static_cast<motion::AxisId>(a);
+      if (k < c.conversion_ratios.size()) m.ratio[k] = c.conversion_ratios[k];
+    }
+    m.max_speed = c.max_speed;
+    m.max_accel = c.max_accel;
+    m.max_decel = c.max_decel;
+    m.max_accel_jerk = c.max_accel_jerk;
+    m.max_decel_jerk = c.max_decel_jerk;
+    m.actual_tolerance = c.actual_position_tolerance;
+    m.command_tolerance = c.command_position_tolerance;
+    spec.coordinate_systems.push_back(std::move(cs));
+  }
   try {
     rt.controller = std::make_unique<rt::Controller>(std::move(spec));
   } catch (const std::invalid_argument& e) {

@@ -97,6 +97,13 @@ Controller::Controller(ControllerSpec spec)
       axes_[a].proxy = &buses_[static_cast<std::size_t>(s.bus)].network->add_drive(s.drive);
     }
   }
+  if (spec_.coordinate_systems.size() > motion::kMaxCoordSystems)
+    throw std::invalid_argument("more than " + std::to_string(motion::kMaxCoordSystems) + " coordinate systems");
+  for (std::size_t c = 0; c < spec_.coordinate_systems.size(); ++c) {
+    const CoordSystemSpec& cs = spec_.coordinate_systems[c];
+    if (!planner_.configure_coordinate_system(static_cast<motion::CoordSystemId>(c), cs.config))
+      throw std::invalid_argument("coordinate system '" + cs.name + "': the planner rejected its configuration");
+  }
 }
 
 std::optional<motion::AxisId> Controller::axis_id(std::string_view name) const {
@@ -122,6 +129,13 @@ std::optional<motion::ControlId> Controller::control_id(std::string_view name_in
   control_names_.emplace(name, id);
   controls_in_use_.store(control_names_.size(), std::memory_order_release);
   return id;
+}
+
+std::optional<motion::CoordSystemId> Controller::coordinate_system_id(std::string_view name) const {
+  const std::string want = lower_name(name);
+  for (std::size_t c = 0; c < spec_.coordinate_systems.size(); ++c)
+    if (lower_name(spec_.coordinate_systems[c].name) == want) return static_cast<motion::CoordSystemId>(c);
+  return std::nullopt;
 }
 
 std::optional<std::uint16_t> Controller::cam_id(std::string_view name) const {
@@ -438,6 +452,8 @@ void Controller::finish_publish() const noexcept {
   }
   for (std::size_t c = 0; c < publish_nctl_; ++c) s.controls[c] = planner_.control(static_cast<motion::ControlId>(c));
   for (std::size_t c = 0; c < cams_.size(); ++c) s.cam_status[c] = cams_[c]->status();
+  for (std::size_t c = 0; c < spec_.coordinate_systems.size(); ++c)
+    s.systems[c] = planner_.coordinate_system(static_cast<motion::CoordSystemId>(c));
   std::copy(real_store_.begin(), real_store_.end(), s.real_values.begin());  // <= kMaxRealElements
   snapshot_->commit();
   publish_pending_ = false;

@@ -105,6 +105,13 @@ struct ArrayRef {
   std::uint32_t offset = 0;
 };
 
+/// A COORDINATE_SYSTEM of the configuration (`coordinate_systems:`): its
+/// planner id is its position in ControllerSpec::coordinate_systems.
+struct CoordSystemSpec {
+  std::string name;
+  motion::CoordSystemConfig config{};  ///< member axis ids resolved
+};
+
 /// Everything a Controller is built from (config::build_runtime makes it from a file).
 struct ControllerSpec {
   std::int64_t period_ns = 1'000'000;
@@ -112,6 +119,7 @@ struct ControllerSpec {
   std::vector<AxisSpec> axes;
   std::vector<CamSpec> cams;
   std::vector<ArraySpec> arrays;
+  std::vector<CoordSystemSpec> coordinate_systems;
 };
 
 /// A command to the RT thread. Trivially copyable (lives in an SPSC ring).
@@ -219,6 +227,8 @@ struct Status {
   std::array<std::int32_t, motion::kMaxCamProfiles> cam_status{};
   /// REAL array elements (ArrayRef::offset + index); only the configured ones are written.
   std::array<double, kMaxRealElements> real_values{};
+  /// COORDINATE_SYSTEM tags (CS.*), by ControllerSpec::coordinate_systems index.
+  std::array<motion::CoordSystemTag, motion::kMaxCoordSystems> systems{};
 };
 
 class Controller {
@@ -283,6 +293,8 @@ class Controller {
   /// Cam profile id of `name` (case-insensitive), or nullopt.
   [[nodiscard]] std::optional<std::uint16_t> cam_id(std::string_view name) const;
   [[nodiscard]] std::size_t cam_count() const noexcept { return cams_.size(); }
+  /// The coordinate system `name` (case-insensitive), or nullopt.
+  [[nodiscard]] std::optional<motion::CoordSystemId> coordinate_system_id(std::string_view name) const;
   /// The array tag `name` (case-insensitive) of the `arrays:` section, or nullopt.
   [[nodiscard]] std::optional<ArrayRef> find_array(std::string_view name) const;
   /// Write one element of an array tag (CAM: member 0 Master, 1 Slave,

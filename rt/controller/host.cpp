@@ -36,6 +36,8 @@ std::optional<std::string> ControllerHost::bind(std::string_view call, motion::R
     if (const auto v = tags_.read(refresh(), name, &e)) sym.numeric_tags.emplace(name, *v);
     else return fmt::format("operand {} ({}): {}", i, sig.operands[i].name, e);
   }
+  for (std::size_t i = 0; i < c_.spec().coordinate_systems.size(); ++i)
+    sym.coordinate_systems.emplace(c_.spec().coordinate_systems[i].name, static_cast<std::uint16_t>(i));
   for (const auto& cam : c_.spec().cams)
     sym.cam_profiles.emplace(cam.name, *c_.cam_id(cam.name));
   for (const auto& arr : c_.spec().arrays) {  // `arrays:` tags, by kind

@@ -100,6 +100,32 @@ constexpr std::array kControlMembers{
     Named{"STATUS", kStatusMember},
 };
 
+// COORDINATE_SYSTEM members and status bits (motion/types.hpp).
+enum CsAttr : std::uint8_t { kCsSystemStatus, kCsMotionStatus, kCsActualPosition, kCsCommandPosition, kCsSpeed };
+constexpr std::array kCsAttrs{
+    Named{"CoordinateSystemStatus", kCsSystemStatus}, Named{"CoordinateMotionStatus", kCsMotionStatus},
+    Named{"ActualPosition", kCsActualPosition},       Named{"CommandPosition", kCsCommandPosition},
+    Named{"Speed", kCsSpeed},
+};
+namespace cms = motion::coordinate_motion_status;
+constexpr std::array kCsMotionBits{
+    Named{"AccelStatus", cms::AccelStatus},
+    Named{"DecelStatus", cms::DecelStatus},
+    Named{"ActualPosToleranceStatus", cms::ActualPosToleranceStatus},
+    Named{"CommandPosToleranceStatus", cms::CommandPosToleranceStatus},
+    Named{"StoppingStatus", cms::StoppingStatus},
+    Named{"MoveStatus", cms::MoveStatus},
+    Named{"MoveTransitionStatus", cms::MoveTransitionStatus},
+    Named{"MovePendingStatus", cms::MovePendingStatus},
+    Named{"MovePendingQueueFullStatus", cms::MovePendingQueueFullStatus},
+    Named{"CoordinateSystemLockStatus", cms::CoordinateSystemLockStatus},
+};
+namespace css = motion::coordinate_system_status;
+constexpr std::array kCsSystemBits{
+    Named{"ShutdownStatus", css::ShutdownStatus}, Named{"ReadyStatus", css::ReadyStatus},
+    Named{"MotionStatus", css::MotionStatus},     Named{"AxisInhibitStatus", css::AxisInhibitStatus},
+};
+
 constexpr std::array kCamMembers{Named{"Master", 0}, Named{"Slave", 1}, Named{"SegmentType", 2}};
 
 /// `name[index]` -> name and index; nullopt when `base` is not of that form.
@@ -199,6 +225,7 @@ std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* erro
                    : fmt::format("no cam profile named '{}'", base.substr(0, br));
     return std::nullopt;
   }
+  if (const auto cs = c_.coordinate_system_id(base)) return resolve_coordinate_system(*cs, base, member, error);
   for (std::size_t a = 0; a < c_.axis_count(); ++a) {
     if (!iequals(c_.axis_name(static_cast<motion::AxisId>(a)), base)) continue;
     const auto id = static_cast<std::uint16_t>(a);
@@ -235,8 +262,43 @@ std::optional<TagRef> TagTable::resolve(std::string_view name, std::string* erro
   return std::nullopt;
 }
 
+std::optional<TagRef> TagTable::resolve_coordinate_system(motion::CoordSystemId cs, std::string_view base,
+                                                         std::string_view member, std::string* error) const {
+  const int dim = c_.spec().coordinate_systems.at(cs).config.dim;
+  if (const auto si = split_index(member)) {
+    const Named* n = find(kCsAttrs, si->first);
+    if (n && (n->value == kCsActualPosition || n->value == kCsCommandPosition)) {
+      if (si->second < static_cast<std::uint32_t>(dim)) return TagRef{TagRef::Kind::kCoordSystem, cs, n->value, false, si->second};
+      if (error) *error = fmt::format("{}.{}: coordinate system '{}' has {} axes ([0] .. [{}])", base, member, base, dim, dim - 1);
+      return std::nullopt;
+    }
+  } else if (const Named* n = find(kCsAttrs, member); n && n->value != kCsActualPosition && n->value != kCsCommandPosition) {
+    return TagRef{TagRef::Kind::kCoordSystem, cs, n->value, false};
+  }
+  if (const Named* n = find(kCsMotionBits, member)) return TagRef{TagRef::Kind::kCoordMotionBit, cs, n->value, false};
+  if (const Named* n = find(kCsSystemBits, member)) return TagRef{TagRef::Kind::kCoordSystemBit, cs, n->value, false};
+  if (error)
+    *error = fmt::format("coordinate system '{}' has no member '{}'; members: CoordinateSystemStatus, "
+                         "CoordinateMotionStatus, ActualPosition[i], CommandPosition[i], Speed, and each status bit "
+                         "by name (e.g. MoveStatus, MovePendingStatus, ReadyStatus)",
+                         base, member);
+  return std::nullopt;
+}
+
 double TagTable::read(const Status& s, const TagRef& t) const {
   switch (t.kind) {
+    case TagRef::Kind::kCoordMotionBit: return (s.systems[t.index].motion_status >> t.member) & 1u;
+    case TagRef::Kind::kCoordSystemBit: return (s.systems[t.index].system_status >> t.member) & 1u;
+    case TagRef::Kind::kCoordSystem: {
+      const motion::CoordSystemTag& c = s.systems[t.index];
+      switch (t.member) {
+        case kCsSystemStatus: return c.system_status;
+        case kCsMotionStatus: return c.motion_status;
+        case kCsActualPosition: return c.actual_position[t.element];
+        case kCsCommandPosition: return c.command_position[t.element];
+        default: return c.speed;
+      }
+    }
     case TagRef::Kind::kUser: return 0.0;  // read through the name (see read(s, name))
     case TagRef::Kind::kCamStatus: return s.cam_status[t.index];
     case TagRef::Kind::kCamPoint: {

@@ -15,6 +15,9 @@
 ///   cam1[0].Status    (CAM_PROFILE status: 0 not calculated, 2 calculated, n in use by n-2 cams)
 ///   pts[i].Master  pts[i].Slave  pts[i].SegmentType   (CAM arrays of `arrays:`, read/write)
 ///   ed[i]             (REAL arrays of `arrays:`, read/write; MAM EventDistance / CalculatedData)
+///   CS.CoordinateSystemStatus  CS.CoordinateMotionStatus  CS.<status bit> (each bit of
+///   both words by name, e.g. CS.MoveStatus, CS.ReadyStatus)  CS.ActualPosition[i]
+///   CS.CommandPosition[i]  CS.Speed   (COORDINATE_SYSTEM tags of `coordinate_systems:`)
 ///   Controller.Cycle  Controller.Time  and the statistics the owner registers
 ///   user numeric tags (created by `tag := value;`)
 ///
@@ -36,13 +39,14 @@ namespace canmotion::rt {
 /// A resolved tag.
 struct TagRef {
   enum class Kind : std::uint8_t { kAxis, kMotionBit, kAxisStatusBit, kAxisFaultBit, kControl, kControlFlag, kController, kUser, kCamStatus,
-                                   kCamPoint, kRealElement };
+                                   kCamPoint, kRealElement, kCoordSystem, kCoordMotionBit, kCoordSystemBit };
   Kind kind = Kind::kAxis;
   std::uint16_t index = 0;  ///< axis id, control id, or statistic/user slot
   std::uint8_t member = 0;  ///< attribute number, bit number or member number
   bool writable = false;
   /// kCamPoint: element index (index = CAM array id, member 0 Master / 1 Slave /
-  /// 2 SegmentType); kRealElement: position in Status::real_values.
+  /// 2 SegmentType); kRealElement: position in Status::real_values;
+  /// kCoordSystem ActualPosition[i] / CommandPosition[i]: i.
   std::uint32_t element = 0;
 };
 
@@ -81,6 +85,9 @@ class TagTable {
   static std::vector<std::string_view> axis_members();
 
  private:
+  std::optional<TagRef> resolve_coordinate_system(motion::CoordSystemId cs, std::string_view base,
+                                                  std::string_view member, std::string* error) const;
+
   Controller& c_;
   std::map<std::string, double, std::less<>> user_;  // lower-case name -> value
   std::vector<std::pair<std::string, std::function<double()>>> stats_;
