@@ -65,6 +65,11 @@ struct Bench {
   void exec(const std::string& text) {
     if (p->execute(req(text)) != Err::None) throw std::runtime_error("refused: " + text);
   }
+  /// The coordinate system moves (MoveStatus): the state a benchmark measures.
+  void require_moving() {
+    if (!(p->coordinate_system(0).speed > 0) || !((p->coordinate_system(0).motion_status >> coordinate_motion_status::MoveStatus) & 1u))
+      throw std::runtime_error("bench setup: the coordinate system does not move");
+  }
   void step() {
     Input in{++cycle, {}, {}};
     Output o{std::span<AxisOutput>(out)};
@@ -85,6 +90,7 @@ void BM_UpdateLine3Axes(benchmark::State& st) {
   Bench b;
   b.exec(kLine);
   for (int i = 0; i < 2000; ++i) b.step();  // cruising
+  b.require_moving();
   for (auto _ : st) b.step();
 }
 BENCHMARK(BM_UpdateLine3Axes);
@@ -96,6 +102,7 @@ void BM_UpdateArc3Axes(benchmark::State& st) {
   b.exec("MCCM(cs, c1, 1, mid, center, via, clockwisefull, 50, unitspersec, 1000, unitspersec2, 1000, unitspersec2,"
          " scurve, 1e5, 1e5, unitspersec3, nosettle, disabled, programmed, 0, 0, none, 0, 0);");
   for (int i = 0; i < 2000; ++i) b.step();
+  b.require_moving();
   for (auto _ : st) b.step();
 }
 BENCHMARK(BM_UpdateArc3Axes);
