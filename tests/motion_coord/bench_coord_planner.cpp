@@ -8,6 +8,9 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -67,7 +70,12 @@ struct Bench {
   }
   /// The coordinate system moves (MoveStatus): the state a benchmark measures.
   void require_moving() {
-    if (!(p->coordinate_system(0).speed > 0) || !((p->coordinate_system(0).motion_status >> coordinate_motion_status::MoveStatus) & 1u))
+    const CoordSystemTag& t = p->coordinate_system(0);
+    const auto p0 = t.command_position;
+    step();
+    const double d = std::hypot(t.command_position[0] - p0[0], t.command_position[1] - p0[1], t.command_position[2] - p0[2]);
+    if (std::getenv("BENCH_SHOW") || !(d > 0.9 * t.speed * 0.001)) std::fprintf(stderr, "speed %g, moved %g in a cycle, at (%g, %g)\n", t.speed, d, t.command_position[0], t.command_position[1]);
+    if (!(t.speed > 0) || !((t.motion_status >> coordinate_motion_status::MoveStatus) & 1u) || !(d > 0.9 * t.speed * 0.001))
       throw std::runtime_error("bench setup: the coordinate system does not move");
   }
   void step() {
