@@ -517,6 +517,21 @@ TEST(CoordInstr, NoAllocationInTheCycleOrTheInstructions) {
   EXPECT_TRUE(r.p->check_incremental_state());
 }
 
+TEST(CoordInstr, EventDistanceGivesCalculatedData) {
+  CoordRig r;
+  r.add_array("ed", 2);
+  r.add_array("cd", 2);
+  r.set("ed", 0, 10);  // the whole move; 10 units before its end
+  r.set("p1", 100, 0);
+  ASSERT_EQ(r.exec("MCLM(cs, m1, 0, p1, 100, unitspersec, 1000, unitspersec2, 1000, unitspersec2, trapezoidal, 0, 0,"
+                   " unitspersec3, nosettle, disabled, programmed, 0, 0, none, ed, cd);"),
+            Err::None);
+  EXPECT_TRUE(r.tag("m1").get(flag::CalculatedDataAvailable));
+  const auto& cd = r.arrays[r.sym.real_arrays.at("cd")];
+  EXPECT_NEAR(cd[0], 1.1, 1e-9);  // 100 units at 100/s with 0.1 s ramps: 1.1 s
+  EXPECT_NEAR(cd[1], 0.95, 1e-9);  // 10 units before the end: 5 of cruise (0.05 s) before the 0.1 s decel ramp
+}
+
 TEST(CoordInstr, UnconfiguredSystemGivesErr11) {
   CoordRig r;
   r.sym.coordinate_systems["nocs"] = 5;
