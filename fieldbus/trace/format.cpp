@@ -295,6 +295,26 @@ void describe_pdo(const Decoded& d, fmt::memory_buffer& out) {
 
 }  // namespace
 
+void append_emcy(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register) {
+  fmt::format_to(fmt::appender(out), "0x{:04X} {}; error register 0x{:02X}", code, co::emcy_code_text(code),
+                 error_register);
+  if (error_register == 0) return;
+  put(out, " (");
+  bool first = true;
+  for (unsigned b = 0; b < 8; ++b) {
+    if ((error_register & (1U << b)) == 0) continue;
+    if (!first) put(out, ", ");
+    first = false;
+    put(out, co::error_register_bit_name(b));
+  }
+  put(out, ")");
+}
+
+void append_emcy_json(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register) {
+  fmt::format_to(fmt::appender(out), ",\"code\":{},\"error_register\":{},\"text\":", code, error_register);
+  append_json_string(out, co::emcy_code_text(code));
+}
+
 std::string_view statusword_state_name(std::uint16_t statusword) noexcept {
   return cia402::state_name(cia402::decode_state(statusword));
 }
@@ -413,20 +433,8 @@ void format_description(const Decoded& d, fmt::memory_buffer& out) {
       put(out, "TIME stamp");
       break;
     case EventKind::kEmcy:
-      fmt::format_to(fmt::appender(out), "EMCY node {}: 0x{:04X} {}; error register 0x{:02X}", d.node, d.emcy_code,
-                     co::emcy_code_text(d.emcy_code),
-                     d.emcy_register);
-      if (d.emcy_register != 0) {
-        put(out, " (");
-        bool first = true;
-        for (unsigned b = 0; b < 8; ++b) {
-          if ((d.emcy_register & (1U << b)) == 0) continue;
-          if (!first) put(out, ", ");
-          first = false;
-          put(out, co::error_register_bit_name(b));
-        }
-        put(out, ")");
-      }
+      fmt::format_to(fmt::appender(out), "EMCY node {}: ", d.node);
+      append_emcy(out, d.emcy_code, d.emcy_register);
       if (d.emcy_vendor != std::array<std::uint8_t, 5>{}) {
         put(out, "; vendor");
         for (std::uint8_t b : d.emcy_vendor) {
@@ -529,8 +537,7 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
       if (d.sync_has_counter) fmt::format_to(fmt::appender(out), ",\"counter\":{}", d.sync_counter);
       break;
     case EventKind::kEmcy:
-      fmt::format_to(fmt::appender(out), ",\"code\":{},\"error_register\":{},\"text\":", d.emcy_code, d.emcy_register);
-      append_json_string(out, co::emcy_code_text(d.emcy_code));
+      append_emcy_json(out, d.emcy_code, d.emcy_register);
       break;
     case EventKind::kBootUp:
     case EventKind::kHeartbeat:

@@ -35,6 +35,13 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
 /// Append `s` as a JSON string literal (quotes, escapes).
 void append_json_string(fmt::memory_buffer& out, std::string_view s);
 
+/// An EMCY's code and error register as text, the one rendering for the
+/// decoded line and the report: "0x2310 Continuous over-current; error
+/// register 0x03 (generic, current)" (the bit list only when a bit is set).
+void append_emcy(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register);
+/// The same as JSON members: `,"code":N,"error_register":N,"text":"..."`.
+void append_emcy_json(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register);
+
 /// "Operation enabled" etc. for a statusword.
 std::string_view statusword_state_name(std::uint16_t statusword) noexcept;
 /// "Enable operation" etc. for a controlword.
