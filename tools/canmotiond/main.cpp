@@ -292,7 +292,7 @@ int run(const Options& o) {
     return 2;
   }
   for (const auto& w : cfg.warnings) fmt::print(stderr, "{}\n", w.str());
-  if (!o.write_dcf.empty()) return write_dcfs(cfg, o.write_dcf);  // nothing opened
+  if (!o.write_dcf.empty() && !o.check_args) return write_dcfs(cfg, o.write_dcf);  // nothing opened
   {
     // Without drive.eds the master cannot know which optional objects a drive has: say once what it does.
     std::vector<std::string> blind;
@@ -546,7 +546,7 @@ int main(int argc, char** argv) {
   app.footer(
       "Examples:\n"
       "  canmotiond --config config/examples/demo.yaml --sim --script config/examples/demo.script\n"
-      "  canmotiond --config machine.yaml --write-dcf dcf/\n"
+      "  canmotiond --config config/examples/demo.yaml --write-dcf dcf/\n"
       "  canmotiond --config /etc/canmotion/canmotiond.yaml --stats\n"
       "Exit status: 0 ok, 1 run-time failure (script failed, bus error), 2 bad configuration or arguments.");
   try {
