@@ -7,9 +7,10 @@
 #    moves; the trace shows no SDO download to an object its EDS lacks;
 # 3. --write-dcf writes one DCF per node that our own reader parses back
 #    (cia402-emu --eds ... --check-args).
-# Usage: eds-daemon-test.sh CANMOTIOND CIA402_EMU EXAMPLES_DIR WORKDIR
+# 4. cantrace --eds names node 2's objects by the EDS.
+# Usage: eds-daemon-test.sh CANMOTIOND CIA402_EMU EXAMPLES_DIR WORKDIR CANTRACE
 set -uo pipefail
-bin="$1" emu="$2" ex="$3" work="$4"
+bin="$1" emu="$2" ex="$3" work="$4" cantrace="$5"
 here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$work"; mkdir -p "$work"
 fail() { echo "eds-daemon-test: FAIL: $*" >&2; exit 1; }
@@ -69,4 +70,9 @@ out=$("$bin" --config "$work/ok.yaml" --write-dcf "$work/dcf" 2>&1); rc=$?
 grep -q '^NodeId=2$' "$work/dcf/X.dcf" || fail "DCF without NodeId=2"
 grep -q '^\[1016' "$work/dcf/X.dcf" && fail "the DCF has 0x1016, which the master does not write"
 "$emu" -i vcan0 -n 2 --eds "$work/dcf/X.dcf" --check-args >/dev/null || fail "the DCF does not parse back"
-echo "eds-daemon-test: refusal before any frame (exit 2), minimal drive moved without writing absent objects, DCF parses back"
+# 4. A vendor's name in the EDS shows in cantrace; without --eds, CiA 402's.
+sed 's/^ParameterName=Modes of operation$/ParameterName=Betriebsart/' "$ex/minimal-drive.eds" > "$work/vendor.eds"
+"$cantrace" --eds 2="$work/vendor.eds" "$work/ok.log" | grep -q 'SDO node 2 write 0x6060:00 Betriebsart = 8' ||
+  fail "cantrace --eds: no vendor name for 0x6060"
+"$cantrace" "$work/ok.log" | grep -q 'SDO node 2 write 0x6060:00 Modes of operation = 8' || fail "cantrace: no CiA 402 name"
+echo "eds-daemon-test: refusal before any frame (exit 2), minimal drive moved without writing absent objects, DCF parses back, cantrace names objects by the EDS"

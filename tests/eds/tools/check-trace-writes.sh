@@ -2,9 +2,10 @@
 # Every SDO download (initiate, client command 0x2n) to NODE in a candump -L
 # trace TRACE is to an index:sub that EDS has. Prints the objects written and
 # exits 1 naming the first one the EDS lacks (or when nothing was written).
-# Usage: check-trace-writes.sh TRACE EDS NODE
+# Usage: check-trace-writes.sh TRACE EDS NODE  (TRACE "-": $CANMOTION_TRACE)
 set -uo pipefail
 trace="$1" eds="$2" node="$3"
+[[ $trace == - ]] && trace="$CANMOTION_TRACE"  # the vcan runner's candump log
 id=$(printf '%03X' $((0x600 + node)))
 # The EDS's sub-objects: [XXXXsubN] sections, and [XXXX] sections with no sub-sections (VARs, sub 0).
 hexfn='function hex(s,  i, n) { n = 0; s = toupper(s); for (i = 1; i <= length(s); i++) n = n * 16 + index("0123456789ABCDEF", substr(s, i, 1)) - 1; return n }'
