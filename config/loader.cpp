@@ -11,6 +11,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -20,6 +21,7 @@
 #include <fmt/format.h>
 
 #include "config/config.hpp"
+#include "config/eds_check.hpp"
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/object_names.hpp"
@@ -290,8 +292,16 @@ class Loader {
 
   void drive(const YAML::Node& n, const std::string& path, DriveSettings& d) {
     if (!check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
-                             "following_error_window", "sdo_writes"}))
+                             "following_error_window", "sdo_writes", "eds"}))
       return;
+    if (n["master_heartbeat_timeout_ms"]) d.master_heartbeat_timeout_set = true;
+    if (n["eds"] && string(n, path, "eds", d.eds)) {
+      // Relative to the YAML file's folder, like a vendor's EDS shipped beside the configuration.
+      const std::filesystem::path e(d.eds);
+      d.eds_path = e.is_absolute() ? e.string() : (std::filesystem::path(file_).parent_path() / e).lexically_normal().string();
+      d.eds_key = path + ".eds";
+      d.eds_where = loc(n["eds"]);
+    }
     if (n["timeouts"]) timeouts(n["timeouts"], path + ".timeouts", d.timeouts);
     enumeration(n, path, "pdo", d.pdo,
                 {{"csp", cia402::PdoProfile::kCsp}, {"csp_csv_cst", cia402::PdoProfile::kCspCsvCst}});
@@ -894,6 +904,10 @@ class Loader {
 
 Config finish(Loader& l, Config cfg) {
   l.cross_check(cfg);
+  // The drives' EDS files, once the configuration itself is valid (the check
+  // builds each drive's boot configuration from it).
+  if (std::none_of(l.diags.begin(), l.diags.end(), [](const Diagnostic& d) { return d.severity == Severity::kError; }))
+    check_drive_descriptions(cfg, l.diags);
   std::vector<Diagnostic> errors;
   for (auto& d : l.diags) {
     if (d.severity == Severity::kError) errors.push_back(d);

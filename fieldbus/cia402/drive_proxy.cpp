@@ -17,7 +17,7 @@ namespace {
 /// Aborts by which a drive says it has no such PDO (CiA 301: the
 /// communication or mapping object, or the sub-index, does not exist): fine
 /// for a PDO the master does not use.
-constexpr bool no_such_pdo(canopen::SdoAbort a) noexcept {
+constexpr bool no_such_object(canopen::SdoAbort a) noexcept {
   return a == canopen::SdoAbort::kNoObject || a == canopen::SdoAbort::kNoSubindex;
 }
 
@@ -49,6 +49,19 @@ int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key)
   return 0;
 }
 }  // namespace
+
+const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept {
+  switch (w.origin) {
+    case WriteOrigin::kInterpolationPeriod: return &hints.interpolation_period;
+    case WriteOrigin::kPdo: return &hints.pdo;
+    case WriteOrigin::kProducerHeartbeat: return &hints.producer_heartbeat;
+    case WriteOrigin::kConsumerHeartbeat: return &hints.consumer_heartbeat;
+    case WriteOrigin::kExtra: return w.extra < hints.extra.size() ? &hints.extra[w.extra] : nullptr;
+    case WriteOrigin::kMode:
+    case WriteOrigin::kUnusedPdo: return nullptr;
+  }
+  return nullptr;
+}
 
 // ============================================================================
 // Failure
@@ -200,7 +213,13 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
 
 void DriveProxy::build_configuration() {
   writes_.clear();
-  auto add = [this](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) { writes_.push_back(BootWrite{w, o, extra}); };
+  auto add = [this](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) {
+    const bool optional =
+        o == WriteOrigin::kUnusedPdo || (o == WriteOrigin::kConsumerHeartbeat && cfg_.consumer_heartbeat_optional);
+    // An optional write to an object the drive's EDS lacks is left out.
+    if (optional && cfg_.dictionary && cfg_.dictionary->has(w.index, w.sub) == canopen::Presence::kAbsent) return;
+    writes_.push_back(BootWrite{w, o, extra, optional});
+  };
   add(WriteOrigin::kMode,
       SdoWrite{obj::kModesOfOperation, 0, 1, static_cast<std::uint8_t>(static_cast<std::int8_t>(cfg_.mode))});
   const auto ip = *encode_interpolation_period(cfg_.cycle_ns);
@@ -418,8 +437,8 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
       while (sdo.poll(r)) {
         if (r.tag == kModeWriteTag) continue;
         const BootWrite* bw = r.tag < writes_.size() ? &writes_[r.tag] : nullptr;
-        if (!r.ok() && bw != nullptr && bw->origin == WriteOrigin::kUnusedPdo && no_such_pdo(r.abort)) {
-          ++tolerated_;  // the drive has fewer PDOs: fine for one we do not use
+        if (!r.ok() && bw != nullptr && bw->optional && no_such_object(r.abort)) {
+          ++tolerated_;  // the drive lacks an optional object (fewer PDOs than 4, no 0x1016)
         } else if (!r.ok()) {
           // Both times are on the cycle's clock (the response's receive stamp, or the timeout's cycle).
           const std::int64_t waited = r.finished_ns >= r.started_ns ? r.finished_ns - r.started_ns : now_ns - r.started_ns;
@@ -429,17 +448,7 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
           failure_.sdo_abort = static_cast<std::uint32_t>(r.abort);
           if (bw != nullptr) {
             failure_.sdo_origin = bw->origin;
-            const std::string* key = nullptr;
-            switch (bw->origin) {
-              case WriteOrigin::kInterpolationPeriod: key = &cfg_.hints.interpolation_period; break;
-              case WriteOrigin::kPdo: key = &cfg_.hints.pdo; break;
-              case WriteOrigin::kProducerHeartbeat: key = &cfg_.hints.producer_heartbeat; break;
-              case WriteOrigin::kConsumerHeartbeat: key = &cfg_.hints.consumer_heartbeat; break;
-              case WriteOrigin::kExtra:
-                if (bw->extra < cfg_.hints.extra.size()) key = &cfg_.hints.extra[bw->extra];
-                break;
-              default: break;
-            }
+            const std::string* key = write_hint_key(cfg_.hints, *bw);
             failure_.hint = key != nullptr && !key->empty() ? key->c_str() : nullptr;
           }
           sdo.cancel_all();

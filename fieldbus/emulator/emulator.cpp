@@ -69,12 +69,18 @@ void Emulator::add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, c
           value,
           text,
           0,
-          0};
-  const std::size_t size = canopen::data_type_size(e.type);
+          0,
+          false};
+  set_type(e, e.type);
+  od_.push_back(e);
+}
+
+void Emulator::set_type(Entry& e, canopen::DataType t) noexcept {
+  e.type = t;
+  const std::size_t size = canopen::data_type_size(t);
   const bool full = size >= 8 || size == 0;
   e.mask = full ? ~std::uint64_t{0} : (std::uint64_t{1} << (8 * size)) - 1;
-  e.sign = canopen::data_type_signed(e.type) && !full ? std::uint64_t{1} << (8 * size - 1) : 0;
-  od_.push_back(e);
+  e.sign = canopen::data_type_signed(t) && !full ? std::uint64_t{1} << (8 * size - 1) : 0;
 }
 
 void Emulator::build_dictionary() {
@@ -196,6 +202,7 @@ void Emulator::build_dictionary() {
     return std::find(cfg_.absent_objects.begin(), cfg_.absent_objects.end(), static_cast<std::uint16_t>(e.key >> 8)) !=
            cfg_.absent_objects.end();
   });
+  if (!cfg_.served.empty()) apply_served();  // a drive described by an EDS
   std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
   od_.shrink_to_fit();  // od_ never changes size after this: Entry pointers stay valid
   rebuild_pdos();
@@ -205,6 +212,7 @@ std::vector<Emulator::ObjectDescription> Emulator::dictionary() const {
   std::vector<ObjectDescription> d;
   d.reserve(od_.size());
   for (const Entry& e : od_) {
+    if (e.hidden) continue;
     d.push_back(ObjectDescription{static_cast<std::uint16_t>(e.key >> 8), static_cast<std::uint8_t>(e.key & 0xFF), e.type,
                                   e.access, e.pdo, e.default_value,
                                   e.text != nullptr ? std::string_view(*e.text) : std::string_view{}});
@@ -283,7 +291,9 @@ const Emulator::Entry* Emulator::find(std::uint16_t index, std::uint8_t sub) con
 bool Emulator::index_exists(std::uint16_t index) const noexcept {
   const std::uint32_t k = key(index, 0);
   auto it = std::lower_bound(od_.begin(), od_.end(), k, [](const Entry& e, std::uint32_t kk) { return e.key < kk; });
-  return it != od_.end() && (it->key >> 8) == index;
+  for (; it != od_.end() && (it->key >> 8) == index; ++it)
+    if (!it->hidden) return true;
+  return false;
 }
 std::uint64_t Emulator::get(std::uint16_t index, std::uint8_t sub) const noexcept {
   const Entry* e = find(index, sub);
@@ -327,7 +337,7 @@ void Emulator::rebuild_pdos() noexcept {
         m.add(e.index, e.sub, e.bits);
       }
       const bool ok = m.finalize();
-      const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0 && find(comm, 1) != nullptr;
+      const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0 && served(comm, 1) != nullptr;
       auto& cache = rx ? rpdo_entries_[p] : tpdo_entries_[p];
       cache = {};
       for (std::uint8_t i = 0; i < m.count; ++i) {
@@ -388,7 +398,7 @@ SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::u
   if (get(index, 0) != 0) return SdoAbort::kDeviceState;  // sub0 must be 0 while entries change
   if (v == 0) return SdoAbort::kNone;
   const auto e = canopen::decode_mapping_entry(static_cast<std::uint32_t>(v));
-  const Entry* target = find(e.index, e.sub);
+  const Entry* target = served(e.index, e.sub);
   if (target == nullptr) return index_exists(e.index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
   const bool mappable = rx ? (target->pdo == canopen::PdoMappable::kRpdo || target->pdo == canopen::PdoMappable::kBoth)
                            : (target->pdo == canopen::PdoMappable::kTpdo || target->pdo == canopen::PdoMappable::kBoth);
@@ -398,7 +408,7 @@ SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::u
 }
 
 SdoAbort Emulator::sdo_read(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> out, std::size_t& len) noexcept {
-  const Entry* e = find(index, sub);
+  const Entry* e = served(index, sub);
   if (e == nullptr) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
   if (e->access == canopen::Access::kWo) return SdoAbort::kWriteOnly;
   if (e->text != nullptr) {
@@ -415,7 +425,7 @@ SdoAbort Emulator::sdo_read(std::uint16_t index, std::uint8_t sub, std::span<std
 
 SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data) noexcept {
   Entry* e = find(index, sub);
-  if (e == nullptr) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
+  if (e == nullptr || e->hidden) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
   if (e->access == canopen::Access::kRo || e->access == canopen::Access::kConst) return SdoAbort::kReadOnly;
   const std::size_t n = canopen::data_type_size(e->type);
   if (data.size() > n) return SdoAbort::kLengthTooHigh;

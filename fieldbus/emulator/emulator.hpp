@@ -46,6 +46,18 @@ enum class HeartbeatLossReaction : std::uint8_t {
   kNone,       ///< only the EMCY 0x8130
 };
 
+/// One sub-object of the set an emulated drive serves (EmulatorConfig::served),
+/// e.g. from a vendor's EDS (eds_dictionary.hpp).
+struct ServedObject {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  canopen::DataType type = canopen::DataType::kUnsigned32;
+  canopen::Access access = canopen::Access::kRw;
+  canopen::PdoMappable pdo = canopen::PdoMappable::kNo;
+  bool has_default = false;
+  std::uint64_t default_value = 0;  ///< raw bits (the node-ID already added)
+};
+
 struct EmulatorConfig {
   std::uint8_t node = 2;
   std::string device_name = "canmotion cia402-emu: emulated CiA 402 servo drive";  ///< 0x1008 (segmented SDO)
@@ -72,6 +84,13 @@ struct EmulatorConfig {
   /// 0x06020000 (object does not exist), as on a real drive without them.
   /// A PDO whose communication object is absent is never valid.
   std::vector<std::uint16_t> absent_objects;
+  /// Not empty (cia402-emu --eds): the drive serves exactly these
+  /// sub-objects over SDO and PDO mapping, with their access, PDO mapping
+  /// flags and defaults. Its own objects not listed abort 0x06020000 /
+  /// 0x06090011 and cannot be mapped (the behaviour behind them stays, e.g.
+  /// the EMCY COB-ID from 0x1014's default); listed numbers it does not know
+  /// are plain storage; strings and domains it does not know are left out.
+  std::vector<ServedObject> served;
   // Load model of CST (see README "Motor and load model"): motor torque T
   // (per mille of rated torque, 0x6071 clamped to 0x6072) accelerates the
   // motor by (T - load_torque - viscous_friction * v) / 1000 * rated_torque_acceleration.
@@ -194,6 +213,7 @@ class Emulator final : public canopen::SdoServerBackend {
     const std::string* text;  // strings (0x1008...)
     std::uint64_t mask;       // the value bits of the type's size (put; all bits for 0 or 8 bytes)
     std::uint64_t sign;       // the sign bit of a signed type shorter than 8 bytes, else 0 (sval)
+    bool hidden = false;      // not in EmulatorConfig::served: used inside, not served (SDO, PDO mapping)
   };
   /// Entries the SYNC / frame path touches, resolved once after the
   /// dictionary is built (od_ never grows or reallocates afterwards, so the
@@ -267,6 +287,10 @@ class Emulator final : public canopen::SdoServerBackend {
   void reset_dictionary(bool communication_only) noexcept;
   canopen::SdoAbort check_pdo_write(std::uint16_t index, std::uint8_t sub, std::uint64_t v) const noexcept;
   void rebuild_pdos() noexcept;
+  // eds_dictionary.cpp: EmulatorConfig::served applied to the built dictionary.
+  void apply_served();
+  static void set_type(Entry& e, canopen::DataType t) noexcept;  // type, mask and sign
+  [[nodiscard]] const Entry* served(std::uint16_t index, std::uint8_t sub) const noexcept;  // nullptr: absent or hidden
 
   void handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::FrameSink& out) noexcept;
   void handle_sync(std::int64_t now_ns, canopen::FrameSink& out) noexcept;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -17,9 +18,12 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "config/config.hpp"
+#include "config/eds_check.hpp"
 #include "config/runtime.hpp"
+#include "fieldbus/eds/dcf.hpp"
 #include "fieldbus/can/candump_format.hpp"
 #include "fieldbus/canopen/emcy.hpp"
 #include "rt/clock.hpp"
@@ -50,7 +54,43 @@ struct Options {
   bool quiet = false;
   double sim_rate = -1;  // --sim-rate; < 0 = default (1 with --socket, else 0 = flat out)
   bool check_args = false;  // --check-args: parse and validate, then exit (tests/docs)
+  std::string write_dcf;    // --write-dcf DIR: one DCF per node of the boot writes, then exit
 };
+
+/// --write-dcf: DIR/<axis>.dcf per CIP axis, the SDO writes of its boot
+/// configuration (config::boot_writes, the proxy's own list). 0, or 1 when a
+/// file cannot be written.
+int write_dcfs(const config::Config& cfg, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  for (std::size_t i = 0; i < cfg.axes.size(); ++i) {
+    const config::AxisSettings& a = cfg.axes[i];
+    const config::BusSettings* bus = cfg.find_bus(a.bus);
+    if (a.axis.type != motion::AxisType::CipDrive || bus == nullptr) continue;
+    const std::vector<cia402::BootWrite> writes = config::boot_writes(a, *bus, cfg.controller.period_s, i);
+    const cia402::DriveConfig dc = config::drive_config(a, *bus, cfg.controller.period_s, i);
+    eds::DcfSpec spec;
+    spec.node_id = a.node;
+    spec.baudrate_kbit = static_cast<std::uint16_t>(bus->bitrate / 1000);
+    spec.node_name = a.name;
+    spec.eds = a.drive.eds_data.get();
+    for (const cia402::BootWrite& w : writes) {
+      const std::string* key = cia402::write_hint_key(dc.hints, w);
+      spec.writes.push_back({w.w.index, w.w.sub, w.w.size, w.w.value, key != nullptr ? *key : std::string()});
+    }
+    const std::string path = (std::filesystem::path(dir) / (a.name + ".dcf")).string();
+    std::ofstream f(path);
+    f << eds::format_dcf(spec);
+    f.close();
+    if (!f) {
+      fmt::print(stderr, "canmotiond: --write-dcf: cannot write {}\n", path);
+      return 1;
+    }
+    fmt::print("canmotiond: {}: node {}, {} boot writes{}\n", path, a.node, writes.size(),
+               a.drive.eds.empty() ? "" : " (checked against " + a.drive.eds + ")");
+  }
+  return 0;
+}
 
 /// Writes the trace and CSV files and prints events; drained from the
 /// controller's rings on a non-RT thread (or inline in --sim).
@@ -255,6 +295,19 @@ config::Config load_config(const Options& o) {
     throw Exit{2};
   }
   for (const auto& w : cfg.warnings) fmt::print(stderr, "{}\n", w.str());
+  if (!o.write_dcf.empty() && !o.check_args) throw Exit{write_dcfs(cfg, o.write_dcf)};  // nothing opened
+  {
+    // Without drive.eds the master cannot know which optional objects a drive has: say once what it does.
+    std::vector<std::string> blind;
+    for (const auto& a : cfg.axes)
+      if (a.axis.type == motion::AxisType::CipDrive && a.drive.eds.empty()) blind.push_back(a.name);
+    if (!blind.empty() && !o.quiet)
+      fmt::print(stderr,
+                 "canmotiond: axes without drive.eds ({}): optional objects (PDOs not used, 0x1016 when "
+                 "master_heartbeat_timeout_ms is not set) are written anyway, and a drive without them (SDO abort "
+                 "0x06020000 / 0x06090011) is accepted\n",
+                 fmt::join(blind, ", "));
+  }
   return cfg;
 }
 
@@ -551,9 +604,13 @@ int main(int argc, char** argv) {
   app.add_flag("--check-args", o.check_args,
                "parse the arguments, load and check the configuration and the --script, then exit (0 = valid); "
                "opens no bus or socket");
+  app.add_option("--write-dcf", o.write_dcf,
+                 "write DIR/<axis>.dcf per CANopen axis: the SDO writes of its boot configuration (PDOs, 0x60C2, "
+                 "heartbeats, sdo_writes) as a CiA 306 DCF for review, then exit; opens no bus");
   app.footer(
       "Examples:\n"
       "  canmotiond --config config/examples/demo.yaml --sim --script config/examples/demo.script\n"
+      "  canmotiond --config config/examples/demo.yaml --write-dcf dcf/\n"
       "  canmotiond --config /etc/canmotion/canmotiond.yaml --stats\n"
       "Exit status: 0 ok, 1 run-time failure (script failed, bus error), 2 bad configuration or arguments.");
   try {

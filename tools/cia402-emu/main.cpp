@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,8 @@
 #include "fieldbus/canopen/frame_sink.hpp"
 #include "fieldbus/canopen/nmt.hpp"
 #include "fieldbus/cia402/cia402.hpp"
+#include "fieldbus/eds/eds.hpp"
+#include "fieldbus/emulator/eds_dictionary.hpp"
 #include "fieldbus/emulator/emulator.hpp"
 
 using namespace canmotion;
@@ -49,6 +52,9 @@ constexpr const char* kFooter = R"(Examples:
       0x6061 never follows 0x6060: the master's mode-switch timeout fires
   cia402-emu -i vcan0 -n 2 --without-object 0x1016 --without-object 0x1403 --without-object 0x1603
       a drive without the optional 0x1016 and without RPDO4 (SDO aborts 0x06020000)
+  cia402-emu -i vcan0 -n 2 --eds config/examples/minimal-drive.eds
+      a drive with exactly the objects of that EDS (no 0x1016, 2 RPDOs, 2 TPDOs),
+      its PDO mapping flags, access types and defaults
 
 The drive waits in NMT pre-operational until a master configures it over SDO
 and starts it (NMT 0x000 01 <node>). It sends its TPDOs on each SYNC (0x080)
@@ -106,6 +112,11 @@ int main(int argc, char** argv) {
   app.add_option("--without-object", absent,
                  "emulate a drive without this object (index, e.g. 0x1016); SDO access aborts with 0x06020000; repeat "
                  "for several");
+  std::string eds_file;
+  app.add_option("--eds", eds_file,
+                 "serve exactly the objects of this EDS or DCF (CiA 306): absent objects abort 0x06020000, PDO "
+                 "counts, mapping flags, access types and defaults from the file")
+      ->check(CLI::ExistingFile);
   app.add_option("--duration", duration, "exit after this many seconds (0 = run until SIGINT/SIGTERM)");
   app.add_flag("-v,--verbose", verbose, "print NMT and CiA 402 state changes");
   bool check_args = false;
@@ -138,6 +149,15 @@ int main(int argc, char** argv) {
       return 1;
     }
     absent_objects.push_back(static_cast<std::uint16_t>(v));
+  }
+  std::optional<eds::Eds> description;
+  if (!eds_file.empty()) {
+    try {
+      description = eds::load(eds_file);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "cia402-emu: --eds: %s\n", e.what());
+      return 1;
+    }
   }
   for (std::size_t i = 0; i < nodes.size(); ++i)
     for (std::size_t j = i + 1; j < nodes.size(); ++j)
@@ -172,6 +192,7 @@ int main(int argc, char** argv) {
     c.viscous_friction = viscous;
     c.refuse_mode_switch = refuse_mode;
     c.absent_objects = absent_objects;
+    if (description) c.served = emulator::served_objects(*description, c.node);
     c.heartbeat_loss_reaction = hb_reaction == "fault"       ? emulator::HeartbeatLossReaction::kFault
                                 : hb_reaction == "quickstop" ? emulator::HeartbeatLossReaction::kQuickStop
                                                              : emulator::HeartbeatLossReaction::kNone;
