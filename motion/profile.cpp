@@ -233,13 +233,43 @@ double closed_form_peak(double v0, const Limits& lim, double R, double vlo, doub
   return vp;
 }
 
+/// Overshoot::StopAtTarget from a state that cannot stop at the target with
+/// `lim` (or whose braking acceleration the decel jerk cannot ramp out before
+/// the velocity reaches zero): stop with decel, accel and both jerks scaled up
+/// by the smallest k >= 1 that neither reverses nor passes the target (Rabs
+/// ahead in direction sg). True when even that stop ends short of the target
+/// (a braking acceleration that cannot be ramped out): the caller goes on
+/// from rest with the programmed limits; ending the profile there would leave
+/// the rest to its final sample, a jump to the target.
+template <class B>
+bool stop_on_target(B& b, const Limits& lim, double sg, double Rabs) noexcept {
+  const double vrel = sg * b.v, arel = sg * b.a;
+  auto stop_dist = [&](const Limits& l) noexcept {
+    Sim s = b.sim();
+    vel_change_lim(s, 0.0, l, sg);
+    return sg * (s.x - b.x);
+  };
+  auto reverses = [&](double jd) noexcept { return arel < 0 && vrel - arel * arel / (2 * jd) < 0; };
+  double lo = 0.0, hi = std::log(1e9);  // log k
+  for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
+    const double mid = (lo + hi) / 2;
+    const Limits l = scaled(lim, std::exp(mid));
+    if (reverses(l.jd) || stop_dist(l) > Rabs) lo = mid; else hi = mid;
+  }
+  const Limits k_lim = scaled(lim, std::exp(hi));
+  const bool short_stop = reverses(lim.jd) && stop_dist(k_lim) < Rabs * (1 - 1e-12);
+  vel_change_lim(b, 0.0, k_lim, sg);
+  return short_stop;
+}
+
 }  // namespace
 
 bool plan_move(Profile& out, const Kin& start, double distance, const Limits& lim, Overshoot policy) noexcept {
   if (!limits_valid(lim) || !kin_valid(start) || !std::isfinite(distance)) return false;
   ProfileBuilder b(out, start);
   const double X = distance;
-  for (int pass = 0; pass < 3; ++pass) {
+  // passes: brake away-going motion; a short stop (StopAtTarget); the move
+  for (int pass = 0; pass < 4; ++pass) {
     const double R = X - b.x;
     double sg = sgn(R);
     if (sg == 0) sg = b.v != 0 ? sgn(b.v) : sgn(b.a);
@@ -265,15 +295,7 @@ bool plan_move(Profile& out, const Kin& start, double distance, const Limits& li
         vel_change_lim(b, 0.0, lim, sg);
         continue;
       }
-      // Stop exactly on target: scale decel (and jerk) up by the smallest k >= 1
-      // that neither reverses nor passes the target.
-      double lo = 0.0, hi = std::log(1e9);  // log k
-      for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
-        const double mid = (lo + hi) / 2;
-        const Limits l = scaled(lim, std::exp(mid));
-        if (reverses(l.jd) || stop_dist(l) > Rabs) lo = mid; else hi = mid;
-      }
-      vel_change_lim(b, 0.0, scaled(lim, std::exp(hi)), sg);
+      if (stop_on_target(b, lim, sg, Rabs)) continue;  // stopped short: on from rest
       break;
     }
     auto f = [&](double vp) noexcept {
