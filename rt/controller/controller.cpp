@@ -325,6 +325,8 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
       } else {
         (void)planner_.set_direct_command(id, c.value);
       }
+    } else if (c.kind == Command::Kind::kControllerMode) {
+      planner_.set_controller_mode(c.value != 0.0 ? motion::ControllerMode::Program : motion::ControllerMode::Run);
     } else if (c.kind == Command::Kind::kEnableDrives) {
       for (auto& b : buses_) b.network->enable_all();
     } else if (c.kind == Command::Kind::kPreOperational && halt_ == Halt::kRunning) {
@@ -409,6 +411,7 @@ void Controller::publish(std::int64_t now_ns) noexcept {
   s.telemetry_dropped = telemetry_dropped_;
   s.commands_deferred = deferred_;
   s.halted = halt_ == Halt::kHalted;
+  s.mode = planner_.controller_mode();
   // Control tags handed out so far (requests can only name those).
   publish_nctl_ = controls_in_use_.load(std::memory_order_acquire);
   publish_pending_ = true;

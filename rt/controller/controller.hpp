@@ -127,6 +127,7 @@ struct Command {
                       ///< (direct_torque false) or DirectCommandTorque (true); no effect without an active MDS
     kWriteArray,    ///< a program writes one array element (Controller::write_array); applied in
                     ///< program order: never in the same cycle after an instruction
+    kControllerMode,  ///< Logix Run (value 0) / Program (1): Planner::set_controller_mode (issue 16)
   };
   Kind kind = Kind::kInstruction;
   motion::Request request{};
@@ -214,6 +215,7 @@ struct Status {
   std::uint64_t telemetry_dropped = 0;
   std::uint64_t commands_deferred = 0;  ///< cycles in which requests had to wait for the next cycle
   bool halted = false;  ///< after kPreOperational: nodes pre-operational, no PDO or SYNC sent any more
+  motion::ControllerMode mode = motion::ControllerMode::Run;  ///< kControllerMode
   /// CAM_PROFILE[0].Status of each cam profile (0 not calculated, 1 calculating,
   /// 2 calculated, n = in use by n - 2 cams).
   std::array<std::int32_t, motion::kMaxCamProfiles> cam_status{};

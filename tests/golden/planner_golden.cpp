@@ -36,8 +36,12 @@ using namespace canmotion::motion;
 namespace {
 
 /// The hash of the whole run on main before the refactor (6ff40ea, with the
-/// drives work of issue 12; first recorded on 94e8130 as 0xa59be6e40e5c199c).
-constexpr std::uint64_t kExpected = 0x717dc2ed1a35fc20ull;
+/// drives work of issue 12; first recorded on 94e8130 as 0xa59be6e40e5c199c),
+/// re-recorded for the issue 16 fidelity fixes (was 0x717dc2ed1a35fc20: MAG
+/// reversed pairs and UINT32 counts, MAS tune/test refused, MDAC reference
+/// change with another master, MATC pending mode/lock rules, exceptions
+/// breaking links, MCD modes, MDS SLAT, homing cancel resync).
+constexpr std::uint64_t kExpected = 0x5985f33de2b9a1acull;
 constexpr std::uint64_t kSeed = 13;
 constexpr int kRuns = 40;
 constexpr int kOpsPerRun = 90;
@@ -166,11 +170,13 @@ struct World {
     c.homing.sequence = HomingConfig::Sequence::Switch;
     c.homing.home_position = 10;
     c.max_torque = 500;
+    c.direct_control = true;  // the axis has direct_control: (MDS allowed since issue 16)
     AxisConfig d = a;  // CIP, CST direct mode, passive immediate homing, FastDisable
     d.type = AxisType::CipDrive;
     d.conversion_constant = 4096.0 / 360.0;
     d.direct_mode = AxisConfig::DirectMode::Torque;
     d.direct_velocity_command = 20;
+    d.direct_control = true;
     d.homing.mode = HomingConfig::Mode::Passive;
     d.programmed_stop_mode = ProgrammedStopMode::FastDisable;
     d.exception_actions = {ExceptionAction::Alarm, ExceptionAction::Shutdown, ExceptionAction::FaultStatusOnly,
