@@ -388,6 +388,7 @@ class Loader {
     motion::AxisConfig& c = a.axis;
     d.present = true;
     d.where = loc(n);
+    c.direct_control = true;  // MDS is validated (the drive's ramp attributes are configured) [seed 002]
     if (!check_map(n, path, {"mode", "max_torque", "velocity_command", "ramp", "slat"})) return;
     using DM = motion::AxisConfig::DirectMode;
     enumeration(n, path, "mode", c.direct_mode, {{"velocity", DM::Velocity}, {"torque", DM::Torque}});
@@ -431,6 +432,7 @@ class Loader {
                 fmt::format("{} units/s x conversion_constant {} does not fit 0x2021 (UNSIGNED32 counts/s)",
                             d.slat_set_point, conv));
         scalar(s, p, "time_delay_ms", d.slat_time_delay_ms, std::uint16_t{0}, std::uint16_t{65535}, "ms");
+        c.direct_slat = d.slat_configuration != 0;  // MDS's Speed is then the SLAT speed (velocity command)
         if (d.slat_configuration != 0 && c.direct_mode != DM::Torque)
           error(s["configuration"] ? s["configuration"] : s, p + ".configuration",
                 fmt::format("SLAT {} needs the direct command in torque: set {}.mode: torque (SLAT acts in CST)",

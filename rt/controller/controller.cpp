@@ -350,6 +350,8 @@ void Controller::take(const cmd::EnableDrives&, std::int64_t) noexcept {
   for (auto& b : buses_) b.network->enable_all();
 }
 
+void Controller::take(const cmd::ControllerMode& c, std::int64_t) noexcept { planner_.set_controller_mode(c.mode); }
+
 void Controller::take(const cmd::DirectCommand& c, std::int64_t) noexcept {
   if (c.axis >= spec_.axes.size()) return;
   // DirectCommandVelocity is the MDS command in velocity mode and the SLAT
@@ -448,6 +450,7 @@ void Controller::publish(std::int64_t now_ns) noexcept {
   s.telemetry_dropped = telemetry_dropped_;
   s.commands_deferred = deferred_;
   s.halted = halt_ == Halt::kHalted;
+  s.mode = planner_.controller_mode();
   // Control tags handed out so far (requests can only name those).
   publish_nctl_ = controls_in_use_.load(std::memory_order_acquire);
   publish_pending_ = true;

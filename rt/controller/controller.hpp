@@ -162,11 +162,15 @@ struct WriteArray {
   std::uint32_t element = 0;
   double value = 0.0;
 };
+/// Logix Run / Program mode (Planner::set_controller_mode, issue 16).
+struct ControllerMode {
+  motion::ControllerMode mode = motion::ControllerMode::Run;
+};
 }  // namespace cmd
 
 /// A command to the RT thread: one of the structs of `cmd`.
 using Command = std::variant<cmd::Instruction, cmd::ResetControl, cmd::EnableDrives, cmd::PreOperational,
-                             cmd::DirectCommand, cmd::WriteArray>;
+                             cmd::DirectCommand, cmd::WriteArray, cmd::ControllerMode>;
 static_assert(std::is_trivially_copyable_v<Command>, "a Command travels through an SPSC ring by copy");
 
 /// Something the RT thread reports. Trivially copyable.
@@ -240,6 +244,7 @@ struct Status {
   std::uint64_t telemetry_dropped = 0;
   std::uint64_t commands_deferred = 0;  ///< cycles in which requests had to wait for the next cycle
   bool halted = false;  ///< after cmd::PreOperational: nodes pre-operational, no PDO or SYNC sent any more
+  motion::ControllerMode mode = motion::ControllerMode::Run;  ///< cmd::ControllerMode (issue 16)
   /// CAM_PROFILE[0].Status of each cam profile (0 not calculated, 1 calculating,
   /// 2 calculated, n = in use by n - 2 cams).
   std::array<std::int32_t, motion::kMaxCamProfiles> cam_status{};
@@ -374,6 +379,7 @@ class Controller {
   void take(const cmd::PreOperational& c, std::int64_t now_ns) noexcept;
   void take(const cmd::DirectCommand& c, std::int64_t now_ns) noexcept;
   void take(const cmd::WriteArray& c, std::int64_t now_ns) noexcept;  ///< controller_arrays.cpp
+  void take(const cmd::ControllerMode& c, std::int64_t now_ns) noexcept;
   void publish(std::int64_t now_ns) noexcept;
   void finish_publish() const noexcept;  ///< the copies of publish() that read_status() may defer
   void record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noexcept;

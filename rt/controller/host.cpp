@@ -83,6 +83,13 @@ std::optional<std::string> ControllerHost::execute(std::string_view call, std::s
   return std::nullopt;
 }
 
+std::optional<std::string> ControllerHost::set_mode(motion::ControllerMode m) {
+  const std::uint64_t seq = c_.submit(cmd::ControllerMode{m});
+  if (seq == 0) return std::string("the command queue to the RT thread is full; try again");
+  last_seq_ = seq;
+  return std::nullopt;
+}
+
 const Status& ControllerHost::refresh() {
   c_.read_status(*status_);
   return *status_;
