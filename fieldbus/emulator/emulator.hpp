@@ -4,10 +4,12 @@
 /// and tools/cia402-emu. It has an object dictionary with the CiA 301
 /// communication objects and the CiA 402 objects the master uses, an SDO
 /// server with the right abort codes, an NMT slave with boot-up and heartbeat,
-/// PDO mapping changeable only over SDO as CiA 301 says, RPDOs applied at the
-/// next SYNC, TPDOs sent on each SYNC, the CiA 402 state machine (modes 6, 8,
+/// PDO mapping changeable only over SDO as CiA 301 says, RPDOs and TPDOs per
+/// their transmission type (CiA 301), the CiA 402 state machine (modes 6, 8,
 /// 9, 10) from the shared cia402.hpp, and a motor model that advances only on
 /// SYNC (by the 0x60C2 period) with limited velocity/acceleration and a lag.
+/// EmulatorBehaviour chooses between a strict drive (what real drives do)
+/// and a permissive one (README "Emulator profiles").
 ///
 /// Faults: following error beyond 0x6065 -> Fault + EMCY 0x8611; master
 /// heartbeat lost (0x1016) -> the configured reaction + EMCY 0x8130; writing
