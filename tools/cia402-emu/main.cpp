@@ -89,11 +89,24 @@ mapping and fault injection: see fieldbus/README.md.
 
 Exit status: 0 after SIGINT/SIGTERM or --duration, 1 on error.)";
 
-std::uint16_t parse_code(const std::string& s) {
+/// A whole string as an unsigned number (decimal, 0x hex or 0 octal); nullopt
+/// if it is not one.
+std::optional<unsigned long> parse_unsigned(const std::string& s) {
   std::size_t pos = 0;
-  const unsigned long v = std::stoul(s, &pos, 0);
-  if (pos != s.size() || v > 0xFFFF) throw CLI::ValidationError("--fail-code", "'" + s + "' is not a 16-bit EMCY code (e.g. 0x2310)");
-  return static_cast<std::uint16_t>(v);
+  unsigned long v = 0;
+  try {
+    v = std::stoul(s, &pos, 0);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (pos != s.size() || s.empty() || s[0] == '-') return std::nullopt;
+  return v;
+}
+
+std::uint16_t parse_code(const std::string& s) {
+  const std::optional<unsigned long> v = parse_unsigned(s);
+  if (!v || *v > 0xFFFF) throw CLI::ValidationError("--fail-code", "'" + s + "' is not a 16-bit EMCY code (e.g. 0x2310)");
+  return static_cast<std::uint16_t>(*v);
 }
 }  // namespace
 
@@ -195,19 +208,13 @@ int main(int argc, char** argv) {
   }
   std::vector<std::uint16_t> absent_objects;
   for (const std::string& a : absent) {
-    std::size_t pos = 0;
-    unsigned long v = 0;
-    try {
-      v = std::stoul(a, &pos, 0);
-    } catch (const std::exception&) {
-      pos = 0;
-    }
-    if (pos != a.size() || v < 0x1000 || v > 0xFFFF) {
+    const std::optional<unsigned long> v = parse_unsigned(a);
+    if (!v || *v < 0x1000 || *v > 0xFFFF) {
       std::fprintf(stderr, "cia402-emu: --without-object '%s' is not an object index 0x1000..0xFFFF (e.g. 0x1016)\n",
                    a.c_str());
       return 1;
     }
-    absent_objects.push_back(static_cast<std::uint16_t>(v));
+    absent_objects.push_back(static_cast<std::uint16_t>(*v));
   }
   std::optional<eds::Eds> description;
   if (!eds_file.empty()) {
@@ -240,19 +247,13 @@ int main(int argc, char** argv) {
   if (mode_switch_syncs) behaviour.mode_switch_syncs = *mode_switch_syncs;
   std::uint32_t modes_mask = emulator::EmulatorConfig{}.supported_modes;
   if (!supported_modes.empty()) {
-    std::size_t pos = 0;
-    unsigned long v = 0;
-    try {
-      v = std::stoul(supported_modes, &pos, 0);
-    } catch (const std::exception&) {
-      pos = 0;
-    }
-    if (pos != supported_modes.size() || v > 0xFFFFFFFFul) {
+    const std::optional<unsigned long> v = parse_unsigned(supported_modes);
+    if (!v || *v > 0xFFFFFFFFul) {
       std::fprintf(stderr, "cia402-emu: --supported-modes '%s' is not a 32-bit 0x6502 value (e.g. 0x3A0)\n",
                    supported_modes.c_str());
       return 1;
     }
-    modes_mask = static_cast<std::uint32_t>(v);
+    modes_mask = static_cast<std::uint32_t>(*v);
   }
   for (std::size_t i = 0; i < nodes.size(); ++i)
     for (std::size_t j = i + 1; j < nodes.size(); ++j)
