@@ -133,6 +133,7 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
 emulator::EmulatorConfig emulator_config(const AxisSettings& a) {
   emulator::EmulatorConfig e;
   e.node = a.node;
+  e.behaviour = emulator::EmulatorBehaviour::loop_default();  // --sim drives: strict but for two master gaps
   const double conv = a.axis.conversion_constant;
   // Give the model headroom over the axis's own limits, so that the emulated
   // drive follows any profile the planner may command.

@@ -54,6 +54,7 @@ struct SimController {
     spec.cams.push_back(cam);
     emulator::EmulatorConfig ec;
     ec.node = kNode;
+    ec.behaviour = emulator::EmulatorBehaviour::loop_default();
     world.add_drive(0, ec);
     ctl = std::make_unique<rt::Controller>(spec);
     world.power_on(0);
