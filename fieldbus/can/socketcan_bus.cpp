@@ -10,6 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <vector>
@@ -89,6 +90,20 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(std::string_view ifname, std::s
   if (::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) return fail("bind", errno);
   ec.clear();
   return bus;
+}
+
+std::int64_t SocketCanBus::tx_queue_len() const noexcept {
+  ifreq ifr{};
+  std::memcpy(ifr.ifr_name, name_.data(), std::min(name_.size(), sizeof ifr.ifr_name - 1));
+  if (::ioctl(fd_, SIOCGIFTXQLEN, &ifr) < 0) return -errno;
+  return ifr.ifr_qlen;
+}
+
+int SocketCanBus::set_tx_queue_len(std::uint32_t frames) noexcept {
+  ifreq ifr{};
+  std::memcpy(ifr.ifr_name, name_.data(), std::min(name_.size(), sizeof ifr.ifr_name - 1));
+  ifr.ifr_qlen = static_cast<int>(frames);
+  return ::ioctl(fd_, SIOCSIFTXQLEN, &ifr) < 0 ? errno : 0;
 }
 
 SocketCanBus::SocketCanBus(int fd, std::string name) noexcept : fd_(fd), name_(std::move(name)) {}

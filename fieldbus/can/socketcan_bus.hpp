@@ -74,6 +74,12 @@ class SocketCanBus final : public Transport {
 
   /// The socket, for poll()/epoll in non-RT tools that want to block.
   [[nodiscard]] int fd() const noexcept { return fd_; }
+  /// The interface's transmit queue length (txqueuelen, SIOCGIFTXQLEN), or
+  /// -errno. Start-up only.
+  [[nodiscard]] std::int64_t tx_queue_len() const noexcept;
+  /// Set txqueuelen (SIOCSIFTXQLEN; needs CAP_NET_ADMIN). 0 or errno
+  /// (EPERM without the capability). Start-up only.
+  int set_tx_queue_len(std::uint32_t frames) noexcept;
   /// errno of the last failed send (0 if none). Realtime-safe.
   [[nodiscard]] int last_errno() const noexcept { return last_errno_; }
 

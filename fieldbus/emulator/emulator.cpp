@@ -189,8 +189,10 @@ void Emulator::build_dictionary() {
   add(obj::kDigitalInputs, 0, 0);
   add(obj::kTargetVelocity, 0, 0);
   add(obj::kSupportedDriveModes, 0,
-      cia402::supported_mode_bit(cia402::Mode::kHoming) | cia402::supported_mode_bit(cia402::Mode::kCsp) |
-          cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst));
+      cfg_.supported_modes != 0
+          ? cfg_.supported_modes
+          : cia402::supported_mode_bit(cia402::Mode::kHoming) | cia402::supported_mode_bit(cia402::Mode::kCsp) |
+                cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst));
   // A drive without some optional objects (EmulatorConfig::absent_objects).
   std::erase_if(od_, [this](const Entry& e) {
     return std::find(cfg_.absent_objects.begin(), cfg_.absent_objects.end(), static_cast<std::uint16_t>(e.key >> 8)) !=

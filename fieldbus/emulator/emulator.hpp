@@ -67,6 +67,8 @@ struct EmulatorConfig {
   /// 0x6061 (the drive refuses the mode switch); the master's mode-switch
   /// timeout (drive.timeouts.mode_switch_ms) must catch it.
   bool refuse_mode_switch = false;
+  /// 0x6502 (supported drive modes); 0: the modes the emulator runs (HM, CSP, CSV, CST).
+  std::uint32_t supported_modes = 0;
   /// Objects (indices) this drive does not have, e.g. the optional 0x1016, or
   /// 0x1402/0x1602 for a drive with fewer PDOs: SDO access to them aborts with
   /// 0x06020000 (object does not exist), as on a real drive without them.

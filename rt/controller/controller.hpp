@@ -330,6 +330,7 @@ class Controller {
     bool have_prev = false;
     std::int32_t prev_counts = 0;
     bool failure_reported = false;
+    bool homing_out = false;  ///< the planner's homing_start as last handed to the proxy (its edges start/cancel)
   };
   class RecordingSink;
 

@@ -129,7 +129,7 @@ case $scn in
     why=$(grep -m1 'configuration write to' "$log") || fail "canmotiond did not explain the failed boot"
     say "message: $why"
     if [[ $scn == sdo_timeout ]]; then
-      parts=("node 2: configuration write to 0x6060:0" "aborted with 0x05040000" "the drive did not answer")
+      parts=("node 2: configuration read of 0x1000:0" "aborted with 0x05040000" "the drive did not answer")
       lo=500 hi=1500
     else
       parts=("node 2: configuration write to 0x1016:1" "aborted with 0x06020000 (object does not exist in the object dictionary)"

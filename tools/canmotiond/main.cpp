@@ -261,6 +261,7 @@ int run(const Options& o) {
     fmt::print(stderr, "canmotiond: {}\n", e.what());
     return 1;
   }
+  for (const auto& n : rt.notes) fmt::print(stderr, "canmotiond: {}\n", n);
   rt::Controller& ctl = *rt.controller;
   rt::ControllerHost host(ctl);
   // The cycle statistics as tags (Controller.latency_max_ns, ...), registered
