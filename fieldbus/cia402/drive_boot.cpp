@@ -163,6 +163,11 @@ void DriveProxy::restart() noexcept {
   failure_ = Failure{};
 }
 
+void DriveProxy::reboot_node() noexcept {
+  restart();
+  force_reset_ = true;
+}
+
 void DriveProxy::reboot(std::int64_t now_ns) noexcept {
   ++reboots_;
   forget_drive(now_ns);
@@ -178,7 +183,8 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
   canopen::SdoClient& sdo = master_.sdo(cfg_.node);
   switch (phase_) {
     case Phase::kWaitBoot:
-      if (cfg_.reset_node_first && !st.booted) {
+      if ((cfg_.reset_node_first && !st.booted) || force_reset_) {
+        force_reset_ = false;
         master_.send_nmt(canopen::NmtCommand::kResetNode, cfg_.node, out);
         phase_ = Phase::kResetWait;
         phase_since_ns_ = now_ns;

@@ -752,6 +752,9 @@ bool DriveNetwork::any_failed() const noexcept {
 void DriveNetwork::enable_all() noexcept {
   for (auto& d : drives_) d->enable();
 }
+void DriveNetwork::reboot_all() noexcept {
+  for (auto& d : drives_) d->reboot_node();
+}
 void DriveNetwork::disable_all() noexcept {
   for (auto& d : drives_) d->disable();
 }

@@ -301,6 +301,10 @@ class DriveProxy {
   /// Restart the boot sequence from the start (wait for the node, NMT
   /// pre-operational if needed, configure, start) and clear the failure.
   void restart() noexcept;
+  /// restart(), and send NMT reset node first (the node may have lost its
+  /// configuration or faulted while it could not hear the master, e.g. after
+  /// a bus-off): it boots and is configured again.
+  void reboot_node() noexcept;
 
   // ---- state --------------------------------------------------------------
   [[nodiscard]] std::uint8_t node() const noexcept { return cfg_.node; }
@@ -370,6 +374,7 @@ class DriveProxy {
 
   Phase phase_ = Phase::kWaitBoot;
   bool started_ = false;
+  bool force_reset_ = false;  // reboot_node(): NMT reset node in kWaitBoot
   std::int64_t phase_since_ns_ = 0;
   State state_ = State::kUnknown;
   State wanted_ = State::kSwitchOnDisabled;
@@ -469,6 +474,8 @@ class DriveNetwork {
   [[nodiscard]] bool any_failed() const noexcept;
   void enable_all() noexcept;
   void disable_all() noexcept;
+  /// Every drive: DriveProxy::reboot_node() (after the bus was bus-off).
+  void reboot_all() noexcept;
   /// The SocketCAN receive filters the master needs (set-up time): EMCY,
   /// TPDO1..4, SDO responses and heartbeats of every drive (one exact-ID
   /// filter each, so the kernel drops everything else, e.g. other masters'

@@ -174,22 +174,44 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
 
 void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   BusRt& bus = buses_[b];
+  auto bus_event = [&](Event::Kind k) noexcept {
+    Event e;
+    e.kind = k;
+    e.bus = static_cast<std::uint8_t>(b);
+    e.cycle = cycle_index_;
+    return e;
+  };
   // Bus events first: a bus-off reported now applies to this cycle's feedback.
   std::array<can::BusEvent, 16>& ev = bus_ev_;
   for (std::size_t n; (n = bus.transport->poll_events(ev)) > 0;) {
     for (std::size_t i = 0; i < n; ++i) {
       if (ev[i].kind == can::BusEvent::Kind::kStateChanged || ev[i].kind == can::BusEvent::Kind::kRestarted) {
-        Event e;
-        e.kind = Event::Kind::kBusState;
-        e.bus = static_cast<std::uint8_t>(b);
+        Event e = bus_event(Event::Kind::kBusState);
         e.bus_state = ev[i].state;
-        e.cycle = cycle_index_;
         emit(e);
+      } else if (ev[i].kind == can::BusEvent::Kind::kErrorFrame) {
+        // Reported when the classes change, else at most once a second (a
+        // bus without ACK sends one error frame per frame sent).
+        const auto cls = static_cast<std::uint32_t>(ev[i].detail);
+        if (cls != bus.err_classes || now_ns - bus.err_reported_ns >= 1'000'000'000) {
+          bus.err_classes = cls;
+          bus.err_reported_ns = now_ns;
+          Event e = bus_event(Event::Kind::kBusError);
+          e.value = cls;
+          emit(e);
+        }
       }
     }
     if (n < ev.size()) break;
   }
+  const bool was_off = bus.bus_off;
   bus.bus_off = bus.transport->state() == can::BusState::kBusOff;
+  if (was_off && !bus.bus_off) {
+    // Back from bus-off: the drives may have faulted or rebooted meanwhile
+    // (their watch of the master expired): boot and configure them again.
+    bus.network->reboot_all();
+    emit(bus_event(Event::Kind::kBusRecovered));
+  }
   for (std::size_t n; (n = bus.transport->receive(rx_)) > 0;) {
     const bool tracing = trace_on_.load(std::memory_order_relaxed);
     for (std::size_t i = 0; i < n; ++i) {
@@ -198,7 +220,6 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
     }
     if (n < rx_.size()) break;
   }
-  (void)now_ns;
 }
 
 // Called once per axis per cycle from cycle() only: inlined there (no call per axis).

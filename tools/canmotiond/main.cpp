@@ -106,6 +106,14 @@ class Outputs {
         fmt::print(stderr, "canmotiond: bus {} node {}: heartbeat lost\n", cfg_.buses[e.bus].name, e.node.node);
       } else if (e.kind == rt::Event::Kind::kBusState) {
         fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
+        if (e.bus_state == can::BusState::kBusOff && !cfg_.buses[e.bus].is_sim())
+          fmt::print(stderr, "canmotiond: bus {}: bus-off: {}\n", cfg_.buses[e.bus].name,
+                     can::SocketCanBus::bus_off_advice(cfg_.buses[e.bus].interface));
+      } else if (e.kind == rt::Event::Kind::kBusError) {
+        fmt::print(stderr, "canmotiond: bus {}: error frames: {}\n", cfg_.buses[e.bus].name,
+                   can::SocketCanBus::error_classes_text(static_cast<std::uint32_t>(e.value)));
+      } else if (e.kind == rt::Event::Kind::kBusRecovered) {
+        fmt::print(stderr, "canmotiond: bus {}: back from bus-off: re-booting its drives\n", cfg_.buses[e.bus].name);
       }
     }
   }
