@@ -8,13 +8,16 @@
 /// Not realtime-safe: everything here runs at start-up.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "fieldbus/canopen/device_dictionary.hpp"
 #include "fieldbus/cia402/drive_pdos.hpp"
+#include "fieldbus/eds/eds.hpp"
 #include "motion/axis.hpp"
 
 namespace canmotion::config {
@@ -109,6 +112,22 @@ struct DriveSettings {
   std::optional<std::int16_t> quick_stop_option;  ///< written to 0x605A when given (CiA 402: 0..8 or manufacturer-specific < 0)
   std::vector<SdoWrite> sdo_writes;
   DriveIdentitySettings identity;
+  /// master_heartbeat_timeout_ms is written in the file (not the default):
+  /// then 0x1016 is required, else optional (left out for a drive whose EDS
+  /// lacks it, accepted missing without an EDS).
+  bool master_heartbeat_timeout_set = false;
+  /// `eds:`: the drive's EDS or DCF (CiA 306) as written; `eds_path`: it
+  /// resolved against the YAML file's folder; `eds_key`: "drives.eds" or
+  /// "axes[i].drive.eds"; empty without one.
+  std::string eds;
+  std::string eds_path;
+  std::string eds_key;
+  Location eds_where;
+  /// The parsed file and its object dictionary, filled by load_file /
+  /// load_string after the check (config/eds_check.hpp); shared by the axes
+  /// naming the same file. Null without `eds:`.
+  std::shared_ptr<const eds::Eds> eds_data;
+  std::shared_ptr<const canopen::DeviceDictionary> dictionary;
 };
 
 /// An axis's `direct_control:` block (MDS, seed 002): the direct command's

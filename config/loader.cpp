@@ -11,6 +11,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -20,6 +21,7 @@
 #include <fmt/format.h>
 
 #include "config/config.hpp"
+#include "config/eds_check.hpp"
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/object_names.hpp"
@@ -291,7 +293,7 @@ class Loader {
 
   void drive(const YAML::Node& n, const std::string& path, DriveSettings& d) {
     if (!check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
-                             "following_error_window", "sdo_writes", "identity", "quick_stop_option"}))
+                             "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds"}))
       return;
     if (std::int16_t q = 0; scalar(n, path, "quick_stop_option", q, std::int16_t{-32768}, std::int16_t{8},
                                    "(0x605A: 0 coast, 1/2 ramp then Switch on disabled, 5/6 ramp and stay in Quick stop "
@@ -309,6 +311,14 @@ class Loader {
         u32("product_code", d.identity.product_code);
         u32("revision", d.identity.revision);
       }
+    }
+    if (n["master_heartbeat_timeout_ms"]) d.master_heartbeat_timeout_set = true;
+    if (n["eds"] && string(n, path, "eds", d.eds)) {
+      // Relative to the YAML file's folder, like a vendor's EDS shipped beside the configuration.
+      const std::filesystem::path e(d.eds);
+      d.eds_path = e.is_absolute() ? e.string() : (std::filesystem::path(file_).parent_path() / e).lexically_normal().string();
+      d.eds_key = path + ".eds";
+      d.eds_where = loc(n["eds"]);
     }
     if (n["timeouts"]) timeouts(n["timeouts"], path + ".timeouts", d.timeouts);
     enumeration(n, path, "pdo", d.pdo,
@@ -399,6 +409,7 @@ class Loader {
     motion::AxisConfig& c = a.axis;
     d.present = true;
     d.where = loc(n);
+    c.direct_control = true;  // MDS is validated (the drive's ramp attributes are configured) [seed 002]
     if (!check_map(n, path, {"mode", "max_torque", "velocity_command", "ramp", "slat"})) return;
     using DM = motion::AxisConfig::DirectMode;
     enumeration(n, path, "mode", c.direct_mode, {{"velocity", DM::Velocity}, {"torque", DM::Torque}});
@@ -442,6 +453,7 @@ class Loader {
                 fmt::format("{} units/s x conversion_constant {} does not fit 0x2021 (UNSIGNED32 counts/s)",
                             d.slat_set_point, conv));
         scalar(s, p, "time_delay_ms", d.slat_time_delay_ms, std::uint16_t{0}, std::uint16_t{65535}, "ms");
+        c.direct_slat = d.slat_configuration != 0;  // MDS's Speed is then the SLAT speed (velocity command)
         if (d.slat_configuration != 0 && c.direct_mode != DM::Torque)
           error(s["configuration"] ? s["configuration"] : s, p + ".configuration",
                 fmt::format("SLAT {} needs the direct command in torque: set {}.mode: torque (SLAT acts in CST)",
@@ -915,6 +927,10 @@ class Loader {
 
 Config finish(Loader& l, Config cfg) {
   l.cross_check(cfg);
+  // The drives' EDS files, once the configuration itself is valid (the check
+  // builds each drive's boot configuration from it).
+  if (std::none_of(l.diags.begin(), l.diags.end(), [](const Diagnostic& d) { return d.severity == Severity::kError; }))
+    check_drive_descriptions(cfg, l.diags);
   std::vector<Diagnostic> errors;
   for (auto& d : l.diags) {
     if (d.severity == Severity::kError) errors.push_back(d);

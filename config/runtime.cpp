@@ -11,6 +11,7 @@
 #include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/canopen/receive_filters.hpp"
 #include "fieldbus/canopen/tx_queue.hpp"
+#include "fieldbus/emulator/eds_dictionary.hpp"
 
 namespace canmotion::config {
 
@@ -122,6 +123,13 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   d.pdo_profile = a.drive.pdo;
   d.producer_heartbeat_ms = a.drive.heartbeat_ms;
   d.consumer_heartbeat_ms = bus.master_heartbeat_ms > 0 ? a.drive.master_heartbeat_timeout_ms : 0;
+  // 0x1016 is optional (CiA 301): required only when the file sets
+  // master_heartbeat_timeout_ms; from the default, a drive whose EDS lacks it
+  // is not asked (and the controller does not disarm it at the end).
+  d.consumer_heartbeat_optional = !a.drive.master_heartbeat_timeout_set;
+  d.dictionary = a.drive.dictionary;
+  if (d.consumer_heartbeat_optional && d.dictionary && d.dictionary->has(0x1016, 1) == canopen::Presence::kAbsent)
+    d.consumer_heartbeat_ms = 0;
   d.boot_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.boot_ms) * 1'000'000;
   d.start_timeout_ns = d.boot_timeout_ns;
   d.sdo_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.sdo_ms) * 1'000'000;
@@ -155,12 +163,15 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
 emulator::EmulatorConfig emulator_config(const AxisSettings& a) {
   emulator::EmulatorConfig e;
   e.node = a.node;
+  e.behaviour = emulator::EmulatorBehaviour::loop_default();  // --sim drives: strict but for two master gaps
   const double conv = a.axis.conversion_constant;
   // Give the model headroom over the axis's own limits, so that the emulated
   // drive follows any profile the planner may command.
   e.max_velocity = std::max(e.max_velocity, 2.0 * a.axis.max_speed * conv);
   e.max_acceleration = std::max(e.max_acceleration, 4.0 * std::max(a.axis.max_accel, a.axis.max_decel) * conv);
   if (a.drive.following_error_window > 0) e.following_error_window = a.drive.following_error_window;
+  // A drive with an EDS is emulated with exactly its objects (as cia402-emu --eds).
+  if (a.drive.eds_data) e.served = emulator::served_objects(*a.drive.eds_data, a.node);
   return e;
 }
 

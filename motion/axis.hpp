@@ -55,6 +55,15 @@ struct AxisConfig {
   /// MDS torque mode: initial DirectVelocityControl Command (units/s) sent
   /// with the torque command, the drive's speed reference for SLAT 1/2.
   double direct_velocity_command = 0.0;
+  /// MDS is allowed: the axis has `direct_control:` in the configuration (the
+  /// drive's ramp attributes are written at boot). Without it MDS answers
+  /// ERR 86 Optional Attribute Not Supported [seed 002: "validated if the CIP
+  /// drive device supports the ramp attributes"].
+  bool direct_control = false;
+  /// Torque mode with SLAT configured (direct_control.slat.configuration 1 or
+  /// 2): MDS's Speed is the DirectVelocityControl command (the SLAT speed), the
+  /// torque command is set live; both direct status bits are set.
+  bool direct_slat = false;
   std::uint8_t group = 0;          ///< motion group index (< kMaxGroups)
   /// Exception action per ExceptionKind. Defaults: position error and drive
   /// fault stop the drive, lost node and bus-off shut down, soft overtravel stops the planner.

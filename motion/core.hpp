@@ -61,6 +61,7 @@ struct Handshakes {
   bool homing_started = false; ///< the homing request was sent
   bool homing_clear = false;   ///< since the start, the feedback showed homing not attained (a stale bit is not completion)
   bool homed = false;          ///< AxisHomedStatus
+  bool resync = false;         ///< a drive homing was cancelled: the command takes the next actual position
 };
 
 /// MDS direct velocity/torque control of an axis.
@@ -139,6 +140,7 @@ struct Core {
   std::array<AxisId, kMaxAxes> order{};  ///< step order: masters before slaves
   std::size_t order_n = 0;
   bool order_dirty = true;  ///< a slot or an axis changed since `order` was computed
+  ControllerMode mode = ControllerMode::Run;  ///< Program: no instruction starts motion (ERR 24)
 
   /// Configure (or reconfigure) an axis. Not realtime.
   bool configure_axis(AxisId id, const AxisConfig& cfg) noexcept;

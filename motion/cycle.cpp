@@ -29,8 +29,9 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   if (a.hs.mso.valid() || a.hs.msf.valid()) servo::feedback(*this, a);
   if (a.direct.waiting || a.direct.stop.valid()) direct::feedback(*this, a);
   if (a.hs.homing) home::feedback(*this, a);
-  // servo off or homing: the command follows the actual position
-  if (!a.servo.on || a.hs.homing || a.direct.status) {
+  // servo off or homing (or a homing just cancelled): the command follows the actual position
+  if (!a.servo.on || a.hs.homing || a.direct.status || a.hs.resync) {
+    a.hs.resync = false;
     a.base = a.fb_pos;
     a.cmd = Kin{a.fb_pos, a.direct.status ? a.fb_vel : 0.0, 0};
   }
@@ -95,12 +96,17 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   switch (worst) {
     case ExceptionAction::StopPlanner: {
       if (a.servo.on) stop_all(a, kNoControl, 0);
+      // "an axis fault also breaks the MDAC link" [seed 000]: the slave's (a
+      // stop of all its planned motion, as MAS All); not the slaves' of a
+      // master (MAS on a master keeps them)
+      mdac::break_links(*this, a);
       break;
     }
     case ExceptionAction::StopDrive:
       servo_off(a);
       a.servo.faulted = true;
-      mdac::break_links(*this, a);  // an axis fault breaks the MDAC link
+      mdac::break_links(*this, a);              // an axis fault breaks the MDAC link [seed 000] ...
+      mdac::break_links_of_master(*this, id_of(a));  // ... on the slave and on the master (faulted, as MASD)
       break;
     case ExceptionAction::Shutdown:
       do_shutdown(a);
@@ -216,7 +222,7 @@ void Core::update_status(AxisRt& a) noexcept {
   const auto* tc = std::get_if<CamGen>(&a.gen[index(Slot::TimeCam)]);
   setb(TimeCamLockStatus, tc && tc->master_driven && tc->md.lock_status());
   const bool torque_mode = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
-  setb(DirectVelocityControlStatus, a.direct.active && !torque_mode);
+  setb(DirectVelocityControlStatus, a.direct.active && (!torque_mode || a.cfg.direct_slat));  // SLAT: both [seed 002]
   setb(DirectTorqueControlStatus, a.direct.active && torque_mode);
   setb(MaximumSpeedExceeded, a.cfg.max_speed > 0 && std::fabs(a.cmd.v) > a.cfg.max_speed * (1 + 1e-9));
   t.motion_status = ms;

@@ -41,7 +41,28 @@ Err check_request(Ctx& x) noexcept {
   return oc.ok ? Err::None : x.reject_operand(oc.index);
 }
 
+/// Program mode: the instructions that would start motion (ERR 24 Illegal
+/// Controller Mode); the others make an axis safe or ready, or compute.
+constexpr bool starts_motion(Instr i) noexcept {
+  switch (i) {
+    case Instr::MSO: case Instr::MSF: case Instr::MASD: case Instr::MASR: case Instr::MAFR: case Instr::MAS:
+    case Instr::MRP: case Instr::MCCP: case Instr::MGS: case Instr::MGSD: case Instr::MGSR: case Instr::MCS:
+    case Instr::MCSD:
+      return false;
+    default:
+      return true;
+  }
+}
+
 }  // namespace
+
+void Planner::set_controller_mode(ControllerMode m) noexcept {
+  if (m == c_.mode) return;
+  c_.mode = m;
+  stop::change_mode(c_, m == ControllerMode::Program);
+  for (std::size_t k = 0; k < c_.axis_count; ++k)
+    if (c_.axes[k].present) c_.update_status(c_.axes[k]);
+}
 
 Result Planner::update(const Input& in, Output& out) noexcept {
   if (c_.started && in.cycle <= c_.cycle) return Result::ErrorCycleNotIncreasing;
@@ -58,6 +79,7 @@ Err Planner::execute(const Request& r) noexcept {
   tag.begin_execution();
   Ctx x{c_, r, tag, OwnerRef{r.control, tag.generation}};
   Err e = check_request(x);
+  if (e == Err::None && c_.mode == ControllerMode::Program && starts_motion(r.instr)) e = Err::IllegalControllerMode;
   // the typed params (from the table-checked request) to the family's start()
   if (e == Err::None) e = std::visit([&x](const auto& p) noexcept { return start(x, p); }, decode(r));
   if (e != Err::None) tag.reject(e, x.exerr);

@@ -64,6 +64,17 @@ class Planner {
   /// The tag of coordinate system `id` (CS.* status words and positions). Realtime-safe.
   const CoordSystemTag& coordinate_system(CoordSystemId id) const noexcept { return c_.systems[id].tag; }
 
+  /// Controller mode change (Logix Run <-> Program, e.g. `canmotionctl mode
+  /// program`): any change breaks every MDAC link [seed 000]; into Program
+  /// every axis stops by its Programmed Stop Mode (moves, jogs, gears and cams
+  /// [seed 004]; pending cams dropped). In Program mode the program does not
+  /// run: instructions that would start motion (MAM MAJ MAG MATC MAPC MCD MDAC
+  /// MDS MAH and the coordinated ones) answer ERR 24 Illegal Controller Mode;
+  /// stops, servo on/off, shutdowns, resets, MRP and MCCP run. Setting the
+  /// present mode does nothing. Realtime-safe.
+  void set_controller_mode(ControllerMode m) noexcept;
+  ControllerMode controller_mode() const noexcept { return c_.mode; }
+
   /// Register the CAM_PROFILE array tag `id` (the binder's cam_profiles id).
   /// The profile must outlive the planner. Not realtime (configuration).
   bool attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noexcept;

@@ -263,6 +263,37 @@ bool fit_end_speed(ProfileBuilder& b, double ve, double Rabs, double sg, const L
   return true;
 }
 
+/// Overshoot::StopAtTarget from a state that cannot stop at the target with
+/// `lim` (or whose braking acceleration the decel jerk cannot ramp out before
+/// the velocity reaches zero): stop with decel, accel and both jerks scaled up
+/// by the smallest k >= 1 that neither reverses nor passes the target (Rabs
+/// ahead in direction sg), ending at `vend` (0, or plan_move_to's end
+/// velocity). True when even that stop ends short of the target
+/// (a braking acceleration that cannot be ramped out): the caller goes on
+/// from rest with the programmed limits; ending the profile there would leave
+/// the rest to its final sample, a jump to the target.
+template <class B>
+bool stop_on_target(B& b, double vend, const Limits& lim, double sg, double Rabs) noexcept {
+  const double vrel = sg * b.v, arel = sg * b.a;
+  auto stop_dist = [&](const Limits& l) noexcept {
+    Sim s = b.sim();
+    vel_change_lim(s, vend, l, sg);
+    return sg * (s.x - b.x);
+  };
+  auto reverses = [&](double jd) noexcept { return arel < 0 && vrel - arel * arel / (2 * jd) < 0; };
+  double lo = 0.0, hi = std::log(1e9);  // log k
+  for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
+    const double mid = (lo + hi) / 2;
+    const Limits l = scaled(lim, std::exp(mid));
+    if (reverses(l.jd) || stop_dist(l) > Rabs) lo = mid; else hi = mid;
+  }
+  const Limits k_lim = scaled(lim, std::exp(hi));
+  const bool short_stop = reverses(lim.jd) && stop_dist(k_lim) < Rabs * (1 - 1e-12);
+  vel_change_lim(b, vend, k_lim, sg);
+  return short_stop;
+}
+
+
 /// dstop <= Rabs < the distance of any fuller profile: stop now with a softer
 /// deceleration d' in (0, d] (bounded bisection on log(d'/d); the stop
 /// distance decreases with d').
@@ -289,7 +320,8 @@ bool plan_move_impl(Profile& out, const Kin& start, double distance, double ve, 
   if (!limits_valid(lim) || !kin_valid(start) || !std::isfinite(distance)) return false;
   ProfileBuilder b(out, start);
   const double X = distance;
-  for (int pass = 0; pass < 3; ++pass) {
+  // passes: brake away-going motion; a short stop (StopAtTarget); the move
+  for (int pass = 0; pass < 4; ++pass) {
     const double R = X - b.x;
     double sg = sgn(R);
     if (sg == 0) sg = b.v != 0 ? sgn(b.v) : sgn(b.a);
@@ -322,15 +354,7 @@ bool plan_move_impl(Profile& out, const Kin& start, double distance, double ve, 
         vel_change_lim(b, 0.0, lim, sg);
         continue;
       }
-      // Stop exactly on target: scale decel (and jerk) up by the smallest k >= 1
-      // that neither reverses nor passes the target.
-      double lo = 0.0, hi = std::log(1e9);  // log k
-      for (int i = 0; i < kSolveIterations && hi - lo > 1e-14; ++i) {
-        const double mid = (lo + hi) / 2;
-        const Limits l = scaled(lim, std::exp(mid));
-        if (reverses(l.jd) || stop_dist(l) > Rabs) lo = mid; else hi = mid;
-      }
-      vel_change_lim(b, vend, scaled(lim, std::exp(hi)), sg);
+      if (stop_on_target(b, vend, lim, sg, Rabs)) continue;  // stopped short: on from rest
       break;
     }
     auto f = [&](double vp) noexcept {

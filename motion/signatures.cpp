@@ -49,7 +49,8 @@ OperandCheck check_operands(Instr i, std::span<const double> values) noexcept {
         ok = std::isfinite(v) && (o.range != Range::Positive || v > 0) && (o.range != Range::NonNegative || v >= 0);
         break;
       case K::Int:
-        ok = std::isfinite(v) && v == std::floor(v) && std::fabs(v) <= 2147483647.0 &&
+        ok = std::isfinite(v) && v == std::floor(v) &&
+             (o.range == Range::Uint32 ? v >= 0 && v <= 4294967295.0 : std::fabs(v) <= 2147483647.0) &&
              (o.range != Range::Positive || v > 0) && (o.range != Range::NonNegative || v >= 0);
         break;
       case K::Enum:

@@ -46,6 +46,7 @@ enum class Range : std::uint8_t {
   Any,          ///< any finite value
   Positive,     ///< > 0
   NonNegative,  ///< >= 0
+  Uint32,       ///< Int operands of type UINT32: 0 .. 4294967295 (else DINT: |v| <= 2147483647)
 };
 
 /// One enumeration entry: ST keyword (lower case, spaces removed) and number.
@@ -163,7 +164,7 @@ inline constexpr OperandSig kMam[] = {ax("Axis"), ctl(), ent("MoveType", kMoveTy
                                       {"EventDistance", K::RealArray}, {"CalculatedData", K::RealArray}};
 
 inline constexpr OperandSig kMag[] = {ax("SlaveAxis"), ax("MasterAxis"), ctl(), ent("Direction", kCamDir), real("Ratio"),
-                                      integer("SlaveCounts"), integer("MasterCounts"), en("MasterReference", kMasterRef),
+                                      integer("SlaveCounts", Range::Uint32), integer("MasterCounts", Range::Uint32), en("MasterReference", kMasterRef),
                                       en("RatioFormat", kRatioFormat), en("Clutch", kClutch), real("AccelRate"),
                                       en("AccelUnits", kAccelUnits01)};
 

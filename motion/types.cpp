@@ -53,6 +53,9 @@ std::string_view err_name(Err e) noexcept {
     case Err::NotAllowedWhileStopping: return "Not Allowed While Stopping";
     case Err::CipAxisInIncorrectState: return "CIP Axis In Incorrect State";
     case Err::RedefinePositionInProcess: return "Redefine Position In Process";
+    case Err::OptionalAttributeNotSupported:  // only MDS gives it (motion/instr/direct.cpp)
+      return "Optional Attribute Not Supported: MDS needs the drive's ramp attributes, configure the axis' "
+             "direct_control: (mode, ramp)";
     case Err::NotAllowedWhileInDirectMotion: return "Not Allowed While In Direct Motion";
     case Err::NotAllowedWhilePlannerActive: return "Not Allowed While Planner Active";
     case Err::MdscNotActivated: return "MDSC Not Activated";

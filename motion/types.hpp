@@ -161,6 +161,7 @@ enum class Err : std::int16_t {
   NotAllowedWhileStopping = 78,
   CipAxisInIncorrectState = 82,
   RedefinePositionInProcess = 85,
+  OptionalAttributeNotSupported = 86,
   NotAllowedWhileInDirectMotion = 87,
   NotAllowedWhilePlannerActive = 88,
   MdscNotActivated = 93,
@@ -280,6 +281,8 @@ inline constexpr unsigned AxisInhibitStatus = 3;
 }  // namespace coordinate_system_status
 
 /// Programmed Stop Mode of an axis (used by MGS programmed).
+/// Controller mode (Logix Run / Program; Planner::set_controller_mode).
+enum class ControllerMode : std::uint8_t { Run = 0, Program = 1 };
 enum class ProgrammedStopMode : std::uint8_t { FastStop = 0, FastDisable = 1, HardDisable = 2, FastShutdown = 3, HardShutdown = 4 };
 
 }  // namespace canmotion::motion

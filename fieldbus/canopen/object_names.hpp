@@ -172,6 +172,8 @@ inline constexpr ObjectInfo kObjects[] = {
   {0x1018, 0x1018, 3, 3, DT::kUnsigned32, AC::kRo, PM::kNo, "Identity object: revision number"},
   {0x1018, 0x1018, 4, 4, DT::kUnsigned32, AC::kRo, PM::kNo, "Identity object: serial number"},
   {0x1019, 0x1019, 0, 0, DT::kUnsigned8, AC::kRw, PM::kNo, "Synchronous counter overflow value"},
+  {0x1029, 0x1029, 0, 0, DT::kUnsigned8, AC::kRo, PM::kNo, "Error behaviour: highest sub-index supported"},
+  {0x1029, 0x1029, 1, 1, DT::kUnsigned8, AC::kRw, PM::kNo, "Error behaviour: communication error"},
   {0x1200, 0x1200, 0, 0, DT::kUnsigned8, AC::kRo, PM::kNo, "SDO server parameter: highest sub-index supported"},
   {0x1200, 0x1200, 1, 1, DT::kUnsigned32, AC::kRo, PM::kNo, "SDO server parameter: COB-ID client to server"},
   {0x1200, 0x1200, 2, 2, DT::kUnsigned32, AC::kRo, PM::kNo, "SDO server parameter: COB-ID server to client"},

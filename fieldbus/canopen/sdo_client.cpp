@@ -8,15 +8,9 @@
 namespace canmotion::canopen {
 
 namespace {
-can::Frame sdo_frame(std::uint8_t node, std::uint8_t b0, std::uint16_t index, std::uint8_t sub) noexcept {
-  can::Frame f;
-  f.id = cob::sdo_rx(node);
-  f.len = 8;
-  f.data[0] = b0;
-  f.data[1] = static_cast<std::uint8_t>(index & 0xFF);
-  f.data[2] = static_cast<std::uint8_t>(index >> 8);
-  f.data[3] = sub;
-  return f;
+can::Frame sdo_frame(std::uint8_t node, std::uint8_t b0, std::uint16_t index, std::uint8_t sub,
+                     std::uint32_t value = 0) noexcept {
+  return sdo::initiate_frame(cob::sdo_rx(node), b0, index, sub, value);
 }
 }  // namespace
 
@@ -85,9 +79,7 @@ void SdoClient::start(const Request& r, std::int64_t now_ns) noexcept {
   } else {
     phase_ = Phase::kInitDownload;
     res_.segmented = true;
-    can::Frame f = sdo_frame(node_, 0x21, r.index, r.sub);
-    f.data[4] = r.len;
-    queue_tx(f);
+    queue_tx(sdo_frame(node_, 0x21, r.index, r.sub, r.len));  // size indicated
   }
 }
 
@@ -110,10 +102,7 @@ void SdoClient::finish(SdoAbort abort, bool by_server, std::int64_t now_ns) noex
 }
 
 void SdoClient::abort_transfer(SdoAbort abort, std::int64_t now_ns) noexcept {
-  can::Frame f = sdo_frame(node_, 0x80, cur_.index, cur_.sub);
-  const auto code = static_cast<std::uint32_t>(abort);
-  for (int i = 0; i < 4; ++i) f.data[4 + i] = static_cast<std::uint8_t>(code >> (8 * i));
-  queue_tx(f);
+  queue_tx(sdo::abort_frame(cob::sdo_rx(node_), cur_.index, cur_.sub, static_cast<std::uint32_t>(abort)));
   finish(abort, false, now_ns);
 }
 
@@ -121,13 +110,8 @@ void SdoClient::send_next_download_segment() noexcept {
   const std::size_t remaining = cur_.len - offset_;
   const std::size_t n = std::min<std::size_t>(7, remaining);
   const bool last = n == remaining;
-  can::Frame f;
-  f.id = cob::sdo_rx(node_);
-  f.len = 8;
-  f.data[0] = static_cast<std::uint8_t>((toggle_ ? sdo::kToggle : 0) | ((7 - n) << 1) | (last ? sdo::kLastSegment : 0));
-  std::copy_n(cur_.data.begin() + static_cast<std::ptrdiff_t>(offset_), n, f.data.begin() + 1);
+  queue_tx(sdo::segment_frame(cob::sdo_rx(node_), toggle_, std::span<const std::uint8_t>(cur_.data.data() + offset_, n), last));
   offset_ += n;
-  queue_tx(f);
 }
 
 void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {

@@ -1,11 +1,13 @@
 #pragma once
 /// \file
-/// SDO frame layout (CiA 301 §7.2.4.3): command byte constants and a decoder
-/// for single frames, shared by the SDO client, the SDO server and the trace
-/// decoder. Realtime-safe, constexpr.
+/// SDO frame layout (CiA 301 §7.2.4.3): command byte constants, the frame
+/// builders and a decoder for single frames, shared by the SDO client, the
+/// SDO server and the trace decoder. Realtime-safe, constexpr.
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string_view>
 
 #include "fieldbus/can/frame.hpp"
@@ -35,6 +37,42 @@ inline constexpr std::uint8_t kLastSegment = 0x01;    ///< c, segment frames
 /// Command specifier (bits 7..5) of an SDO command byte.
 [[nodiscard]] constexpr std::uint8_t command_specifier(std::uint8_t b0) noexcept {
   return static_cast<std::uint8_t>(b0 >> 5);
+}
+
+/// An 8-byte SDO frame on `cob_id` with command byte `b0`, the multiplexer
+/// `index`/`sub` (bytes 1..3) and `value` in bytes 4..7 (little endian: an
+/// expedited value's bytes, an announced size or an abort code).
+[[nodiscard]] constexpr can::Frame initiate_frame(std::uint32_t cob_id, std::uint8_t b0, std::uint16_t index,
+                                                  std::uint8_t sub, std::uint32_t value = 0) noexcept {
+  can::Frame f;
+  f.id = cob_id;
+  f.len = 8;
+  f.data[0] = b0;
+  f.data[1] = static_cast<std::uint8_t>(index & 0xFF);
+  f.data[2] = static_cast<std::uint8_t>(index >> 8);
+  f.data[3] = sub;
+  for (int i = 0; i < 4; ++i) f.data[static_cast<std::size_t>(4 + i)] = static_cast<std::uint8_t>(value >> (8 * i));
+  return f;
+}
+
+/// An abort transfer frame (either side) for `index`/`sub` with `code`
+/// (an SdoAbort value).
+[[nodiscard]] constexpr can::Frame abort_frame(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub,
+                                               std::uint32_t code) noexcept {
+  return initiate_frame(cob_id, static_cast<std::uint8_t>(kCsAbort << 5), index, sub, code);
+}
+
+/// A segment frame (download segment request or upload segment response):
+/// 1..7 bytes of `data` (more are cut), toggle bit `toggle`, `last` = c bit.
+[[nodiscard]] constexpr can::Frame segment_frame(std::uint32_t cob_id, bool toggle, std::span<const std::uint8_t> data,
+                                                 bool last) noexcept {
+  const std::size_t n = std::min<std::size_t>(7, data.size());
+  can::Frame f;
+  f.id = cob_id;
+  f.len = 8;
+  f.data[0] = static_cast<std::uint8_t>((toggle ? kToggle : 0) | ((7 - n) << 1) | (last ? kLastSegment : 0));
+  std::copy_n(data.begin(), n, f.data.begin() + 1);
+  return f;
 }
 
 /// Kind of one SDO frame, direction resolved.

@@ -8,21 +8,11 @@
 namespace canmotion::canopen {
 
 can::Frame SdoServer::response(std::uint8_t b0, std::uint16_t index, std::uint8_t sub) const noexcept {
-  can::Frame f;
-  f.id = cob::sdo_tx(node_);
-  f.len = 8;
-  f.data[0] = b0;
-  f.data[1] = static_cast<std::uint8_t>(index & 0xFF);
-  f.data[2] = static_cast<std::uint8_t>(index >> 8);
-  f.data[3] = sub;
-  return f;
+  return sdo::initiate_frame(cob::sdo_tx(node_), b0, index, sub);
 }
 
 void SdoServer::send_abort(std::uint16_t index, std::uint8_t sub, SdoAbort code, FrameSink& out) noexcept {
-  can::Frame f = response(0x80, index, sub);
-  const auto c = static_cast<std::uint32_t>(code);
-  for (int i = 0; i < 4; ++i) f.data[4 + i] = static_cast<std::uint8_t>(c >> (8 * i));
-  out.send(f);
+  out.send(sdo::abort_frame(cob::sdo_tx(node_), index, sub, static_cast<std::uint32_t>(code)));
   ++aborts_sent_;
   phase_ = Phase::kIdle;
 }
@@ -101,9 +91,7 @@ void SdoServer::on_frame(const can::Frame& f, std::int64_t now_ns, FrameSink& ou
       size_ = len;
       offset_ = 0;
       toggle_ = false;
-      can::Frame r = response(0x41, s.index, s.sub);
-      for (int i = 0; i < 4; ++i) r.data[4 + i] = static_cast<std::uint8_t>(len >> (8 * i));
-      out.send(r);
+      out.send(sdo::initiate_frame(cob::sdo_tx(node_), 0x41, s.index, s.sub, static_cast<std::uint32_t>(len)));
       return;
     }
     case sdo::SdoFrameKind::kUploadSegmentRequest: {
@@ -111,11 +99,8 @@ void SdoServer::on_frame(const can::Frame& f, std::int64_t now_ns, FrameSink& ou
       if (s.toggle != toggle_) return send_abort(index_, sub_, SdoAbort::kToggleBit, out);
       const std::size_t n = std::min<std::size_t>(7, size_ - offset_);
       const bool last = offset_ + n == size_;
-      can::Frame r;
-      r.id = cob::sdo_tx(node_);
-      r.len = 8;
-      r.data[0] = static_cast<std::uint8_t>((toggle_ ? sdo::kToggle : 0) | ((7 - n) << 1) | (last ? sdo::kLastSegment : 0));
-      std::copy_n(buf_.begin() + static_cast<std::ptrdiff_t>(offset_), n, r.data.begin() + 1);
+      const can::Frame r =
+          sdo::segment_frame(cob::sdo_tx(node_), toggle_, std::span<const std::uint8_t>(buf_.data() + offset_, n), last);
       offset_ += n;
       toggle_ = !toggle_;
       if (last) phase_ = Phase::kIdle;

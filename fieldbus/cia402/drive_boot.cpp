@@ -13,12 +13,26 @@ namespace canmotion::cia402 {
 
 void DriveProxy::build_configuration() {
   writes_.clear();
-  auto add = [this](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) { writes_.push_back(BootWrite{w, o, extra}); };
+  // An optional transfer to an object the drive's EDS lacks is left out.
+  auto absent = [this](const SdoWrite& w) {
+    return cfg_.dictionary && cfg_.dictionary->has(w.index, w.sub) == canopen::Presence::kAbsent;
+  };
+  auto add = [&](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) {
+    const bool optional =
+        o == WriteOrigin::kUnusedPdo || (o == WriteOrigin::kConsumerHeartbeat && cfg_.consumer_heartbeat_optional);
+    if (optional && absent(w)) return;
+    writes_.push_back(BootWrite{w, o, extra, optional});
+  };
   // Checks first (reads; nothing is written before they pass): the device
   // type (mandatory in CiA 301), the identity the configuration expects
   // (0x1018:2/3 are optional: read only when expected), the supported modes.
-  auto check = [this](std::uint16_t index, std::uint8_t sub, BootCheck c) {
-    writes_.push_back(BootWrite{SdoWrite{index, sub, 4, 0}, WriteOrigin::kCheck, 0, c});
+  // 0x6502 and 0x6061 are optional: a drive without them is not checked
+  // (the written mode is taken as the one it runs).
+  auto check = [&](std::uint16_t index, std::uint8_t sub, BootCheck c) {
+    const SdoWrite w{index, sub, 4, 0};
+    const bool optional = c == BootCheck::kSupportedModes || c == BootCheck::kModeDisplay;
+    if (optional && absent(w)) return;
+    writes_.push_back(BootWrite{w, WriteOrigin::kCheck, 0, optional, c});
   };
   check(obj::kDeviceType, 0, BootCheck::kDeviceType);
   if (cfg_.identity.has_vendor_id) check(obj::kIdentity, 1, BootCheck::kVendorId);
@@ -214,14 +228,12 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
       while (sdo.poll(r)) {
         if (r.tag == kModeWriteTag) continue;
         const BootWrite* bw = r.tag < writes_.size() ? &writes_[r.tag] : nullptr;
-        const bool optional_read = bw != nullptr && (bw->check == BootCheck::kSupportedModes || bw->check == BootCheck::kModeDisplay);
-        if (!r.ok() && bw != nullptr && bw->origin == WriteOrigin::kUnusedPdo && canopen::object_absent(r.abort)) {
-          ++tolerated_;  // the drive has fewer PDOs: fine for one we do not use
-        } else if (!r.ok() && optional_read && canopen::object_absent(r.abort)) {
-          // No 0x6502 / 0x6061: the modes are not checked, the written mode is
+        if (!r.ok() && bw != nullptr && bw->optional && canopen::object_absent(r.abort)) {
+          // The drive lacks an optional object: fewer PDOs than 4, no 0x1016;
+          // no 0x6502 / 0x6061: the modes are not checked, the written mode is
           // taken as the one the drive runs (what a drive without them allows).
           ++tolerated_;
-        } else if (r.ok() && bw != nullptr && bw->check != BootCheck::kNone) {
+        } else if (r.ok() && bw != nullptr && bw->is_read()) {
           bool again = false;
           if (!check_read(*bw, r.u32(), now_ns, again)) {
             sdo.cancel_all();
@@ -241,17 +253,7 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
           failure_.sdo_abort = static_cast<std::uint32_t>(r.abort);
           if (bw != nullptr) {
             failure_.sdo_origin = bw->origin;
-            const std::string* key = nullptr;
-            switch (bw->origin) {
-              case WriteOrigin::kInterpolationPeriod: key = &cfg_.hints.interpolation_period; break;
-              case WriteOrigin::kPdo: key = &cfg_.hints.pdo; break;
-              case WriteOrigin::kProducerHeartbeat: key = &cfg_.hints.producer_heartbeat; break;
-              case WriteOrigin::kConsumerHeartbeat: key = &cfg_.hints.consumer_heartbeat; break;
-              case WriteOrigin::kExtra:
-                if (bw->extra < cfg_.hints.extra.size()) key = &cfg_.hints.extra[bw->extra];
-                break;
-              default: break;
-            }
+            const std::string* key = write_hint_key(cfg_.hints, *bw);
             failure_.hint = key != nullptr && !key->empty() ? key->c_str() : nullptr;
           }
           sdo.cancel_all();
@@ -266,7 +268,7 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
         const BootWrite& bw = writes_[next_write_];
         const SdoWrite& w = bw.w;
         const auto tag = static_cast<std::uint32_t>(next_write_);
-        if (bw.check != BootCheck::kNone) {
+        if (bw.is_read()) {
           if (!sdo.upload(w.index, w.sub, tag)) break;
         } else {
           std::uint8_t b[4];

@@ -45,6 +45,20 @@ int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key)
 }
 }  // namespace
 
+const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept {
+  switch (w.origin) {
+    case WriteOrigin::kInterpolationPeriod: return &hints.interpolation_period;
+    case WriteOrigin::kPdo: return &hints.pdo;
+    case WriteOrigin::kProducerHeartbeat: return &hints.producer_heartbeat;
+    case WriteOrigin::kConsumerHeartbeat: return &hints.consumer_heartbeat;
+    case WriteOrigin::kExtra: return w.extra < hints.extra.size() ? &hints.extra[w.extra] : nullptr;
+    case WriteOrigin::kMode:
+    case WriteOrigin::kUnusedPdo:
+    case WriteOrigin::kCheck: return nullptr;
+  }
+  return nullptr;
+}
+
 // ============================================================================
 // Failure
 // ============================================================================

@@ -29,6 +29,7 @@
 
 #include "fieldbus/can/frame.hpp"
 #include "fieldbus/can/transport.hpp"  // can::Filter
+#include "fieldbus/canopen/device_dictionary.hpp"
 #include "fieldbus/canopen/frame_sink.hpp"
 #include "fieldbus/canopen/master.hpp"
 #include "fieldbus/canopen/pdo.hpp"
@@ -143,7 +144,31 @@ struct DriveConfig {
   std::vector<ModeNeed> needed_modes;
   bool reset_node_first = false;  ///< send NMT reset node instead of waiting for a boot-up first
   WriteHints hints;               ///< named in the message when a configuration write is refused
+  /// The drive's object dictionary from its EDS (null or not described: no
+  /// EDS). Optional boot writes (unused PDOs, an optional 0x1016) to an
+  /// object it lacks are left out; without a description they are tried and
+  /// abort 0x06020000 / 0x06090011 is accepted.
+  std::shared_ptr<const canopen::DeviceDictionary> dictionary;
+  /// 0x1016:1 comes from a default, not from the configuration: a drive
+  /// without 0x1016 is fine (the write is optional, see `dictionary`).
+  bool consumer_heartbeat_optional = false;
 };
+
+/// One SDO transfer of the boot configuration, in the order the proxy makes
+/// them: a write (download), or with `check` set a read (upload, origin
+/// WriteOrigin::kCheck) that checks the drive.
+struct BootWrite {
+  SdoWrite w;
+  WriteOrigin origin = WriteOrigin::kMode;
+  std::uint16_t extra = 0;  ///< kExtra: index in DriveConfig::extra_writes
+  bool optional = false;    ///< a drive without the object is fine (abort 0x06020000 / 0x06090011 accepted)
+  BootCheck check = BootCheck::kNone;  ///< not kNone: a read (upload) that checks the drive
+  [[nodiscard]] constexpr bool is_read() const noexcept { return check != BootCheck::kNone; }
+};
+
+/// The configuration key behind a boot write (from `hints`), or nullptr when
+/// none is named (0x6060, unused PDOs, the checking reads). Realtime-safe.
+[[nodiscard]] const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept;
 
 /// Where the proxy is in bringing its node up.
 enum class Phase : std::uint8_t { kWaitBoot, kResetWait, kConfiguring, kStarting, kOperational, kFailed };
@@ -328,9 +353,15 @@ class DriveProxy {
   /// heartbeat shows it left NMT operational while the proxy runs it.
   [[nodiscard]] bool heartbeat_lost() const noexcept { return master_.status(cfg_.node).lost; }
   [[nodiscard]] bool left_operational() const noexcept { return nmt_left_; }
-  /// Configuration writes the drive refused that do not matter (unused PDOs
-  /// it does not have), since the last (re)start of the configuration.
+  /// Optional configuration writes and reads the drive refused because it
+  /// lacks the object (unused PDOs, an optional 0x1016, no 0x6502 / 0x6061),
+  /// since the last (re)start of the configuration.
   [[nodiscard]] std::size_t tolerated_aborts() const noexcept { return tolerated_; }
+  /// The boot configuration's SDO transfers, in order: the checking reads
+  /// (BootWrite::is_read(): 0x1000, 0x1018 as configured, 0x6502 first,
+  /// 0x6061 last) and the writes (built at set-up; optional ones to objects
+  /// the DriveConfig::dictionary lacks are not in it).
+  [[nodiscard]] std::span<const BootWrite> boot_writes() const noexcept { return writes_; }
   /// Boot-ups that (re-)ran the configuration: while running, while
   /// configuring, or after a failed boot.
   [[nodiscard]] std::uint32_t reboots() const noexcept { return reboots_; }
@@ -355,12 +386,6 @@ class DriveProxy {
   DriveConfig cfg_;
   canopen::Master& master_;
   DrivePdoSet pdos_;
-  struct BootWrite {
-    SdoWrite w;
-    WriteOrigin origin = WriteOrigin::kMode;
-    std::uint16_t extra = 0;  ///< kExtra: index in cfg_.extra_writes
-    BootCheck check = BootCheck::kNone;  ///< a read (upload) that checks the drive
-  };
   std::size_t leading_reads_ = 0;      // the checks that run before any write
   std::int64_t mode_shown_since_ns_ = -1;  // boot: first 0x6061 read that did not show the mode yet
   /// A boot read's value: true when the boot goes on (`again`: read it again).

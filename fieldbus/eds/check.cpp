@@ -106,7 +106,7 @@ class Checker {
       const ObjectList l = Eds::expected_list(u.index);
       const int line = missing_line(u.index);
       refuse(RefusalKind::kMissingObject, u.index, u.sub, line, u.key,
-             fmt::format("{} is not in the EDS ({}); the master would {} it", label(u.index, u.sub),
+             fmt::format("{} is not in the EDS ({}); the master would {}", label(u.index, u.sub),
                          line != 0 ? fmt::format("[{}] does not list 0x{:04X}", object_list_name(l), u.index)
                                    : fmt::format("no section [{:04X}]", u.index),
                          usage_verb(u.usage)));
@@ -119,7 +119,7 @@ class Checker {
         return;
       }
       refuse(RefusalKind::kMissingSubIndex, u.index, u.sub, o->line, u.key,
-             fmt::format("0x{:04X} ({}) has no sub-index {} (it has {}); the master would {} it", u.index, o->name, u.sub,
+             fmt::format("0x{:04X} ({}) has no sub-index {} (it has {}); the master would {}", u.index, o->name, u.sub,
                          sub_list(*o), usage_verb(u.usage)));
       return;
     }
@@ -149,12 +149,12 @@ class Checker {
 
   static std::string_view usage_verb(Usage u) {
     switch (u) {
-      case Usage::kWrite: return "write";
-      case Usage::kRead: return "read";
-      case Usage::kMapRpdo: return "map into an RPDO";
-      case Usage::kMapTpdo: return "map into a TPDO";
+      case Usage::kWrite: return "write it";
+      case Usage::kRead: return "read it";
+      case Usage::kMapRpdo: return "map it into an RPDO";
+      case Usage::kMapTpdo: return "map it into a TPDO";
     }
-    return "use";
+    return "use it";
   }
 
   static std::string sub_list(const Object& o) {

@@ -118,6 +118,13 @@ bool Eds::is_dcf() const noexcept {
   return false;
 }
 
+canopen::DeviceDictionary device_dictionary(const Eds& e) {
+  std::vector<canopen::DeviceDictionary::Entry> entries;
+  for (const Object& o : e.objects)
+    for (const SubObject& s : o.subs) entries.push_back({o.index, s.sub, s.type, to_canopen(s.access), s.name});
+  return canopen::DeviceDictionary(std::move(entries), e.file);
+}
+
 ObjectList Eds::expected_list(std::uint16_t index) noexcept {
   if (index == 0x1000 || index == 0x1001 || index == 0x1018) return ObjectList::kMandatory;
   if (index >= 0x2000 && index <= 0x5FFF) return ObjectList::kManufacturer;

@@ -29,6 +29,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fieldbus/canopen/device_dictionary.hpp"
 #include "fieldbus/canopen/object_names.hpp"
 
 namespace canmotion::eds {
@@ -217,6 +218,11 @@ struct Eds {
 /// Read and parse a file. Throws ParseError (an unreadable file is one
 /// Diagnostic with line 0).
 [[nodiscard]] Eds load(const std::filesystem::path& path);
+
+/// The file's objects as the master's "does the drive have it?" query sees
+/// them (every sub-index with its ParameterName, data type and SDO access);
+/// source() is `e.file`. Set-up only (allocates).
+[[nodiscard]] canopen::DeviceDictionary device_dictionary(const Eds& e);
 
 /// Read `text` as a value of type `t` ("0x1F", "-5", "$NODEID+0x180",
 /// "1.5", hex bytes for OCTET_STRING/DOMAIN ...). On failure returns

@@ -43,6 +43,25 @@ std::uint8_t error_register_for(std::uint16_t code) {
 }
 }  // namespace
 
+EmulatorBehaviour EmulatorBehaviour::permissive() noexcept {
+  EmulatorBehaviour b;
+  b.optional_objects_absent = false;
+  b.ip_index_read_only = false;
+  b.remap_preoperational_only = false;
+  b.cia402_default_pdos = false;
+  b.rpdo_too_long_emcy = false;
+  b.check_sync_length = false;
+  b.error_behaviour = false;
+  b.boot_ns = 0;
+  b.sdo_reply_delay_ns = 0;
+  b.one_transition_per_sync = false;
+  b.fault_cause_syncs = 0;
+  b.mode_switch_syncs = 0;
+  b.refuse_unsupported_modes = false;
+  b.homing_takes_time = false;
+  return b;
+}
+
 Emulator::Emulator(const EmulatorConfig& cfg)
     : cfg_(cfg),
       device_name_(cfg.device_name),
@@ -69,12 +88,18 @@ void Emulator::add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, c
           value,
           text,
           0,
-          0};
-  const std::size_t size = canopen::data_type_size(e.type);
+          0,
+          false};
+  set_type(e, e.type);
+  od_.push_back(e);
+}
+
+void Emulator::set_type(Entry& e, canopen::DataType t) noexcept {
+  e.type = t;
+  const std::size_t size = canopen::data_type_size(t);
   const bool full = size >= 8 || size == 0;
   e.mask = full ? ~std::uint64_t{0} : (std::uint64_t{1} << (8 * size)) - 1;
-  e.sign = canopen::data_type_signed(e.type) && !full ? std::uint64_t{1} << (8 * size - 1) : 0;
-  od_.push_back(e);
+  e.sign = canopen::data_type_signed(t) && !full ? std::uint64_t{1} << (8 * size - 1) : 0;
 }
 
 void Emulator::build_dictionary() {
@@ -101,33 +126,42 @@ void Emulator::build_dictionary() {
   add(0x1018, 3, cfg_.revision);
   add(0x1018, 4, n);
   add(0x1019, 0, 0);
+  if (cfg_.behaviour.error_behaviour) {
+    add(0x1029, 0, 1);
+    add(0x1029, 1, 0);  // communication error: enter Pre-operational
+  }
   add(0x1200, 0, 2);
   add(0x1200, 1, canopen::cob::sdo_rx(n));
   add(0x1200, 2, canopen::cob::sdo_tx(n));
+  // PDO1 at power-on: CiA 402's predefined RPDO1/TPDO1 (controlword /
+  // statusword only, event-driven), or (permissive) the master's CSP mapping.
+  const bool cia402_pdos = cfg_.behaviour.cia402_default_pdos;
+  const std::uint8_t pdo1_count = cia402_pdos ? 1 : 2;
+  const std::uint8_t pdo1_type = cia402_pdos ? 255 : 1;
   for (std::uint8_t p = 0; p < 4; ++p) {
     const auto pn = static_cast<std::uint8_t>(p + 1);
     const std::uint32_t inval = p == 0 ? 0 : canopen::kPdoInvalid;
     add(static_cast<std::uint16_t>(0x1400 + p), 0, 2);
     add(static_cast<std::uint16_t>(0x1400 + p), 1, canopen::cob::rpdo(pn, n) | inval);
-    add(static_cast<std::uint16_t>(0x1400 + p), 2, 1);
-    add(static_cast<std::uint16_t>(0x1600 + p), 0, p == 0 ? 2 : 0);
+    add(static_cast<std::uint16_t>(0x1400 + p), 2, p == 0 ? pdo1_type : 1);
+    add(static_cast<std::uint16_t>(0x1600 + p), 0, p == 0 ? pdo1_count : 0);
     for (std::uint8_t s = 1; s <= 8; ++s) {
       std::uint32_t v = 0;
       if (p == 0 && s == 1) v = 0x60400010;
-      if (p == 0 && s == 2) v = 0x607A0020;
+      if (p == 0 && s == 2 && !cia402_pdos) v = 0x607A0020;
       add(static_cast<std::uint16_t>(0x1600 + p), s, v);
     }
     add(static_cast<std::uint16_t>(0x1800 + p), 0, 6);
     add(static_cast<std::uint16_t>(0x1800 + p), 1, canopen::cob::tpdo(pn, n) | inval);
-    add(static_cast<std::uint16_t>(0x1800 + p), 2, 1);
+    add(static_cast<std::uint16_t>(0x1800 + p), 2, p == 0 ? pdo1_type : 1);
     add(static_cast<std::uint16_t>(0x1800 + p), 3, 0);
     add(static_cast<std::uint16_t>(0x1800 + p), 5, 0);
     add(static_cast<std::uint16_t>(0x1800 + p), 6, 0);
-    add(static_cast<std::uint16_t>(0x1A00 + p), 0, p == 0 ? 2 : 0);
+    add(static_cast<std::uint16_t>(0x1A00 + p), 0, p == 0 ? pdo1_count : 0);
     for (std::uint8_t s = 1; s <= 8; ++s) {
       std::uint32_t v = 0;
       if (p == 0 && s == 1) v = 0x60410010;
-      if (p == 0 && s == 2) v = 0x60640020;
+      if (p == 0 && s == 2 && !cia402_pdos) v = 0x60640020;
       add(static_cast<std::uint16_t>(0x1A00 + p), s, v);
     }
   }
@@ -188,16 +222,21 @@ void Emulator::build_dictionary() {
   add(obj::kFollowingErrorActualValue, 0, 0);
   add(obj::kDigitalInputs, 0, 0);
   add(obj::kTargetVelocity, 0, 0);
-  add(obj::kSupportedDriveModes, 0,
-      cfg_.supported_modes != 0
-          ? cfg_.supported_modes
-          : cia402::supported_mode_bit(cia402::Mode::kHoming) | cia402::supported_mode_bit(cia402::Mode::kCsp) |
-                cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst));
-  // A drive without some optional objects (EmulatorConfig::absent_objects).
+  add(obj::kSupportedDriveModes, 0, cfg_.supported_modes);
+  // A drive without some optional objects (EmulatorConfig::absent_objects,
+  // EmulatorBehaviour::optional_objects_absent).
   std::erase_if(od_, [this](const Entry& e) {
-    return std::find(cfg_.absent_objects.begin(), cfg_.absent_objects.end(), static_cast<std::uint16_t>(e.key >> 8)) !=
-           cfg_.absent_objects.end();
+    const auto index = static_cast<std::uint16_t>(e.key >> 8);
+    if (cfg_.behaviour.optional_objects_absent &&
+        std::find(kOptionalObjects.begin(), kOptionalObjects.end(), index) != kOptionalObjects.end())
+      return true;
+    return std::find(cfg_.absent_objects.begin(), cfg_.absent_objects.end(), index) != cfg_.absent_objects.end();
   });
+  if (cfg_.behaviour.ip_index_read_only) {
+    for (Entry& e : od_)
+      if (e.key == key(obj::kInterpolationTimePeriod, 2)) e.access = canopen::Access::kRo;
+  }
+  if (!cfg_.served.empty()) apply_served();  // a drive described by an EDS
   std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
   od_.shrink_to_fit();  // od_ never changes size after this: Entry pointers stay valid
   rebuild_pdos();
@@ -207,6 +246,7 @@ std::vector<Emulator::ObjectDescription> Emulator::dictionary() const {
   std::vector<ObjectDescription> d;
   d.reserve(od_.size());
   for (const Entry& e : od_) {
+    if (e.hidden) continue;
     d.push_back(ObjectDescription{static_cast<std::uint16_t>(e.key >> 8), static_cast<std::uint8_t>(e.key & 0xFF), e.type,
                                   e.access, e.pdo, e.default_value,
                                   e.text != nullptr ? std::string_view(*e.text) : std::string_view{}});
@@ -285,7 +325,9 @@ const Emulator::Entry* Emulator::find(std::uint16_t index, std::uint8_t sub) con
 bool Emulator::index_exists(std::uint16_t index) const noexcept {
   const std::uint32_t k = key(index, 0);
   auto it = std::lower_bound(od_.begin(), od_.end(), k, [](const Entry& e, std::uint32_t kk) { return e.key < kk; });
-  return it != od_.end() && (it->key >> 8) == index;
+  for (; it != od_.end() && (it->key >> 8) == index; ++it)
+    if (!it->hidden) return true;
+  return false;
 }
 std::uint64_t Emulator::get(std::uint16_t index, std::uint8_t sub) const noexcept {
   const Entry* e = find(index, sub);
@@ -329,7 +371,7 @@ void Emulator::rebuild_pdos() noexcept {
         m.add(e.index, e.sub, e.bits);
       }
       const bool ok = m.finalize();
-      const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0 && find(comm, 1) != nullptr;
+      const bool valid = (cob & canopen::kPdoInvalid) == 0 && ok && m.count > 0 && served(comm, 1) != nullptr;
       auto& cache = rx ? rpdo_entries_[p] : tpdo_entries_[p];
       cache = {};
       for (std::uint8_t i = 0; i < m.count; ++i) {
@@ -347,6 +389,7 @@ void Emulator::rebuild_pdos() noexcept {
         tpdo_[p] = m;
         tpdo_valid_[p] = valid;
         tpdo_sync_count_[p] = 0;
+        tpdo_sent_[p] = false;  // types 0/254/255: the next chance sends it
       }
     }
   }
@@ -359,6 +402,7 @@ void Emulator::rebuild_pdos() noexcept {
 }
 
 SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::uint64_t v) const noexcept {
+  if (cfg_.behaviour.remap_preoperational_only && nmt_ == canopen::NmtState::kOperational) return SdoAbort::kDeviceState;
   if (is_rpdo_comm(index) || is_tpdo_comm(index)) {
     if (sub == 1) {
       const auto cur = static_cast<std::uint32_t>(get(index, 1));
@@ -390,7 +434,7 @@ SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::u
   if (get(index, 0) != 0) return SdoAbort::kDeviceState;  // sub0 must be 0 while entries change
   if (v == 0) return SdoAbort::kNone;
   const auto e = canopen::decode_mapping_entry(static_cast<std::uint32_t>(v));
-  const Entry* target = find(e.index, e.sub);
+  const Entry* target = served(e.index, e.sub);
   if (target == nullptr) return index_exists(e.index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
   const bool mappable = rx ? (target->pdo == canopen::PdoMappable::kRpdo || target->pdo == canopen::PdoMappable::kBoth)
                            : (target->pdo == canopen::PdoMappable::kTpdo || target->pdo == canopen::PdoMappable::kBoth);
@@ -400,7 +444,7 @@ SdoAbort Emulator::check_pdo_write(std::uint16_t index, std::uint8_t sub, std::u
 }
 
 SdoAbort Emulator::sdo_read(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> out, std::size_t& len) noexcept {
-  const Entry* e = find(index, sub);
+  const Entry* e = served(index, sub);
   if (e == nullptr) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
   if (e->access == canopen::Access::kWo) return SdoAbort::kWriteOnly;
   if (e->text != nullptr) {
@@ -417,7 +461,7 @@ SdoAbort Emulator::sdo_read(std::uint16_t index, std::uint8_t sub, std::span<std
 
 SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data) noexcept {
   Entry* e = find(index, sub);
-  if (e == nullptr) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
+  if (e == nullptr || e->hidden) return index_exists(index) ? SdoAbort::kNoSubindex : SdoAbort::kNoObject;
   if (e->access == canopen::Access::kRo || e->access == canopen::Access::kConst) return SdoAbort::kReadOnly;
   const std::size_t n = canopen::data_type_size(e->type);
   if (data.size() > n) return SdoAbort::kLengthTooHigh;
@@ -429,10 +473,10 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
     const SdoAbort a = check_pdo_write(index, sub, v);
     if (a != SdoAbort::kNone) return a;
   }
-  if (index == obj::kModesOfOperation) {
-    const auto m = static_cast<std::int8_t>(v);
-    if (m != 0 && m != 6 && m != 8 && m != 9 && m != 10) return SdoAbort::kInvalidValue;
-  }
+  if (index == obj::kModesOfOperation && !mode_supported(static_cast<std::int8_t>(v))) return SdoAbort::kInvalidValue;
+  if (index == obj::kHomingMethod && !homing_method_supported(static_cast<std::int8_t>(v))) return SdoAbort::kInvalidValue;
+  if (index == 0x1019 && cfg_.behaviour.check_sync_length && (v == 1 || v > 240)) return SdoAbort::kInvalidValue;
+  if (index == 0x1029 && sub == 1 && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 1 && v == 0) return SdoAbort::kInvalidValue;
   if (index == obj::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;
   if (index == obj::kSlatConfiguration && v > 2) return SdoAbort::kInvalidValue;
@@ -456,9 +500,10 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   if (index == 0x1017) next_heartbeat_ns_ = now_ns_ + static_cast<std::int64_t>(v) * 1'000'000;
   if (index == 0x1016) consumers_[static_cast<std::size_t>(std::min<std::uint8_t>(sub, 4) - 1)] = Consumer{};
   if (index == kFaultInjection && v != 0) inject_fault(static_cast<std::uint16_t>(v));
-  if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled && !cfg_.refuse_mode_switch)
+  if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled && !cfg_.refuse_mode_switch &&
+      cfg_.behaviour.mode_switch_syncs == 0)
     mode_display_ = static_cast<std::int8_t>(v);
-  if (index == obj::kControlword && out_ != nullptr) apply_controlword(static_cast<std::uint16_t>(v), *out_);
+  if (index == obj::kControlword && out_ != nullptr && cfg_.remote) apply_controlword(static_cast<std::uint16_t>(v), *out_);
   return SdoAbort::kNone;
 }
 
@@ -485,18 +530,28 @@ void Emulator::power_on(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   reset_dictionary(false);
   sdo_.reset();
   state_ = State::kNotReadyToSwitchOn;  // transition 0
-  state_ = State::kSwitchOnDisabled;    // transition 1: initialisation is instantaneous
+  // Transition 1 when the DC bus has charged (automatic_transitions()).
+  boot_ready_ns_ = now_ns + cfg_.behaviour.boot_ns;
   last_cw_ = 0;
+  settled_cw_ = {};
   active_fault_ = pending_fault_ = 0;
+  fault_cause_syncs_left_ = 0;
+  rpdo_short_error_ = rpdo_long_error_ = sync_length_error_ = false;
+  rpdo_short_mask_ = rpdo_long_mask_ = 0;
+  homing_active_ = homing_done_ = homing_error_ = false;
+  homing_phase_ = HomingPhase::kIdle;
+  sdo_queue_size_ = 0;
   following_error_ = false;
   vel_ = acc_ = 0;
-  mode_display_ = static_cast<std::int8_t>(get(obj::kModesOfOperation));
+  mode_display_ = mode_wanted_ = static_cast<std::int8_t>(get(obj::kModesOfOperation));
+  mode_countdown_ = 0;
   set(obj::kPositionActualValue, 0, static_cast<std::uint32_t>(position()));
   set(obj::kTargetPosition, 0, static_cast<std::uint32_t>(position()));
   nmt_ = canopen::NmtState::kPreOperational;
   out.send(canopen::make_heartbeat_frame(cfg_.node, canopen::NmtState::kBootUp));
   ++counters_.boot_ups;
   next_heartbeat_ns_ = now_ns;
+  automatic_transitions(false, out);  // transition 1 at once when boot_ns is 0
 }
 
 void Emulator::handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::FrameSink& out) noexcept {
@@ -510,12 +565,42 @@ void Emulator::handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::Fra
     case 0x82:
       reset_dictionary(true);
       sdo_.reset();
+      sdo_queue_size_ = 0;
       nmt_ = canopen::NmtState::kPreOperational;
       out.send(canopen::make_heartbeat_frame(cfg_.node, canopen::NmtState::kBootUp));
       ++counters_.boot_ups;
       next_heartbeat_ns_ = now_ns;
       break;
     default: break;
+  }
+}
+
+/// FrameSink that holds the SDO server's replies in the emulator's delay
+/// queue (EmulatorBehaviour::sdo_reply_delay_ns) instead of sending them.
+class DelayedSdoSink final : public canopen::FrameSink {
+ public:
+  explicit DelayedSdoSink(Emulator& e) noexcept : e_(e) {}
+  bool send(const can::Frame& f) noexcept override {
+    if (e_.sdo_queue_size_ == e_.sdo_queue_.size()) {
+      ++e_.counters_.sdo_replies_dropped;  // a drive's SDO buffer overrun
+      return false;
+    }
+    const std::size_t tail = (e_.sdo_queue_head_ + e_.sdo_queue_size_) % e_.sdo_queue_.size();
+    e_.sdo_queue_[tail] = Emulator::DelayedFrame{f, e_.now_ns_ + e_.cfg_.behaviour.sdo_reply_delay_ns};
+    ++e_.sdo_queue_size_;
+    return true;
+  }
+
+ private:
+  Emulator& e_;
+};
+
+void Emulator::flush_sdo_replies(canopen::FrameSink& out) noexcept {
+  // Strictly later than the call that queued them (due_ns > that call's time).
+  while (sdo_queue_size_ > 0 && sdo_queue_[sdo_queue_head_].due_ns <= now_ns_) {
+    out.send(sdo_queue_[sdo_queue_head_].frame);
+    sdo_queue_head_ = (sdo_queue_head_ + 1) % sdo_queue_.size();
+    --sdo_queue_size_;
   }
 }
 
@@ -529,7 +614,17 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
     return;
   }
   if (f.id == (val(hot_.sync_cob) & 0x7FFu)) {
-    if (nmt_ == canopen::NmtState::kOperational || nmt_ == canopen::NmtState::kPreOperational) handle_sync(now_ns_, out);
+    if (nmt_ == canopen::NmtState::kOperational || nmt_ == canopen::NmtState::kPreOperational) {
+      // CiA 301: a SYNC carries the counter byte exactly when 0x1019 > 0.
+      const std::uint8_t want = get(0x1019) == 0 ? 0 : 1;
+      const bool bad = cfg_.behaviour.check_sync_length && f.len != want;
+      comm_error(sync_length_error_, bad, canopen::emcy_code::kUnexpectedSyncLength, out);
+      if (bad) {
+        ++counters_.sync_length_errors;  // not processed
+      } else {
+        handle_sync(now_ns_, out);
+      }
+    }
     out_ = nullptr;
     return;
   }
@@ -540,7 +635,12 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
   if (f.id == canopen::cob::sdo_rx(cfg_.node) && cfg_.node >= 1 && cfg_.node <= 127) {
     if (nmt_ != canopen::NmtState::kStopped && !f.remote()) {
       ++counters_.sdo_requests;
-      sdo_.on_frame(f, now_ns_, out);
+      if (cfg_.behaviour.sdo_reply_delay_ns > 0) {
+        DelayedSdoSink delayed(*this);
+        sdo_.on_frame(f, now_ns_, delayed);
+      } else {
+        sdo_.on_frame(f, now_ns_, out);
+      }
     }
   } else if (fc == 0x700u && from_node != 0 && f.id <= 0x7FFu) {
     for (std::uint8_t s = 1; s <= 4; ++s) {
@@ -556,13 +656,27 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
     for (std::uint8_t k = 0; k < rpdo_active_count_; ++k) {
       const std::size_t p = rpdo_active_[k];
       if (f.id != rpdo_[p].cob_id) continue;
-      if (f.len < rpdo_[p].size_bytes) {
+      // CiA 301: a short RPDO is not processed (EMCY 8210h); a long one is
+      // processed with its first bytes (EMCY 8220h, strict). Each EMCY once
+      // while the error lasts, 0000h when a right one follows.
+      const bool short_pdo = f.len < rpdo_[p].size_bytes;
+      const bool long_pdo = cfg_.behaviour.rpdo_too_long_emcy && f.len > rpdo_[p].size_bytes;
+      const auto bit = static_cast<std::uint8_t>(1u << p);
+      rpdo_short_mask_ = static_cast<std::uint8_t>(short_pdo ? rpdo_short_mask_ | bit : rpdo_short_mask_ & ~bit);
+      rpdo_long_mask_ = static_cast<std::uint8_t>(long_pdo ? rpdo_long_mask_ | bit : rpdo_long_mask_ & ~bit);
+      comm_error(rpdo_short_error_, rpdo_short_mask_ != 0, canopen::emcy_code::kPdoLength, out);
+      comm_error(rpdo_long_error_, rpdo_long_mask_ != 0, canopen::emcy_code::kPdoLengthExceeded, out);
+      if (short_pdo) {
         ++counters_.rpdo_length_errors;
-        send_emcy(canopen::emcy_code::kPdoLength, out);
+        continue;
+      }
+      ++counters_.rpdos;
+      if (rpdo_[p].transmission_type >= 254) {
+        // Event-driven RPDO: applied on receipt, not at the next SYNC.
+        if (apply_rpdo(p, canopen::payload_word(f))) evaluate_controlword(out);
       } else {
         rpdo_latch_[p] = canopen::payload_word(f);  // all handle_sync() reads of it
         rpdo_pending_ = static_cast<std::uint8_t>(rpdo_pending_ | (1u << p));
-        ++counters_.rpdos;
       }
     }
   }
@@ -608,18 +722,26 @@ void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
     if (!k.armed || k.lost || ms == 0) continue;
     if (now_ns - k.last_ns > ms * 1'000'000) {
       k.lost = true;
-      put(hot_.error_register, val(hot_.error_register) | canopen::kErrCommunication);
+      refresh_error_register();  // communication error
       switch (cfg_.heartbeat_loss_reaction) {
-        case HeartbeatLossReaction::kFault: enter_fault(canopen::emcy_code::kHeartbeatError, out); break;
+        case HeartbeatLossReaction::kFault: pending_fault_ = canopen::emcy_code::kHeartbeatError; break;
         case HeartbeatLossReaction::kQuickStop:
-          if (state_ == State::kOperationEnabled) state_ = State::kQuickStopActive;
+          if (state_ == State::kOperationEnabled) state_ = State::kQuickStopActive;  // transition 11
           send_emcy(canopen::emcy_code::kHeartbeatError, out);
           break;
         case HeartbeatLossReaction::kNone: send_emcy(canopen::emcy_code::kHeartbeatError, out); break;
       }
+      automatic_transitions(false, out);  // 13 now, not at the next SYNC (the master may be gone)
+      apply_error_behaviour();
     }
   }
+  automatic_transitions(false, out);
   sdo_.step(now_ns, out);
+  flush_sdo_replies(out);
+  if (nmt_ == canopen::NmtState::kOperational) {
+    put(hot_.statusword, statusword());  // an SDO controlword or a fault may have changed it
+    send_tpdos(false, out);
+  }
   out_ = nullptr;
 }
 
@@ -663,7 +785,7 @@ void Emulator::service(can::SimBus::Endpoint& bus, std::int64_t now_ns) noexcept
 // ============================================================================
 std::uint16_t Emulator::statusword() const noexcept {
   std::uint16_t sw = cia402::state_bits(state_);
-  sw |= cia402::sw::kRemote;
+  if (cfg_.remote) sw |= cia402::sw::kRemote;
   switch (state_) {
     case State::kReadyToSwitchOn:
     case State::kSwitchedOn:
@@ -678,7 +800,8 @@ std::uint16_t Emulator::statusword() const noexcept {
     if (cia402::is_cyclic(mode)) sw |= cia402::sw::kFollowsCommand;
     if (mode == cia402::Mode::kHoming) {
       if (homing_done_) sw |= cia402::sw::kHomingAttained | cia402::sw::kTargetReached;
-      if (!homing_active_ && !homing_done_) sw |= cia402::sw::kTargetReached;  // interrupted / not started
+      if (homing_error_) sw |= cia402::sw::kHomingError | (vel_ == 0.0 ? cia402::sw::kTargetReached : 0);
+      if (!homing_active_ && !homing_done_ && !homing_error_) sw |= cia402::sw::kTargetReached;  // interrupted / not started
     }
   }
   if (following_error_ && mode == cia402::Mode::kCsp) sw |= cia402::sw::kFollowingError;
@@ -693,7 +816,7 @@ std::int32_t Emulator::position() const noexcept {
 void Emulator::enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept {
   active_fault_ = code;
   set(obj::kErrorCode, 0, code);
-  set(0x1001, 0, get(0x1001, 0) | error_register_for(code));
+  refresh_error_register();
   for (std::uint8_t s = 8; s > 1; --s) set(0x1003, s, get(0x1003, static_cast<std::uint8_t>(s - 1)));
   set(0x1003, 1, code);
   set(0x1003, 0, std::min<std::uint64_t>(get(0x1003, 0) + 1, 8));
@@ -704,19 +827,28 @@ void Emulator::enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept
 void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept {
   const auto qs = static_cast<std::int16_t>(sval(hot_.quick_stop_option));
   std::uint16_t prev = last_cw_;
-  for (int i = 0; i < 2; ++i) {
+  // Permissive: 0x000F from Ready to switch on gives 3 and 4 in this call;
+  // strict: one transition, the next at the next SYNC (handle_sync()).
+  const int max_transitions = cfg_.behaviour.one_transition_per_sync ? 1 : 2;
+  for (int i = 0; i < max_transitions; ++i) {
     const cia402::StepResult r = cia402::apply_controlword(state_, prev, cw, qs);
     if (r.transition == cia402::kNoTransition) {
       if (prev == cw) settled_cw_ = SettledControlword{true, state_, cw, qs};
       break;
     }
     if (r.transition == 15) {
+      if (fault_cause_remains()) {
+        ++counters_.refused_fault_resets;  // stays in Fault; the edge is used up
+        break;
+      }
       active_fault_ = 0;
       following_error_ = false;
       following_error_cycles_ = 0;
       set(obj::kErrorCode, 0, 0);
-      set(0x1001, 0, 0);
-      for (auto& k : consumers_) k.lost = false;
+      if (cfg_.behaviour.fault_cause_syncs == 0) {
+        for (auto& k : consumers_) k.lost = false;  // permissive: the reset forgets a lost heartbeat
+      }
+      refresh_error_register();
       send_emcy(canopen::emcy_code::kNoError, out);  // error reset
     }
     if (r.next == State::kOperationEnabled) {
@@ -726,7 +858,8 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
                         static_cast<std::int16_t>(sval(hot_.target_torque))};
       delay_.fill(sp);
       prev_demand_ = sp.position;
-      if (!cfg_.refuse_mode_switch) mode_display_ = static_cast<std::int8_t>(sval(hot_.modes));
+      if (!cfg_.refuse_mode_switch && cfg_.behaviour.mode_switch_syncs == 0 && mode_supported(static_cast<std::int8_t>(sval(hot_.modes))))
+        mode_display_ = static_cast<std::int8_t>(sval(hot_.modes));
       reset_direct_model();
     }
     state_ = r.next;
@@ -735,8 +868,7 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
   // Homing start: rising edge of bit 4 in Operation enabled, mode 6.
   if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kHoming) &&
       (cw & cia402::cw::kHomingStart) != 0 && (last_cw_ & cia402::cw::kHomingStart) == 0) {
-    homing_active_ = true;
-    homing_done_ = false;
+    start_homing();
   }
   if ((cw & cia402::cw::kHomingStart) == 0) homing_active_ = false;
   last_cw_ = cw;
@@ -784,23 +916,7 @@ void Emulator::advance_motor(double dt) noexcept {
         v_des = cst_step(std::clamp(static_cast<double>(sp.torque), -tmax, tmax), sp.velocity, dt, torque);
         break;
       }
-      case cia402::Mode::kHoming:
-        if (homing_active_ && !homing_done_) {
-          const auto method = static_cast<std::int8_t>(sval(hot_.homing_method));
-          if (method == 35 || method == 37 || std::abs(pos_) < 1.0) {
-            pos_ = static_cast<double>(sval(hot_.home_offset));
-            homing_done_ = true;
-            homing_active_ = false;
-            stop_immediately = true;
-          } else {
-            // Search the home switch at position 0 with the switch-search speed.
-            const double speed = static_cast<double>(val(hot_.homing_speed_switch));
-            const double step = std::min(speed * dt, std::abs(pos_));
-            v_des = (pos_ > 0 ? -step : step) / dt;
-            amax = std::max(amax, std::abs(v_des - vel_) / dt);
-          }
-        }
-        break;
+      case cia402::Mode::kHoming: v_des = homing_velocity(dt, amax, stop_immediately); break;
       default: break;
     }
   } else if (state_ == State::kQuickStopActive) {
@@ -823,9 +939,6 @@ void Emulator::advance_motor(double dt) noexcept {
   const double trq = mode == cia402::Mode::kCst && state_ == State::kOperationEnabled ? torque : acc_ * torque_per_acc_;
   torque_ = trq;
   put(hot_.torque_actual, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(round_half_away(trq), -32768.0, 32767.0))));
-  if (state_ == State::kQuickStopActive && vel_ == 0.0 && !cia402::quick_stop_stays(static_cast<std::int16_t>(sval(hot_.quick_stop_option)))) {
-    state_ = State::kSwitchOnDisabled;  // transition 12 (quick stop completed)
-  }
 }
 
 void Emulator::update_outputs() noexcept {
@@ -838,82 +951,190 @@ void Emulator::update_outputs() noexcept {
   put(hot_.statusword, statusword());
 }
 
-void Emulator::send_tpdos(canopen::FrameSink& out) noexcept {
+std::uint64_t Emulator::tpdo_payload(std::size_t p) const noexcept {
+  const canopen::PdoMap& m = tpdo_[p];
+  const auto& cache = tpdo_entries_[p];
+  const canopen::PdoPlan& plan = tpdo_plan_[p];
+  std::uint64_t w = 0;  // the payload, stored at once
+  for (std::uint8_t i = 0; i < m.count; ++i) {
+    const MappedEntry& me = cache[i];
+    // Callers store statusword() in 0x6041 first (update_outputs(), step()).
+    w = plan.put(w, i, me.is_statusword ? val(hot_.statusword) : val(me.entry));
+  }
+  return w;
+}
+
+void Emulator::send_tpdos(bool at_sync, canopen::FrameSink& out) noexcept {
   for (std::uint8_t k = 0; k < tpdo_active_count_; ++k) {  // the valid ones, ascending
     const std::size_t p = tpdo_active_[k];
     const canopen::PdoMap& m = tpdo_[p];
     const std::uint8_t t = m.transmission_type;
-    if (t >= 241 && t <= 253) continue;  // RTR-only / reserved: not sent on SYNC
-    ++tpdo_sync_count_[p];
-    if (t >= 2 && t <= 240 && tpdo_sync_count_[p] % t != 0) continue;  // (1: every SYNC, no division)
+    if (t >= 241 && t <= 253) continue;  // RTR-only / reserved: never sent by themselves
+    const bool event = t >= 254;
+    if (!event && !at_sync) continue;  // synchronous types: only at a SYNC
+    if (t >= 1 && t <= 240) {
+      ++tpdo_sync_count_[p];
+      if (t >= 2 && tpdo_sync_count_[p] % t != 0) continue;  // (1: every SYNC, no division)
+    }
+    const std::uint64_t w = tpdo_payload(p);
+    if (t == 0 || event) {
+      const bool changed = !tpdo_sent_[p] || w != tpdo_last_payload_[p];
+      if (t == 0 && !changed) continue;  // acyclic synchronous: at the SYNC after a change
+      if (event) {
+        const auto comm = static_cast<std::uint16_t>(0x1800 + p);
+        const std::int64_t since = now_ns_ - tpdo_last_sent_ns_[p];
+        const auto event_ms = static_cast<std::int64_t>(get(comm, 5));
+        const bool timer = tpdo_sent_[p] && event_ms > 0 && since >= event_ms * 1'000'000;
+        if (!changed && !timer) continue;
+        const auto inhibit_100us = static_cast<std::int64_t>(get(comm, 3));
+        if (tpdo_sent_[p] && since < inhibit_100us * 100'000) continue;  // sent when the inhibit time is over
+      }
+    }
     can::Frame f;
     f.id = m.cob_id;
     f.len = m.size_bytes;
-    const auto& cache = tpdo_entries_[p];
-    const canopen::PdoPlan& plan = tpdo_plan_[p];
-    std::uint64_t w = 0;  // the payload, stored at once
-    for (std::uint8_t i = 0; i < m.count; ++i) {
-      const MappedEntry& me = cache[i];
-      // handle_sync() calls this right after update_outputs() stored statusword() in 0x6041.
-      w = plan.put(w, i, me.is_statusword ? val(hot_.statusword) : val(me.entry));
-    }
     canopen::set_payload_word(f, w);
     out.send(f);
+    tpdo_last_payload_[p] = w;
+    tpdo_last_sent_ns_[p] = now_ns_;
+    tpdo_sent_[p] = true;
     ++counters_.tpdos;
+  }
+}
+
+bool Emulator::apply_rpdo(std::size_t p, std::uint64_t w) noexcept {
+  const canopen::PdoMap& m = rpdo_[p];
+  const canopen::PdoPlan& plan = rpdo_plan_[p];
+  const auto& cache = rpdo_entries_[p];
+  bool cw_written = false;
+  for (std::uint8_t i = 0; i < m.count; ++i) {
+    const MappedEntry& me = cache[i];
+    put(me.entry, plan.get(w, i));
+    if (me.is_controlword) cw_written = true;
+  }
+  return cw_written;
+}
+
+void Emulator::evaluate_controlword(canopen::FrameSink& out) noexcept {
+  if (!cfg_.remote) return;  // local control: the bus's controlword is ignored
+  const auto cw = static_cast<std::uint16_t>(val(hot_.controlword));
+  // The controlword of the last call again, in a state where it was seen
+  // to cause no transition without an edge: apply_controlword() would
+  // change nothing (no transition, no homing edge, homing_active_ already
+  // cleared if bit 4 is 0), so it is not called (most SYNCs).
+  const bool settled = cw == last_cw_ && settled_cw_.valid && settled_cw_.state == state_ && settled_cw_.cw == cw &&
+                       settled_cw_.qs == static_cast<std::int16_t>(sval(hot_.quick_stop_option)) &&
+                       ((cw & cia402::cw::kHomingStart) != 0 || !homing_active_);
+  if (!settled) apply_controlword(cw, out);
+}
+
+bool Emulator::mode_supported(std::int8_t mode) const noexcept {
+  if (mode == 0) return true;  // no mode
+  return (cfg_.supported_modes & cia402::supported_mode_bit(static_cast<cia402::Mode>(mode))) != 0;
+}
+
+void Emulator::switch_mode(std::int8_t mode) noexcept {
+  if (state_ == State::kOperationEnabled && mode != mode_display_) {
+    // Mode switch while enabled: the new mode starts from the present state.
+    prev_demand_ = pos_;
+    delay_.fill(Setpoint{position(), static_cast<std::int32_t>(sval(hot_.target_velocity)),
+                         static_cast<std::int16_t>(sval(hot_.target_torque))});
+    reset_direct_model();
+  }
+  mode_display_ = mode;
+}
+
+void Emulator::update_mode_display() noexcept {
+  if (cfg_.refuse_mode_switch) return;  // fault injection: 0x6061 keeps showing the old mode
+  const auto modes = static_cast<std::int8_t>(sval(hot_.modes));
+  if (cfg_.behaviour.refuse_unsupported_modes && !mode_supported(modes)) {
+    mode_wanted_ = mode_display_;  // an RPDO wrote a mode the drive lacks: not taken
+    return;
+  }
+  if (modes != mode_wanted_) {
+    mode_wanted_ = modes;
+    mode_countdown_ = cfg_.behaviour.mode_switch_syncs;
+  }
+  if (mode_countdown_ > 0) {
+    --mode_countdown_;
+    return;
+  }
+  if (mode_wanted_ != mode_display_) switch_mode(mode_wanted_);
+}
+
+bool Emulator::fault_cause_remains() const noexcept {
+  if (fault_cause_held_ || fault_cause_syncs_left_ > 0) return true;
+  if (cfg_.behaviour.fault_cause_syncs == 0) return false;
+  for (const Consumer& k : consumers_)
+    if (k.lost) return true;  // the master's heartbeat has not come back
+  return false;
+}
+
+void Emulator::refresh_error_register() noexcept {
+  std::uint8_t r = active_fault_ != 0 ? error_register_for(active_fault_) : 0;
+  bool comm = rpdo_short_error_ || rpdo_long_error_ || sync_length_error_;
+  for (const Consumer& k : consumers_) comm = comm || k.lost;
+  if (comm) r |= canopen::kErrGeneric | canopen::kErrCommunication;
+  put(hot_.error_register, r);
+}
+
+void Emulator::comm_error(bool& flag, bool active, std::uint16_t code, canopen::FrameSink& out) noexcept {
+  if (flag == active) return;
+  flag = active;
+  refresh_error_register();
+  send_emcy(active ? code : canopen::emcy_code::kNoError, out);
+}
+
+void Emulator::apply_error_behaviour() noexcept {
+  if (!cfg_.behaviour.error_behaviour) return;
+  switch (get(0x1029, 1)) {
+    case 0:
+      if (nmt_ == canopen::NmtState::kOperational) nmt_ = canopen::NmtState::kPreOperational;
+      break;
+    case 2: nmt_ = canopen::NmtState::kStopped; break;
+    default: break;  // 1: no change of the NMT state
+  }
+}
+
+void Emulator::automatic_transitions(bool at_sync, canopen::FrameSink& out) noexcept {
+  // 1: initialisation done (the DC bus has charged).
+  if (state_ == State::kNotReadyToSwitchOn && now_ns_ >= boot_ready_ns_) state_ = State::kSwitchOnDisabled;
+  if (at_sync) {
+    // 12: the quick stop has stopped the motor (0x605A = 1..4; 5..8 stay).
+    if (state_ == State::kQuickStopActive && vel_ == 0.0 &&
+        !cia402::quick_stop_stays(static_cast<std::int16_t>(sval(hot_.quick_stop_option))))
+      state_ = State::kSwitchOnDisabled;
+    // 14: the fault reaction, begun before this SYNC, is complete.
+    if (state_ == State::kFaultReactionActive) state_ = State::kFault;
+    if (fault_cause_syncs_left_ > 0) --fault_cause_syncs_left_;
+  }
+  // 13: a fault was detected (injected, following error, heartbeat lost).
+  if (pending_fault_ != 0) {
+    const std::uint16_t code = pending_fault_;
+    pending_fault_ = 0;
+    if (code != canopen::emcy_code::kHeartbeatError && code != canopen::emcy_code::kFollowingError)
+      fault_cause_syncs_left_ = cfg_.behaviour.fault_cause_syncs;  // an injected fault's cause lasts
+    enter_fault(code, out);
   }
 }
 
 void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noexcept {
   ++counters_.syncs;
   const bool operational = nmt_ == canopen::NmtState::kOperational;
-  // RPDOs received since the last SYNC take effect now.
+  // Synchronous RPDOs received since the last SYNC take effect now.
   if (operational) {
     bool cw_written = false;
     for (unsigned pending = rpdo_pending_; pending != 0; pending &= pending - 1) {  // ascending
       const auto p = static_cast<std::size_t>(std::countr_zero(pending));
-      const canopen::PdoMap& m = rpdo_[p];
-      // The latched frame was at least m.size_bytes long (checked in on_frame).
-      const std::uint64_t w = rpdo_latch_[p];
-      const canopen::PdoPlan& plan = rpdo_plan_[p];
-      const auto& cache = rpdo_entries_[p];
-      for (std::uint8_t i = 0; i < m.count; ++i) {
-        const MappedEntry& me = cache[i];
-        put(me.entry, plan.get(w, i));
-        if (me.is_controlword) cw_written = true;
-      }
+      // The latched frame was at least rpdo_[p].size_bytes long (checked in on_frame).
+      cw_written = apply_rpdo(p, rpdo_latch_[p]) || cw_written;
     }
     rpdo_pending_ = 0;
-    if (cw_written) {
-      const auto cw = static_cast<std::uint16_t>(val(hot_.controlword));
-      // The controlword of the last call again, in a state where it was seen
-      // to cause no transition without an edge: apply_controlword() would
-      // change nothing (no transition, no homing edge, homing_active_ already
-      // cleared if bit 4 is 0), so it is not called (most SYNCs).
-      const bool settled = cw == last_cw_ && settled_cw_.valid && settled_cw_.state == state_ && settled_cw_.cw == cw &&
-                           settled_cw_.qs == static_cast<std::int16_t>(sval(hot_.quick_stop_option)) &&
-                           ((cw & cia402::cw::kHomingStart) != 0 || !homing_active_);
-      if (!settled) apply_controlword(cw, out);
-    }
-    const auto modes = static_cast<std::int8_t>(sval(hot_.modes));
-    if (cfg_.refuse_mode_switch) {
-      // fault injection: 0x6061 keeps showing the old mode
-    } else if (state_ != State::kOperationEnabled) mode_display_ = modes;
-    else if (modes != mode_display_) {
-      // Mode switch while enabled: the new mode starts from the present state.
-      mode_display_ = modes;
-      prev_demand_ = pos_;
-      delay_.fill(Setpoint{position(), static_cast<std::int32_t>(sval(hot_.target_velocity)),
-                           static_cast<std::int16_t>(sval(hot_.target_torque))});
-      reset_direct_model();
-    }
+    // Strict: the controlword is evaluated at every SYNC, so that 4 follows 3.
+    if (cw_written || cfg_.behaviour.one_transition_per_sync) evaluate_controlword(out);
+    update_mode_display();
   }
   if (cfg_.fail_after_syncs != 0 && counters_.syncs == cfg_.fail_after_syncs) pending_fault_ = cfg_.fail_emcy_code;
-  if (state_ == State::kFaultReactionActive) state_ = State::kFault;  // transition 14: reaction done
-  if (pending_fault_ != 0) {
-    const std::uint16_t code = pending_fault_;
-    pending_fault_ = 0;
-    enter_fault(code, out);
-  }
   // Motor: advances by the interpolation period 0x60C2, only here.
   const cia402::InterpolationPeriod ip{static_cast<std::uint8_t>(val(hot_.ip_value)),
                                         static_cast<std::int8_t>(sval(hot_.ip_index))};
@@ -933,16 +1154,17 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
       following_error_ = true;
       ++following_error_cycles_;
       const auto timeout_ms = static_cast<double>(val(hot_.fe_timeout));
-      if (static_cast<double>(following_error_cycles_) * static_cast<double>(period_ns) / 1e6 >= timeout_ms) {
-        enter_fault(canopen::emcy_code::kFollowingError, out);
-      }
+      if (static_cast<double>(following_error_cycles_) * static_cast<double>(period_ns) / 1e6 >= timeout_ms &&
+          pending_fault_ == 0)
+        pending_fault_ = canopen::emcy_code::kFollowingError;
     } else {
       following_error_ = false;
       following_error_cycles_ = 0;
     }
   }
+  automatic_transitions(true, out);
   update_outputs();
-  if (operational) send_tpdos(out);
+  if (operational) send_tpdos(true, out);
 }
 
 }  // namespace canmotion::emulator

@@ -4,10 +4,12 @@
 /// and tools/cia402-emu. It has an object dictionary with the CiA 301
 /// communication objects and the CiA 402 objects the master uses, an SDO
 /// server with the right abort codes, an NMT slave with boot-up and heartbeat,
-/// PDO mapping changeable only over SDO as CiA 301 says, RPDOs applied at the
-/// next SYNC, TPDOs sent on each SYNC, the CiA 402 state machine (modes 6, 8,
+/// PDO mapping changeable only over SDO as CiA 301 says, RPDOs and TPDOs per
+/// their transmission type (CiA 301), the CiA 402 state machine (modes 6, 8,
 /// 9, 10) from the shared cia402.hpp, and a motor model that advances only on
 /// SYNC (by the 0x60C2 period) with limited velocity/acceleration and a lag.
+/// EmulatorBehaviour chooses between a strict drive (what real drives do)
+/// and a permissive one (README "Emulator profiles").
 ///
 /// Faults: following error beyond 0x6065 -> Fault + EMCY 0x8611; master
 /// heartbeat lost (0x1016) -> the configured reaction + EMCY 0x8130; writing
@@ -46,8 +48,118 @@ enum class HeartbeatLossReaction : std::uint8_t {
   kNone,       ///< only the EMCY 0x8130
 };
 
+/// One sub-object of the set an emulated drive serves (EmulatorConfig::served),
+/// e.g. from a vendor's EDS (eds_dictionary.hpp).
+struct ServedObject {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  canopen::DataType type = canopen::DataType::kUnsigned32;
+  canopen::Access access = canopen::Access::kRw;
+  canopen::PdoMappable pdo = canopen::PdoMappable::kNo;
+  bool has_default = false;
+  std::uint64_t default_value = 0;  ///< raw bits (the node-ID already added)
+};
+
+/// How closely the emulated drive behaves like a real one (README
+/// "Emulator profiles"). `strict()` has every behaviour of a real drive that
+/// a master must cope with; `permissive()` is the lenient drive the project
+/// started with (every object exists, instant boot, same-call SDO replies, 3+4
+/// in one SYNC, ...). Each field can be set on its own (cia402-emu flags).
+/// Behaviours that are CiA 301/402 rules and not a drive's choice (TPDO
+/// transmission types, RPDO 254/255 on receipt, EMCY 8210h/8220h/8240h once
+/// with the error register and 0000h when they clear) are the same in both.
+struct EmulatorBehaviour {
+  /// The optional objects a drive may lack are absent: 0x1016 (consumer
+  /// heartbeat) and the project's vendor-area MDS objects 0x2010..0x2022
+  /// (SDO abort 0x06020000).
+  bool optional_objects_absent = true;
+  /// 0x60C2:2 (interpolation time index) is read-only (abort 0x06010002):
+  /// the drive only takes periods in milliseconds (index -3).
+  bool ip_index_read_only = true;
+  /// PDO parameters (0x1400..0x1BFF) change only in NMT Pre-operational;
+  /// in Operational they abort with 0x08000022.
+  bool remap_preoperational_only = true;
+  /// CiA 402 predefined PDOs at power-on: RPDO1 = controlword only, TPDO1 =
+  /// statusword only, both transmission type 255 (event-driven); PDOs 2..4
+  /// invalid and unmapped. Permissive: RPDO1 = 0x6040 + 0x607A, TPDO1 =
+  /// 0x6041 + 0x6064, type 1 (the master's own CSP mapping).
+  bool cia402_default_pdos = true;
+  /// An RPDO longer than its mapping: EMCY 8220h once (the mapped bytes are
+  /// used, as CiA 301 allows). Permissive: accepted silently.
+  bool rpdo_too_long_emcy = true;
+  /// The SYNC's length is checked against 0x1019 (0 bytes when 0x1019 = 0,
+  /// 1 byte otherwise): a SYNC of the wrong length is not processed and sends
+  /// EMCY 8240h once. 0x1019 writes take only 0 and 2..240 (0x06090030).
+  bool check_sync_length = true;
+  /// 0x1029:1 (error behaviour, communication error) exists and acts on a
+  /// communication error (lost master heartbeat): 0 = Pre-operational
+  /// (default), 1 = no change, 2 = Stopped.
+  bool error_behaviour = true;
+  /// After power-on the drive stays in Not ready to switch on (statusword
+  /// 0x0000) this long while the DC bus charges (0 = transition 1 at once).
+  std::int64_t boot_ns = 100'000'000;
+  /// SDO replies wait at least this long, and are never sent in the call
+  /// that received the request (0 = in the same call, at once).
+  std::int64_t sdo_reply_delay_ns = 1;
+  /// At most one commanded transition per SYNC (3 and 4 of 0x000F in two
+  /// SYNCs); the controlword is evaluated again at every SYNC until the
+  /// state settles. Permissive: 3 and 4 in the same call.
+  bool one_transition_per_sync = true;
+  /// A fault's cause outlasts the fault reaction: an injected fault's for
+  /// this many SYNCs, a lost heartbeat until the master's heartbeat is seen
+  /// again; a fault reset (15) meanwhile is refused (stays in Fault).
+  std::uint32_t fault_cause_syncs = 20;
+  /// 0x6061 shows a new 0x6060 this many SYNCs later (0 = at once).
+  std::uint32_t mode_switch_syncs = 2;
+  /// A mode not in 0x6502 is refused on every path: SDO abort 0x06090030,
+  /// and from an RPDO 0x6061 keeps the old mode. Permissive: the RPDO's
+  /// mode is shown in 0x6061.
+  bool refuse_unsupported_modes = true;
+  /// Homing moves per method family over several SYNCs (see
+  /// homing_model.cpp); methods the drive lacks are refused (0x06090030).
+  /// Permissive: 35/37 complete in one SYNC, others go straight to 0.
+  bool homing_takes_time = true;
+
+  [[nodiscard]] static EmulatorBehaviour strict() noexcept { return EmulatorBehaviour{}; }
+  [[nodiscard]] static EmulatorBehaviour permissive() noexcept;
+  /// What the loop rigs (SimRig, SimWorld via config::emulator_config, the
+  /// controller test rigs) use: strict except the two behaviours today's
+  /// master fails on at every boot (issue 15 items 5/6, being fixed in
+  /// fieldbus/cia402): it writes 0x1016 and the MDS objects 0x2010..0x2022
+  /// to every drive (optional_objects_absent) and 0x60C2:2
+  /// (ip_index_read_only), and stops at the abort. Make it strict() when the
+  /// master copes with both.
+  [[nodiscard]] static EmulatorBehaviour loop_default() noexcept {
+    EmulatorBehaviour b;
+    b.optional_objects_absent = false;
+    b.ip_index_read_only = false;
+    return b;
+  }
+};
+
+/// The objects a drive may lack (EmulatorBehaviour::optional_objects_absent).
+inline constexpr std::array<std::uint16_t, 6> kOptionalObjects = {0x1016, cia402::obj::kRampVelocityLimit,
+                                                                  cia402::obj::kRampJerkControl,
+                                                                  cia402::obj::kSlatConfiguration,
+                                                                  cia402::obj::kSlatSetPoint, cia402::obj::kSlatTimeDelay};
+
 struct EmulatorConfig {
   std::uint8_t node = 2;
+  /// Strict (default) or permissive, and the finer flags (see EmulatorBehaviour).
+  EmulatorBehaviour behaviour{};
+  /// Statusword bit 9 (remote): 0 = the drive is under local control and
+  /// ignores the bus's controlword (as a drive with its local panel active).
+  bool remote = true;
+  /// 0x6502 supported drive modes (bits per CiA 402); 0x6060 values outside
+  /// it are refused.
+  std::uint32_t supported_modes = cia402::supported_mode_bit(cia402::Mode::kHoming) |
+                                  cia402::supported_mode_bit(cia402::Mode::kCsp) |
+                                  cia402::supported_mode_bit(cia402::Mode::kCsv) |
+                                  cia402::supported_mode_bit(cia402::Mode::kCst);
+  // Homing geometry of the strict model (drive counts; see homing_model.cpp).
+  double home_switch_position = 0.0;     ///< edge of the home switch
+  double index_pulse_period = 4096.0;    ///< an index pulse at every multiple of this
+  double homing_max_travel = 10'000'000.0;  ///< no switch/index within this travel: homing error
   std::string device_name = "canmotion cia402-emu: emulated CiA 402 servo drive";  ///< 0x1008 (segmented SDO)
   std::uint32_t vendor_id = 0x00000000;  ///< 0x1018:1 (0: unassigned)
   std::uint32_t product_code = 0x00000402;
@@ -67,13 +179,18 @@ struct EmulatorConfig {
   /// 0x6061 (the drive refuses the mode switch); the master's mode-switch
   /// timeout (drive.timeouts.mode_switch_ms) must catch it.
   bool refuse_mode_switch = false;
-  /// 0x6502 (supported drive modes); 0: the modes the emulator runs (HM, CSP, CSV, CST).
-  std::uint32_t supported_modes = 0;
   /// Objects (indices) this drive does not have, e.g. the optional 0x1016, or
   /// 0x1402/0x1602 for a drive with fewer PDOs: SDO access to them aborts with
   /// 0x06020000 (object does not exist), as on a real drive without them.
   /// A PDO whose communication object is absent is never valid.
   std::vector<std::uint16_t> absent_objects;
+  /// Not empty (cia402-emu --eds): the drive serves exactly these
+  /// sub-objects over SDO and PDO mapping, with their access, PDO mapping
+  /// flags and defaults. Its own objects not listed abort 0x06020000 /
+  /// 0x06090011 and cannot be mapped (the behaviour behind them stays, e.g.
+  /// the EMCY COB-ID from 0x1014's default); listed numbers it does not know
+  /// are plain storage; strings and domains it does not know are left out.
+  std::vector<ServedObject> served;
   // Load model of CST (see README "Motor and load model"): motor torque T
   // (per mille of rated torque, 0x6071 clamped to 0x6072) accelerates the
   // motor by (T - load_torque - viscous_friction * v) / 1000 * rated_torque_acceleration.
@@ -95,6 +212,9 @@ struct EmulatorCounters {
   std::uint64_t heartbeats = 0;
   std::uint64_t boot_ups = 0;
   std::uint64_t rpdo_length_errors = 0;
+  std::uint64_t sync_length_errors = 0;     ///< SYNCs dropped for their length (0x1019)
+  std::uint64_t refused_fault_resets = 0;   ///< fault resets refused while the cause remained
+  std::uint64_t sdo_replies_dropped = 0;    ///< delayed SDO replies lost to a full queue
 };
 
 class Emulator final : public canopen::SdoServerBackend {
@@ -136,8 +256,15 @@ class Emulator final : public canopen::SdoServerBackend {
   /// (any dictionary write through set(), a PDO rebuild, a reset).
   [[nodiscard]] std::uint64_t accept_generation() const noexcept { return accept_gen_; }
 
-  /// Inject a fault with EMCY `code` (as writing 0x2000 does).
+  /// Inject a fault with EMCY `code` (as writing 0x2000 does). Its cause
+  /// lasts EmulatorBehaviour::fault_cause_syncs SYNCs.
   void inject_fault(std::uint16_t code) noexcept { pending_fault_ = code; }
+  /// Keep (true) or remove (false) the cause of the present fault: a fault
+  /// reset is refused while it is kept (fault injection, e.g. a DC bus that
+  /// stays under-voltage).
+  void hold_fault_cause(bool on) noexcept { fault_cause_held_ = on; }
+  /// Statusword bit 9 at run time (see EmulatorConfig::remote).
+  void set_remote(bool on) noexcept { cfg_.remote = on; }
 
   // ---- observation --------------------------------------------------------
   [[nodiscard]] std::uint8_t node() const noexcept { return cfg_.node; }
@@ -196,6 +323,7 @@ class Emulator final : public canopen::SdoServerBackend {
     const std::string* text;  // strings (0x1008...)
     std::uint64_t mask;       // the value bits of the type's size (put; all bits for 0 or 8 bytes)
     std::uint64_t sign;       // the sign bit of a signed type shorter than 8 bytes, else 0 (sval)
+    bool hidden = false;      // not in EmulatorConfig::served: used inside, not served (SDO, PDO mapping)
   };
   /// Entries the SYNC / frame path touches, resolved once after the
   /// dictionary is built (od_ never grows or reallocates afterwards, so the
@@ -269,6 +397,10 @@ class Emulator final : public canopen::SdoServerBackend {
   void reset_dictionary(bool communication_only) noexcept;
   canopen::SdoAbort check_pdo_write(std::uint16_t index, std::uint8_t sub, std::uint64_t v) const noexcept;
   void rebuild_pdos() noexcept;
+  // eds_dictionary.cpp: EmulatorConfig::served applied to the built dictionary.
+  void apply_served();
+  static void set_type(Entry& e, canopen::DataType t) noexcept;  // type, mask and sign
+  [[nodiscard]] const Entry* served(std::uint16_t index, std::uint8_t sub) const noexcept;  // nullptr: absent or hidden
 
   void handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::FrameSink& out) noexcept;
   void handle_sync(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
@@ -284,7 +416,40 @@ class Emulator final : public canopen::SdoServerBackend {
   double cst_step(double torque_cmd, double velocity_cmd, double dt, double& torque) noexcept;
   void reset_direct_model() noexcept;
   void update_outputs() noexcept;
-  void send_tpdos(canopen::FrameSink& out) noexcept;
+  /// TPDOs per transmission type (CiA 301): at a SYNC (`at_sync`) types 0
+  /// (if changed) and 1..240 (every n-th); on every call 254/255 (on change,
+  /// after the inhibit time 0x18xx:3, or when the event timer 0x18xx:5 ran out).
+  void send_tpdos(bool at_sync, canopen::FrameSink& out) noexcept;
+  std::uint64_t tpdo_payload(std::size_t p) const noexcept;
+  /// Write RPDO p's payload word into the dictionary; true if it carries the controlword.
+  bool apply_rpdo(std::size_t p, std::uint64_t w) noexcept;
+  /// The controlword (0x6040) through the state machine, unless it is settled.
+  void evaluate_controlword(canopen::FrameSink& out) noexcept;
+  /// 0x6061 towards 0x6060 (at a SYNC; EmulatorBehaviour::mode_switch_syncs).
+  void update_mode_display() noexcept;
+  void switch_mode(std::int8_t mode) noexcept;
+  [[nodiscard]] bool mode_supported(std::int8_t mode) const noexcept;
+  /// The automatic transitions, all here: 1 (initialisation done after
+  /// EmulatorBehaviour::boot_ns), 12 (quick stop completed, at a SYNC),
+  /// 14 (fault reaction completed, at the SYNC after 13), 13 (a pending
+  /// fault). Called at each SYNC and from step().
+  void automatic_transitions(bool at_sync, canopen::FrameSink& out) noexcept;
+  [[nodiscard]] bool fault_cause_remains() const noexcept;
+  /// 0x1001 from the present conditions (the fault's class, communication errors).
+  void refresh_error_register() noexcept;
+  /// A communication error condition (`flag`) appears (EMCY `code` once) or
+  /// clears (EMCY 0000h with the remaining error register).
+  void comm_error(bool& flag, bool active, std::uint16_t code, canopen::FrameSink& out) noexcept;
+  /// 0x1029:1 on a communication error (EmulatorBehaviour::error_behaviour).
+  void apply_error_behaviour() noexcept;
+  // homing_model.cpp: the velocity homing asks for at this SYNC (strict:
+  // per method family; permissive: the original one-step model). Sets
+  // `stop` when the motor stops at once and may raise `amax`.
+  double homing_velocity(double dt, double& amax, bool& stop) noexcept;
+  void start_homing() noexcept;
+  [[nodiscard]] bool homing_method_supported(std::int8_t method) const noexcept;
+  /// Release delayed SDO replies that are due (step()).
+  void flush_sdo_replies(canopen::FrameSink& out) noexcept;
 
   EmulatorConfig cfg_;
   std::vector<Entry> od_;
@@ -345,6 +510,39 @@ class Emulator final : public canopen::SdoServerBackend {
   std::uint32_t following_error_cycles_ = 0;
   bool homing_done_ = false;
   bool homing_active_ = false;
+  bool homing_error_ = false;
+  /// Phases of the strict homing model (homing_model.cpp).
+  enum class HomingPhase : std::uint8_t { kIdle, kSettle, kSearchSwitch, kBackOff, kApproachEdge, kSearchIndex };
+  HomingPhase homing_phase_ = HomingPhase::kIdle;
+  double homing_travel_ = 0;        // counts moved since the start
+  double homing_edge_ = 0;          // where the switch edge was found / the index pulse sought
+  double homing_dir_ = 1.0;         // direction of the switch search (+1 / -1)
+  std::uint32_t homing_settle_ = 0; // SYNCs left in kSettle
+  // Strict behaviours (EmulatorBehaviour).
+  std::int64_t boot_ready_ns_ = 0;          // transition 1 at this time
+  std::uint32_t fault_cause_syncs_left_ = 0;
+  bool fault_cause_held_ = false;
+  std::int8_t mode_wanted_ = 0;             // the 0x6060 value 0x6061 is moving to
+  std::uint32_t mode_countdown_ = 0;        // SYNCs until 0x6061 shows it
+  bool rpdo_short_error_ = false;           // EMCY 8210h sent, not yet cleared
+  bool rpdo_long_error_ = false;            // EMCY 8220h sent, not yet cleared
+  bool sync_length_error_ = false;          // EMCY 8240h sent, not yet cleared
+  std::uint8_t rpdo_short_mask_ = 0;        // bit p: RPDO p + 1's last frame was short
+  std::uint8_t rpdo_long_mask_ = 0;         // bit p: RPDO p + 1's last frame was long
+  // TPDO event state (types 0, 254, 255).
+  std::array<std::uint64_t, 4> tpdo_last_payload_{};
+  std::array<std::int64_t, 4> tpdo_last_sent_ns_{};
+  std::array<bool, 4> tpdo_sent_{};
+  // Delayed SDO replies (EmulatorBehaviour::sdo_reply_delay_ns): a FIFO of
+  // 16 (the master has one SDO transfer per drive in flight; a segmented
+  // transfer adds one reply per request).
+  struct DelayedFrame {
+    can::Frame frame;
+    std::int64_t due_ns;
+  };
+  std::array<DelayedFrame, 16> sdo_queue_{};
+  std::size_t sdo_queue_head_ = 0, sdo_queue_size_ = 0;
+  friend class DelayedSdoSink;
   // Motor.
   double pos_ = 0;
   double vel_ = 0;

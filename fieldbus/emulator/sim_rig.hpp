@@ -26,7 +26,13 @@ namespace canmotion::emulator {
 struct SimRigConfig {
   std::int64_t cycle_ns = 1'000'000;
   std::vector<std::uint8_t> nodes = {2, 3, 4};
-  EmulatorConfig emulator{};      ///< template; `node` is set per drive
+  /// Template; `node` is set per drive. Behaviour: EmulatorBehaviour::loop_default()
+  /// (strict but for two master gaps); a test may choose strict() or permissive().
+  EmulatorConfig emulator = [] {
+    EmulatorConfig e;
+    e.behaviour = EmulatorBehaviour::loop_default();
+    return e;
+  }();
   cia402::DriveConfig drive{};    ///< template; `node` and `cycle_ns` are set per drive
   canopen::MasterConfig master{};
   /// The master's interface queues this many frames per cycle (txqueuelen,

@@ -54,12 +54,17 @@ void put_raw(fmt::memory_buffer& out, const can::Frame& f) {
   for (std::size_t i = 0; i < f.len && i < can::kMaxPayload; ++i) put_hex(out, f.data[i], 2);
 }
 
-void put_obj(fmt::memory_buffer& out, std::uint16_t index, std::uint8_t sub) {
+const co::DeviceDictionary* dictionary_of(const NodeDictionaries* names, std::uint8_t node) {
+  return names != nullptr && node < names->size() ? (*names)[node] : nullptr;
+}
+
+void put_obj(fmt::memory_buffer& out, const co::DeviceDictionary* dict, std::uint16_t index, std::uint8_t sub) {
   put(out, "0x");
   put_hex(out, index, 4);
   out.push_back(':');
   put_hex(out, sub, 2);
-  const std::string_view name = co::object_name(index, sub);
+  // The node's EDS name (cantrace --eds), else the CiA 301/402 name.
+  const std::string_view name = dict != nullptr ? dict->name_or_standard(index, sub) : co::object_name(index, sub);
   if (!name.empty()) {
     out.push_back(' ');
     put(out, name);
@@ -85,10 +90,11 @@ void put_controlword(fmt::memory_buffer& out, std::uint16_t cw) {
 }
 
 // A value of index:sub, typed by the object table.
-void put_value(fmt::memory_buffer& out, std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> v,
-               std::uint32_t total) {
+void put_value(fmt::memory_buffer& out, const co::DeviceDictionary* dict, std::uint16_t index, std::uint8_t sub,
+               std::span<const std::uint8_t> v, std::uint32_t total) {
   const co::ObjectInfo* info = co::object_info(index, sub);
-  const co::DataType type = info != nullptr ? info->type : co::DataType::kDomain;
+  const co::DeviceDictionary::Entry* described = dict != nullptr ? dict->find(index, sub) : nullptr;
+  const co::DataType type = described != nullptr ? described->type : info != nullptr ? info->type : co::DataType::kDomain;
   std::uint64_t u = 0;
   for (std::size_t i = 0; i < v.size() && i < 8; ++i) u |= static_cast<std::uint64_t>(v[i]) << (8 * i);
   if (type == co::DataType::kVisibleString) {
@@ -137,7 +143,7 @@ void put_value(fmt::memory_buffer& out, std::uint16_t index, std::uint8_t sub, s
     put(out, "0x");
     put_hex(out, static_cast<std::uint32_t>(u), 8);
     put(out, " (");
-    put_obj(out, e.index, e.sub);
+    put_obj(out, dict, e.index, e.sub);
     fmt::format_to(fmt::appender(out), ", {} bit)", e.bits);
     return;
   }
@@ -161,17 +167,17 @@ void put_value(fmt::memory_buffer& out, std::uint16_t index, std::uint8_t sub, s
   put(out, ")");
 }
 
-void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
+void describe_sdo(const Decoded& d, fmt::memory_buffer& out, const co::DeviceDictionary* dict) {
   const sdo::SdoFrame& s = d.sdo;
   fmt::format_to(fmt::appender(out), "SDO node {} ", d.node);
   auto val = [&] {
     put(out, " = ");
-    put_value(out, d.sdo_index, d.sdo_sub, d.value, d.sdo_total);
+    put_value(out, dict, d.sdo_index, d.sdo_sub, d.value, d.sdo_total);
   };
   // An initiate frame that carries data: the value (expedited) or the size.
   auto initiate = [&](const char* verb) {
     put(out, verb);
-    put_obj(out, d.sdo_index, d.sdo_sub);
+    put_obj(out, dict, d.sdo_index, d.sdo_sub);
     if (s.expedited) {
       val();
     } else {
@@ -185,7 +191,7 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
       break;
     case sdo::SdoFrameKind::kInitiateDownloadResponse:
       put(out, "write ");
-      put_obj(out, d.sdo_index, d.sdo_sub);
+      put_obj(out, dict, d.sdo_index, d.sdo_sub);
       put(out, ": OK");
       break;
     case sdo::SdoFrameKind::kDownloadSegmentRequest:
@@ -193,7 +199,7 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
                      s.last ? ", last" : "");
       if (d.sdo_has_value) {
         put(out, ": ");
-        put_obj(out, d.sdo_index, d.sdo_sub);
+        put_obj(out, dict, d.sdo_index, d.sdo_sub);
         val();
       }
       break;
@@ -201,13 +207,13 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
       fmt::format_to(fmt::appender(out), "write segment OK (toggle {})", s.toggle ? 1 : 0);
       if (d.sdo_complete) {
         put(out, ": ");
-        put_obj(out, d.sdo_index, d.sdo_sub);
+        put_obj(out, dict, d.sdo_index, d.sdo_sub);
         fmt::format_to(fmt::appender(out), " written, {} bytes", d.sdo_total);
       }
       break;
     case sdo::SdoFrameKind::kInitiateUploadRequest:
       put(out, "read ");
-      put_obj(out, d.sdo_index, d.sdo_sub);
+      put_obj(out, dict, d.sdo_index, d.sdo_sub);
       break;
     case sdo::SdoFrameKind::kInitiateUploadResponse:
       initiate("read ");
@@ -220,13 +226,13 @@ void describe_sdo(const Decoded& d, fmt::memory_buffer& out) {
                      s.last ? ", last" : "");
       if (d.sdo_has_value) {
         put(out, ": ");
-        put_obj(out, d.sdo_index, d.sdo_sub);
+        put_obj(out, dict, d.sdo_index, d.sdo_sub);
         val();
       }
       break;
     case sdo::SdoFrameKind::kAbort:
       put(out, d.sdo_response ? "abort by server " : "abort by client ");
-      put_obj(out, d.sdo_index, d.sdo_sub);
+      put_obj(out, dict, d.sdo_index, d.sdo_sub);
       fmt::format_to(fmt::appender(out), ": 0x{:08X} {}", s.abort_code, co::sdo_abort_text(s.abort_code));
       break;
     case sdo::SdoFrameKind::kBlock:
@@ -294,6 +300,26 @@ void describe_pdo(const Decoded& d, fmt::memory_buffer& out) {
 }
 
 }  // namespace
+
+void append_emcy(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register) {
+  fmt::format_to(fmt::appender(out), "0x{:04X} {}; error register 0x{:02X}", code, co::emcy_code_text(code),
+                 error_register);
+  if (error_register == 0) return;
+  put(out, " (");
+  bool first = true;
+  for (unsigned b = 0; b < 8; ++b) {
+    if ((error_register & (1U << b)) == 0) continue;
+    if (!first) put(out, ", ");
+    first = false;
+    put(out, co::error_register_bit_name(b));
+  }
+  put(out, ")");
+}
+
+void append_emcy_json(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register) {
+  fmt::format_to(fmt::appender(out), ",\"code\":{},\"error_register\":{},\"text\":", code, error_register);
+  append_json_string(out, co::emcy_code_text(code));
+}
 
 std::string_view statusword_state_name(std::uint16_t statusword) noexcept {
   return cia402::state_name(cia402::decode_state(statusword));
@@ -388,7 +414,7 @@ std::string_view event_kind_name(const Decoded& d) noexcept {
   return "unknown";
 }
 
-void format_description(const Decoded& d, fmt::memory_buffer& out) {
+void format_description(const Decoded& d, fmt::memory_buffer& out, const NodeDictionaries* names) {
   const can::Frame& f = d.tf.frame;
   switch (d.kind) {
     case EventKind::kNmt:
@@ -413,20 +439,8 @@ void format_description(const Decoded& d, fmt::memory_buffer& out) {
       put(out, "TIME stamp");
       break;
     case EventKind::kEmcy:
-      fmt::format_to(fmt::appender(out), "EMCY node {}: 0x{:04X} {}; error register 0x{:02X}", d.node, d.emcy_code,
-                     co::emcy_code_text(d.emcy_code),
-                     d.emcy_register);
-      if (d.emcy_register != 0) {
-        put(out, " (");
-        bool first = true;
-        for (unsigned b = 0; b < 8; ++b) {
-          if ((d.emcy_register & (1U << b)) == 0) continue;
-          if (!first) put(out, ", ");
-          first = false;
-          put(out, co::error_register_bit_name(b));
-        }
-        put(out, ")");
-      }
+      fmt::format_to(fmt::appender(out), "EMCY node {}: ", d.node);
+      append_emcy(out, d.emcy_code, d.emcy_register);
       if (d.emcy_vendor != std::array<std::uint8_t, 5>{}) {
         put(out, "; vendor");
         for (std::uint8_t b : d.emcy_vendor) {
@@ -446,7 +460,7 @@ void format_description(const Decoded& d, fmt::memory_buffer& out) {
       fmt::format_to(fmt::appender(out), "Node guarding request node {}", d.node);
       break;
     case EventKind::kSdo:
-      describe_sdo(d, out);
+      describe_sdo(d, out, dictionary_of(names, d.node));
       break;
     case EventKind::kPdo:
       describe_pdo(d, out);
@@ -482,7 +496,7 @@ void format_text(const Decoded& d, std::string_view iface, const FormatOptions& 
   // Pad the raw frame to the width of the longest standard frame (3 + 1 + 16).
   for (std::size_t w = out.size() - start; w < 20; ++w) out.push_back(' ');
   put(out, "  ");
-  format_description(d, out);
+  format_description(d, out, opt.names);
   out.push_back('\n');
 }
 
@@ -529,8 +543,7 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
       if (d.sync_has_counter) fmt::format_to(fmt::appender(out), ",\"counter\":{}", d.sync_counter);
       break;
     case EventKind::kEmcy:
-      fmt::format_to(fmt::appender(out), ",\"code\":{},\"error_register\":{},\"text\":", d.emcy_code, d.emcy_register);
-      append_json_string(out, co::emcy_code_text(d.emcy_code));
+      append_emcy_json(out, d.emcy_code, d.emcy_register);
       break;
     case EventKind::kBootUp:
     case EventKind::kHeartbeat:
@@ -552,7 +565,7 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
         for (std::uint8_t b : d.value) put_hex(out, b, 2);
         put(out, "\",\"value\":");
         fmt::memory_buffer v;
-        put_value(v, d.sdo_index, d.sdo_sub, d.value, d.sdo_total);
+        put_value(v, dictionary_of(opt.names, d.node), d.sdo_index, d.sdo_sub, d.value, d.sdo_total);
         append_json_string(out, std::string_view(v.data(), v.size()));
         fmt::format_to(fmt::appender(out), ",\"size\":{}", d.sdo_total);
       }
@@ -596,7 +609,7 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
   if (d.has_actual) fmt::format_to(fmt::appender(out), ",\"actual_position\":{}", d.actual_position);
   put(out, ",\"text\":");
   fmt::memory_buffer desc;
-  format_description(d, desc);
+  format_description(d, desc, opt.names);
   append_json_string(out, std::string_view(desc.data(), desc.size()));
   if (d.problem != nullptr) {
     put(out, ",\"problem\":");

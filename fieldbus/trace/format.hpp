@@ -8,14 +8,22 @@
 
 #include <fmt/format.h>
 
+#include <array>
+
+#include "fieldbus/canopen/device_dictionary.hpp"
 #include "fieldbus/trace/decoder.hpp"
 
 namespace canmotion::trace {
 
 /// How to print times.
+/// Per node-ID, the node's object dictionary from its EDS (cantrace --eds),
+/// or null: objects are then named from canopen's CiA 301/402 table.
+using NodeDictionaries = std::array<const canopen::DeviceDictionary*, 128>;
+
 struct FormatOptions {
   bool has_time = true;  ///< false: the trace had no timestamps; print "-"
   int time_digits = 6;   ///< 6 (us) or 9 (ns) fractional digits
+  const NodeDictionaries* names = nullptr;  ///< object names from EDS files (null: none)
 };
 
 /// Append `t_ns` as seconds ("1700000000.123456") to `out`.
@@ -27,13 +35,20 @@ void format_text(const Decoded& d, std::string_view iface, const FormatOptions& 
 
 /// Append the description only (no time, no raw frame, no newline), e.g.
 /// "TPDO1 node 1: Statusword=0x0637 [Operation enabled], Position actual value=100000".
-void format_description(const Decoded& d, fmt::memory_buffer& out);
+void format_description(const Decoded& d, fmt::memory_buffer& out, const NodeDictionaries* names = nullptr);
 
 /// Append one JSON object on one line (with '\n'), for `cantrace --json`.
 void format_json(const Decoded& d, std::string_view iface, const FormatOptions& opt, fmt::memory_buffer& out);
 
 /// Append `s` as a JSON string literal (quotes, escapes).
 void append_json_string(fmt::memory_buffer& out, std::string_view s);
+
+/// An EMCY's code and error register as text, the one rendering for the
+/// decoded line and the report: "0x2310 Continuous over-current; error
+/// register 0x03 (generic, current)" (the bit list only when a bit is set).
+void append_emcy(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register);
+/// The same as JSON members: `,"code":N,"error_register":N,"text":"..."`.
+void append_emcy_json(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register);
 
 /// "Operation enabled" etc. for a statusword.
 std::string_view statusword_state_name(std::uint16_t statusword) noexcept;

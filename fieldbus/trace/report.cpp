@@ -36,10 +36,6 @@ std::string_view kind_label(std::size_t k) {
 
 double us(double ns) { return ns / 1000.0; }
 
-std::string_view emcy_text(std::uint16_t code) {
-  return co::emcy_code_text(code);
-}
-
 void node_label(Out& out, std::uint8_t n, const NodeSettings& s) {
   fmt::format_to(fmt::appender(out), "node {}", n);
   if (!s.name.empty()) fmt::format_to(fmt::appender(out), " ({})", s.name);
@@ -201,18 +197,8 @@ void format_summary_text(std::string_view iface, const Analyzer& a, const Report
     for (const EmcyRecord& e : ns.emcys) {
       put(out, "    ");
       time_at(out, opt, e.t_ns, t0);
-      fmt::format_to(fmt::appender(out), "  0x{:04X} {}; error register 0x{:02X}", e.code, emcy_text(e.code), e.error_register);
-      if (e.error_register != 0) {
-        put(out, " (");
-        bool first_bit = true;
-        for (unsigned bit = 0; bit < 8; ++bit) {
-          if ((e.error_register & (1U << bit)) == 0) continue;
-          if (!first_bit) put(out, ", ");
-          first_bit = false;
-          put(out, co::error_register_bit_name(bit));
-        }
-        put(out, ")");
-      }
+      put(out, "  ");
+      append_emcy(out, e.code, e.error_register);
       put(out, "\n");
     }
     if (ns.emcys.size() < ns.emcy_count) fmt::format_to(fmt::appender(out), "    ... {} more not listed\n", ns.emcy_count - ns.emcys.size());
@@ -363,8 +349,7 @@ void format_summary_json(std::string_view iface, const Analyzer& a, const Report
       const EmcyRecord& e = ns.emcys[i];
       put(out, i ? ",{\"t\":" : "{\"t\":");
       t(e.t_ns);
-      fmt::format_to(fmt::appender(out), ",\"code\":{},\"error_register\":{},\"text\":", e.code, e.error_register);
-      append_json_string(out, emcy_text(e.code));
+      append_emcy_json(out, e.code, e.error_register);
       put(out, "}");
     }
     fmt::format_to(fmt::appender(out), "],\"sdo_abort_count\":{},\"sdo_aborts\":[", ns.abort_count);

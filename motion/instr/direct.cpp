@@ -21,19 +21,30 @@ Err start(Ctx& x, const MdsParams& p) noexcept {
   AxisRt& a = x.axis(p.axis);
   if (Err e = x.c.common_checks(a, false); e != Err::None) return e;
   if (a.cfg.type != AxisType::CipDrive) return Err::WrongAxisType;  // AXIS_CIP_DRIVE only [seed 002]
+  // "validated if the CIP drive device supports the ramp attributes" [seed 002]:
+  // here, if the axis has direct_control: (ramps written at boot)
+  if (!a.cfg.direct_control) return Err::OptionalAttributeNotSupported;
   if (a.hs.homing) return Err::HomeInProcess;
   for (const auto& g : a.gen)
     if (!std::holds_alternative<std::monostate>(g)) return Err::NotAllowedWhilePlannerActive;
   const bool torque = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;
-  const double full = torque ? a.cfg.max_torque : a.cfg.max_speed;
+  // SLAT: Speed is the DirectVelocityControl command (a speed) [seed 002]
+  const bool slat = torque && a.cfg.direct_slat;
+  const double full = torque && !slat ? a.cfg.max_torque : a.cfg.max_speed;
   const double cmd = p.percent_of_maximum ? units::percent(p.speed, full) : p.speed;
   if (!std::isfinite(cmd)) return x.reject_operand(op<Instr::MDS>("Speed"));
-  if (a.direct.mds.valid() && a.direct.mds != x.self)
+  const bool first = !a.direct.mds.valid();
+  if (!first && a.direct.mds != x.self)
     if (ControlTag* o = x.c.tag(a.direct.mds)) o->set(flag::IP, false);  // superseded by this MDS
   a.direct.status = true;
   a.direct.active = true;
-  a.direct.cmd = cmd;
-  if (!a.direct.mds.valid()) a.direct.vel_cmd = a.cfg.direct_velocity_command;  // kept by a superseding MDS
+  if (slat) {
+    a.direct.vel_cmd = cmd;
+    if (first) a.direct.cmd = 0.0;  // the torque command: set live (set_direct_command), kept by a superseding MDS
+  } else {
+    a.direct.cmd = cmd;
+    if (first) a.direct.vel_cmd = a.cfg.direct_velocity_command;  // kept by a superseding MDS
+  }
   a.direct.mds = x.self;
   a.direct.stop = {};
   x.tag.set(flag::IP, true);

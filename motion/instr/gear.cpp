@@ -18,24 +18,14 @@ std::int64_t mul_div_floor(std::int64_t a, std::int64_t b, std::int64_t c) noexc
   return static_cast<std::int64_t>(q);
 }
 
-/// A master chain that would close a cycle: the master (transitively) geared to the slave.
-bool geared_to(const Core& c, AxisId master, AxisId slave) noexcept {
-  AxisId m = master;
-  for (std::size_t n = 0; n < kMaxAxes; ++n) {
-    const auto* g = std::get_if<GearGen>(&c.axes[m].gen[index(Slot::Gear)]);
-    if (!g) break;
-    if (g->master_id == slave) return true;
-    m = g->master_id;
-  }
-  return false;
-}
-
 /// The ratio (signed, with the direction `dir`) of a real or fractional MAG.
 Err gear_ratio(Ctx& x, const MagParams& p, int dir, GearGen& g) noexcept {
   if (g.fractional) {
     const double sc = p.slave_counts, mc = p.master_counts;
-    if (!(sc > 0) || sc > 2147483647.0) return x.reject_operand(op<Instr::MAG>("SlaveCounts"));
-    if (!(mc > 0) || mc > 2147483647.0) return x.reject_operand(op<Instr::MAG>("MasterCounts"));
+    // UINT32 operands [seed 003]: 1 .. 4294967295
+    constexpr double kUint32Max = 4294967295.0;
+    if (!(sc > 0) || sc > kUint32Max) return x.reject_operand(op<Instr::MAG>("SlaveCounts"));
+    if (!(mc > 0) || mc > kUint32Max) return x.reject_operand(op<Instr::MAG>("MasterCounts"));
     g.slave_counts = dir * static_cast<std::int64_t>(sc);
     g.master_counts = static_cast<std::int64_t>(mc);
     return Err::None;
@@ -73,7 +63,11 @@ Err start(Ctx& x, const MagParams& p) noexcept {
   const AxisRt& m = x.axis(p.master);
   if (!m.cfg.configured) return Err::AxisNotConfigured;
   if (m.cfg.inhibited) return Err::AxisIsInhibited;
-  if (p.master == p.slave || geared_to(x.c, p.master, p.slave)) return Err::MasterAxisConflict;
+  // Only slave = master is refused. A reversed pair (the master geared to this
+  // slave) is allowed: "if a Servo master axis and slave axis are reversed, the
+  // axes become cross-coupled and unexpected motion may result" [seed 003]; the
+  // step order then steps one of them with the other's command of last cycle.
+  if (p.master == p.slave) return Err::MasterAxisConflict;
   // Direction: same/opposite, or reverse/unchanged relative to the last gearing
   // direction (first use: reverse = opposite, unchanged = same) [seed 003]:
   // the rule of the cams' Direction

@@ -67,6 +67,7 @@ namespace home {
 
 void cancel(Core& c, AxisRt& a) noexcept {
   a.hs.homing = false;
+  a.hs.resync = a.cfg.type == AxisType::CipDrive;  // the drive moved since the last feedback
   if (ControlTag* h = c.tag(a.hs.mah)) h->set(flag::IP, false);
 }
 

@@ -40,8 +40,9 @@ Err start(Ctx& x, const MdacParams& p) noexcept {
   const std::size_t last = all ? a.links.active.size() : first + 1;
   for (std::size_t k = first; k < last; ++k) {
     const MdacLink& l = a.links.active[k];
-    // changing the master reference of a moving slave errors; the original stays [seed 000]
-    if (l.valid() && l.master == p.master && l.use_actual != use_actual && moving) return Err::MdscInvalidModeOrMasterChange;
+    // changing the master reference of a moving slave errors; the original stays
+    // [seed 000], whether the MDAC names the same master or another one
+    if (l.valid() && l.use_actual != use_actual && moving) return Err::MdscInvalidModeOrMasterChange;
   }
   const MdacLink nl{p.master, use_actual, all, x.self};
   for (std::size_t k = first; k < last; ++k) {

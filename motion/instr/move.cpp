@@ -415,9 +415,21 @@ Err mcd_limits(Ctx& x, const McdParams& p, const AxisRt& a, const ProfileGen& g,
   return Err::None;
 }
 
-/// Re-plan the move or jog `g` from its present state with limits `l`.
+/// The state of `g` on its profile's abscissa: time, or master travel for
+/// master-driven motion (velocity per master unit, acceleration per master
+/// unit squared: the profile's own sample at md.u).
+Kin abscissa_state(const ProfileGen& g) noexcept {
+  if (!g.master_driven) return g.k;
+  int h = g.hint;
+  const Kin ku = g.prof.sample(g.md.u, h);
+  return Kin{g.k.p, ku.v, ku.a};
+}
+
+/// Re-plan the move or jog `g` from its present state with limits `l`
+/// (per second, or per master unit when master driven).
 bool mcd_replan(bool jog, const ProfileGen& g, double V, const Limits& l, Profile& prof) noexcept {
-  Kin from = g.k;
+  const Kin now = abscissa_state(g);
+  Kin from = now;
   if (!g.scurve) from.a = 0.0;  // trapezoidal motion steps its acceleration
   if (jog) return plan_velocity(prof, from, (g.jog_velocity < 0 ? -1.0 : 1.0) * V, l);
   if (!(V > 0)) return plan_velocity(prof, from, 0.0, l);  // speed 0: pause
@@ -426,10 +438,10 @@ bool mcd_replan(bool jog, const ProfileGen& g, double V, const Limits& l, Profil
   // limits (a merge from motion away from it): then it keeps reversing.
   Overshoot policy = Overshoot::StopAtTarget;
   Profile probe;
-  if (plan_stop(probe, g.k, g.lim.d, g.lim.jd)) {
-    const double rem = g.total - g.k.p;
-    const double stop = probe.end_position() - g.k.p;
-    if ((rem >= 0 && stop > rem) || (rem < 0 && stop < rem) || g.k.v * rem < 0) policy = Overshoot::Reverse;
+  if (plan_stop(probe, now, g.lim.d, g.lim.jd)) {
+    const double rem = g.total - now.p;
+    const double stop = probe.end_position() - now.p;
+    if ((rem >= 0 && stop > rem) || (rem < 0 && stop < rem) || now.v * rem < 0) policy = Overshoot::Reverse;
   }
   return plan_move(prof, from, g.total - g.k.p, l, policy);
 }
@@ -445,13 +457,18 @@ Err start(Ctx& x, const McdParams& p) noexcept {
   const bool td = (p.change_speed && !is_master_driven(p.speed_units)) || (p.change_accel && !is_master_driven(p.accel_units)) ||
                   (p.change_decel && !is_master_driven(p.decel_units)) || (chj && !is_master_driven(p.jerk_units));
   if (md && td) return Err::MdscUnitsConflict;
-  if (md) return Err::MdscNotActivated;
   auto* g = std::get_if<ProfileGen>(&a.gen[index(p.jog ? Slot::Jog : Slot::Move)]);
   if (!g || g->role != (p.jog ? GenRole::Jog : GenRole::Move)) {
-    x.tag.set(flag::DN, true);  // nothing to change
+    // nothing to change; master-driven units still need an MDAC link of that motion type
+    const std::size_t lnk = p.jog ? link::Jog : link::Move;
+    if (md && !a.links.active[lnk].valid() && !a.links.pending[lnk].valid()) return Err::MdscNotActivated;
+    x.tag.set(flag::DN, true);
     return Err::None;
   }
   if (g->seconds) return Err::IllegalDynamicChange;
+  // the units must be in the mode of the running motion: MCD does not switch
+  // between master- and time-driven (as MCCD: MDSC_INVALID_MODE_OR_MASTER_CHANGE [seed 001])
+  if ((md && !g->master_driven) || (td && g->master_driven)) return Err::MdscInvalidModeOrMasterChange;
   Limits lim = g->lim;
   double V = g->speed;
   if (Err e = mcd_limits(x, p, a, *g, lim, V); e != Err::None) return e;
@@ -462,6 +479,7 @@ Err start(Ctx& x, const McdParams& p) noexcept {
   g->prof = prof;
   g->hint = 0;
   g->t0_cycle = x.c.cycle;
+  g->md.u = 0.0;  // master driven: the new profile starts at the master travel of now (no jump)
   g->lim = l;
   g->speed = V;
   if (p.jog) g->jog_velocity = (g->jog_velocity < 0 ? -1.0 : 1.0) * V;

@@ -96,6 +96,10 @@ Err start(Ctx& x, const MasParams& p) noexcept {
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
   const StopType type = p.stop_type;
+  // canmotion runs no tune or test process (CiA 402 drives tune and test with
+  // their own tools): nothing MAS could stop; refused, ERR 13 at StopType
+  // (motion/README.md, choices)
+  if (type == StopType::Tune || type == StopType::Test) return x.reject_operand(op<Instr::MAS>("StopType"));
   const std::uint32_t mask = stop_mask(type);
   double d = 0.0, jd = 0.0;
   if (Err e = mas_dynamics(x, p, a, mask, d, jd); e != Err::None) return e;
@@ -124,17 +128,8 @@ Err start(Ctx& x, const MgsParams& p) noexcept {
     const ProgrammedStopMode m = p.mode == GroupStopMode::FastStop      ? ProgrammedStopMode::FastStop
                                  : p.mode == GroupStopMode::FastDisable ? ProgrammedStopMode::FastDisable
                                                                         : a.cfg.programmed_stop_mode;
-    if (a.hs.homing) home::cancel(x.c, a);
-    mdac::break_links(x.c, a);  // MGS breaks the MDAC links of its slaves
-    if (m == ProgrammedStopMode::HardDisable) return x.c.servo_off(a);
-    if (m == ProgrammedStopMode::HardShutdown) return x.c.do_shutdown(a);
-    const std::uint8_t post = m == ProgrammedStopMode::FastDisable ? 1 : (m == ProgrammedStopMode::FastShutdown ? 2 : 0);
-    const bool r_ax = a.servo.on && x.c.stop_all(a, x.self.id, post);
+    const bool r_ax = stop::programmed_stop(x.c, a, m, x.self.id);  // MGS breaks the MDAC links of its slaves
     ramping = ramping || r_ax;
-    if (!r_ax) {
-      if (post == 1) x.c.servo_off(a);
-      if (post == 2) x.c.do_shutdown(a);
-    }
   });
   x.tag.set(flag::DN, true);
   if (ramping) {
@@ -181,6 +176,38 @@ void finish_group_stops(Core& c) noexcept {
       }
       g.active = false;
     }
+  }
+}
+
+bool programmed_stop(Core& c, AxisRt& a, ProgrammedStopMode m, ControlId owner) noexcept {
+  if (a.hs.homing) home::cancel(c, a);
+  mdac::break_links(c, a);
+  if (m == ProgrammedStopMode::HardDisable) {
+    c.servo_off(a);
+    return false;
+  }
+  if (m == ProgrammedStopMode::HardShutdown) {
+    c.do_shutdown(a);
+    return false;
+  }
+  const std::uint8_t post = m == ProgrammedStopMode::FastDisable ? 1 : (m == ProgrammedStopMode::FastShutdown ? 2 : 0);
+  const bool ramp = a.servo.on && c.stop_all(a, owner, post);
+  if (!ramp) {
+    if (post == 1) c.servo_off(a);
+    if (post == 2) c.do_shutdown(a);
+  }
+  return ramp;
+}
+
+void change_mode(Core& c, bool program) noexcept {
+  for (std::size_t i = 0; i < c.axis_count; ++i) {
+    AxisRt& a = c.axes[i];
+    if (!a.present) continue;
+    mdac::break_links(c, a);  // a mode change breaks every link, on slaves and masters alike [seed 000]
+    if (!program || !a.cfg.configured || a.cfg.inhibited) continue;
+    time_cam::drop_pending(c, a);
+    position_cam::drop_pending(c, a);
+    (void)programmed_stop(c, a, a.cfg.programmed_stop_mode, kNoControl);
   }
 }
 

@@ -48,6 +48,16 @@ namespace stop {
 /// Once per cycle, after the axes stepped: an MGS whose ramps all ended gets
 /// PC (IP cleared).
 void finish_group_stops(Core& c) noexcept;
+/// Stop one axis the way a Programmed Stop Mode says (MGS, a controller mode
+/// change): homing cancelled, its MDAC links broken, then a ramp at the
+/// maximum decel (owned by `owner`, followed by servo off or shutdown for the
+/// Fast modes) or at once (Hard modes). True when a ramp runs.
+bool programmed_stop(Core& c, AxisRt& a, ProgrammedStopMode m, ControlId owner) noexcept;
+/// A controller mode change (Run <-> Program, Planner::set_controller_mode):
+/// every MDAC link is broken (both directions [seed 000]); into Program mode
+/// every axis also stops by its Programmed Stop Mode, pending cams dropped
+/// (cam motion stops when the controller changes modes [seed 004]).
+void change_mode(Core& c, bool program) noexcept;
 }  // namespace stop
 
 }  // namespace canmotion::motion

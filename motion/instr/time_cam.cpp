@@ -23,8 +23,11 @@ Err matc_mode_checks(const AxisRt& a, const MatcParams& p) noexcept {
   const bool pending = p.execution_schedule == schedule::Pending;
   // time driven: Lock Direction must be None [RM002H p.512, reference §5]
   if (!p.master_driven && p.lock_direction != LockDirection::None) return Err::MdscLockDirConflict;
-  // pending cams use an immediate lock; a position lock is LOCK_DIRECTION_CONFLICT (95) [seed 004]
+  // "All pending CAMs must use the Immediate Forward or the Immediate Reverse
+  // Lock Direction" [seed 004]: a position lock is LOCK_DIRECTION_CONFLICT (95),
+  // and so is None on a master-driven pending cam (time driven: None, above)
   if (pending && position_lock(p.lock_direction)) return Err::MdscLockDirConflict;
+  if (pending && p.master_driven && p.lock_direction == LockDirection::None) return Err::MdscLockDirConflict;
   const auto* cur = std::get_if<CamGen>(&a.gen[index(Slot::TimeCam)]);
   if (pending && cur != nullptr) {
     // the pending and the active cam must be in the same mode [seed 004]; it
@@ -118,7 +121,7 @@ Err start(Ctx& x, const MatcParams& p) noexcept {
   const bool active = std::holds_alternative<CamGen>(a.gen[index(Slot::TimeCam)]);
   if (p.execution_schedule == schedule::Pending) {  // takes over at the end of the current pass [seed 004]
     time_cam::drop_pending(x.c, a);                   // a second pending MATC overlays the first
-    a.cams.time = PendingCam{prof, cfg, x.self};
+    a.cams.time = PendingCam{prof, cfg, x.self, p.master_driven};
     a.cams.time_dir = dir;
     x.tag.set(flag::DN, true);
     x.tag.set(flag::IP, true);
@@ -135,6 +138,14 @@ Err start(Ctx& x, const MatcParams& p) noexcept {
     return x.reject_operand(op<Instr::MATC>("Direction"));
   }
   x.c.fold(a, Slot::TimeCam, true);
+  // a preloaded pending cam in the other mode cannot follow this one: "An
+  // instruction that pends a CAM to an active CAM in a different mode (than
+  // the active CAM) will cause an error" [seed 004]; it errs now (ERR 105, as
+  // when pended onto an active cam) and is dropped
+  if (a.cams.time.valid() && a.cams.time.master_driven != p.master_driven) {
+    if (ControlTag* pt = x.c.tag(a.cams.time.owner)) pt->reject(Err::MdscInvalidModeOrMasterChange);
+    time_cam::drop_pending(x.c, a);
+  }
   g.profile = prof;
   g.t0_cycle = x.c.cycle;
   g.owner = x.self;

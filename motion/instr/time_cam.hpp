@@ -41,6 +41,7 @@ struct PendingCam {
   cam::CamProfile* profile = nullptr;
   cam::CamMotionConfig cfg{};
   OwnerRef owner{};
+  bool master_driven = false;  ///< its InstructionMode: must match the cam it follows [seed 004]
   constexpr bool valid() const noexcept { return profile != nullptr; }
 };
 

@@ -101,6 +101,8 @@ constexpr std::string_view kHelp[] = {
     "  RUN [name]                followed by script lines and a line END: run the motion script, streaming its",
     "                            PRINT lines (t=...), then OK or ERR <script error>",
     "  STATS                     controller statistics, key=value lines, then OK",
+    "  MODE [run|program]        the controller mode (OK mode=run|program); program stops every axis by its",
+    "                            Programmed Stop Mode, breaks the MDAC links and refuses motion (ERR 24) until run",
     "  HELP                      this text",
     "  QUIT                      OK, then the server closes the connection",
     "tags: X.ActualPosition X.CommandPosition X.ActualVelocity X.CommandVelocity X.PositionError X.MotionStatus",
@@ -525,6 +527,7 @@ struct CommandServer::Impl {
     if (iequals(verb, "WATCH")) return do_watch(c, w);
     if (iequals(verb, "UNWATCH")) return send_line(c, "ERR no WATCH is running");
     if (iequals(verb, "STATS")) return do_stats(c);
+    if (iequals(verb, "MODE")) return do_mode(c, w);
     if (iequals(verb, "HELP")) {
       for (std::string_view h : kHelp) send_line(c, h);
       return send_line(c, "OK");
@@ -544,7 +547,7 @@ struct CommandServer::Impl {
     if (iequals(verb, "END")) return send_line(c, "ERR END without RUN");
     if (line.find('(') != std::string_view::npos) return do_call(c, line);
     send_line(c, fmt::format("ERR unknown request '{}': expected an instruction call like MSO(X, mso1), GET, SET, "
-                             "STATUS, WATCH, UNWATCH, RUN, STATS, HELP or QUIT",
+                             "STATUS, WATCH, UNWATCH, RUN, STATS, MODE, HELP or QUIT",
                              verb.substr(0, 64)));
   }
 
@@ -592,6 +595,22 @@ struct CommandServer::Impl {
       reply += fmt::format(" {}={}", w[i], script::format_value(*v));
     }
     send_line(c, reply);
+  }
+
+  /// MODE [run|program]: the controller mode (issue 16); a change is answered
+  /// once the RT thread applied it.
+  void do_mode(Client& c, const std::vector<std::string>& w) {
+    auto name = [](motion::ControllerMode m) { return m == motion::ControllerMode::Program ? "program" : "run"; };
+    if (w.size() == 1) return send_line(c, fmt::format("OK mode={}", name(status().mode)));
+    if (w.size() != 2 || !(iequals(w[1], "run") || iequals(w[1], "program")))
+      return send_line(c, "ERR MODE takes run or program (or nothing to read the mode): MODE program");
+    const auto m = iequals(w[1], "program") ? motion::ControllerMode::Program : motion::ControllerMode::Run;
+    if (auto e = host.set_mode(m)) return send_line(c, "ERR " + *e);
+    c.control.clear();
+    c.reply = fmt::format("OK mode={}", name(m));
+    c.seq = host.last_seq();
+    c.since = Wall::now();
+    c.mode = Mode::kPending;
   }
 
   void do_set(Client& c, const std::vector<std::string>& w) {

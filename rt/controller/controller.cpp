@@ -158,10 +158,9 @@ std::vector<std::pair<std::string, motion::ControlId>> Controller::controls() co
   return {control_names_.begin(), control_names_.end()};
 }
 
-std::uint64_t Controller::submit(Command c) {
+std::uint64_t Controller::submit(const Command& c) {
   std::lock_guard lock(names_mu_);
-  c.seq = next_seq_;
-  if (!commands_.try_push(c)) return 0;
+  if (!commands_.try_push(Queued{c, next_seq_})) return 0;
   return next_seq_++;
 }
 
@@ -330,8 +329,21 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
 }
 
 void Controller::cycle(std::int64_t now_ns) noexcept {
-  // 2. Drain received frames on every bus; heartbeat timeouts and node
-  // events reach the drive proxies now, before the planner reads them.
+  receive_all(now_ns);                                       // 2
+  for (std::size_t a = 0; a < axes_.size(); ++a) feedback(a);  // 3
+  take_commands(now_ns);                                     // 4
+  plan();                                                    // 5
+  for (std::size_t a = 0; a < axes_.size(); ++a) apply(a, out_[a]);  // 6
+  send_all(now_ns);                                          // 7
+  if (halt_ == Halt::kDisarming) advance_halt(now_ns);
+  publish(now_ns);                                           // 8
+  ++cycle_index_;
+  cycle_.store(cycle_index_, std::memory_order_release);
+}
+
+// 2. Drain received frames on every bus; heartbeat timeouts and node events
+// reach the drive proxies now, before the planner reads them.
+void Controller::receive_all(std::int64_t now_ns) noexcept {
   for (std::size_t b = 0; b < buses_.size(); ++b) receive(b, now_ns);
   for (std::size_t b = 0; b < buses_.size(); ++b) {
     buses_[b].network->update(now_ns);
@@ -345,98 +357,113 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
       emit(e);
     }
   }
-  // 3. Feedback in position units.
-  for (std::size_t a = 0; a < axes_.size(); ++a) feedback(a);
-  // 4. Pending commands (at most kMaxRequestsPerCycle instructions).
-  std::size_t nreq = 0;
+}
+
+// 4. Pending commands, in submission order: at most kMaxRequestsPerCycle
+// instructions; an array write after an instruction waits for the next cycle.
+void Controller::take_commands(std::int64_t now_ns) noexcept {
+  nreq_ = 0;
   bool deferred = false;
   for (;;) {
-    Command& c = popped_;
+    Queued& q = popped_;
     if (held_) {
-      c = *held_;
+      q = *held_;
       held_.reset();
-    } else if (!commands_.try_pop(c)) {
+    } else if (!commands_.try_pop(q)) {
       break;
     }
-    if (c.kind == Command::Kind::kWriteArray && nreq > 0) {
-      held_ = c;  // program order: an instruction queued before it runs first (this cycle)
+    if (must_wait(q.command)) {
+      held_ = q;
       deferred = true;
       break;
     }
-    if (c.kind == Command::Kind::kWriteArray) {
-      apply_write(c);
-    } else if (c.kind == Command::Kind::kInstruction) {
-      if (nreq == requests_.size()) {
-        held_ = c;
-        deferred = true;
-        break;
-      }
-      requests_[nreq++] = c.request;
-    } else if (c.kind == Command::Kind::kResetControl) {
-      planner_.reset_control(c.control);
-    } else if (c.kind == Command::Kind::kDirectCommand && c.axis < spec_.axes.size()) {
-      // DirectCommandVelocity is the MDS command in velocity mode and the SLAT
-      // speed reference in torque mode; DirectCommandTorque only exists in torque mode.
-      const bool torque_mode = spec_.axes[c.axis].config.direct_mode == motion::AxisConfig::DirectMode::Torque;
-      const auto id = static_cast<motion::AxisId>(c.axis);
-      if (c.direct_torque) {
-        if (torque_mode) (void)planner_.set_direct_command(id, c.value);
-      } else if (torque_mode) {
-        (void)planner_.set_direct_velocity_command(id, c.value);
-      } else {
-        (void)planner_.set_direct_command(id, c.value);
-      }
-    } else if (c.kind == Command::Kind::kEnableDrives) {
-      for (auto& b : buses_) b.network->enable_all();
-    } else if (c.kind == Command::Kind::kPreOperational && halt_ == Halt::kRunning) {
-      // The drives stop watching the master's heartbeat first, or they fault
-      // (EMCY 0x8130) once the master is gone.
-      for (auto& ax : axes_) {
-        if (ax.proxy == nullptr || ax.proxy->config().consumer_heartbeat_ms == 0) continue;  // not armed
-        auto& sdo = buses_[static_cast<std::size_t>(ax.bus)].network->master().sdo(ax.proxy->node());
-        (void)sdo.download_value<std::uint32_t>(0x1016, 1, 0, kDisarmTag);
-      }
-      halt_ = Halt::kDisarming;
-      halt_since_ns_ = now_ns;
-    }
-    done_seq_ = c.seq;
+    std::visit([this, now_ns](const auto& c) noexcept { take(c, now_ns); }, q.command);
+    done_seq_ = q.seq;
   }
   if (deferred) ++deferred_;
-  // 5. Plan.
+}
+
+bool Controller::must_wait(const Command& c) const noexcept {
+  if (std::holds_alternative<cmd::WriteArray>(c)) return nreq_ > 0;  // program order: the instruction runs first
+  if (std::holds_alternative<cmd::Instruction>(c)) return nreq_ == requests_.size();
+  return false;
+}
+
+void Controller::take(const cmd::Instruction& c, std::int64_t) noexcept { requests_[nreq_++] = c.request; }
+
+void Controller::take(const cmd::ResetControl& c, std::int64_t) noexcept { planner_.reset_control(c.control); }
+
+void Controller::take(const cmd::EnableDrives&, std::int64_t) noexcept {
+  for (auto& b : buses_) b.network->enable_all();
+}
+
+void Controller::take(const cmd::ControllerMode& c, std::int64_t) noexcept { planner_.set_controller_mode(c.mode); }
+
+void Controller::take(const cmd::DirectCommand& c, std::int64_t) noexcept {
+  if (c.axis >= spec_.axes.size()) return;
+  // DirectCommandVelocity is the MDS command in velocity mode and the SLAT
+  // speed reference in torque mode; DirectCommandTorque only exists in torque mode.
+  const bool torque_mode = spec_.axes[c.axis].config.direct_mode == motion::AxisConfig::DirectMode::Torque;
+  const auto id = static_cast<motion::AxisId>(c.axis);
+  if (c.torque) {
+    if (torque_mode) (void)planner_.set_direct_command(id, c.value);
+  } else if (torque_mode) {
+    (void)planner_.set_direct_velocity_command(id, c.value);
+  } else {
+    (void)planner_.set_direct_command(id, c.value);
+  }
+}
+
+// The controlled stop, first step: the drives stop watching the master's
+// heartbeat, or they fault (EMCY 0x8130) once the master is gone.
+void Controller::take(const cmd::PreOperational&, std::int64_t now_ns) noexcept {
+  if (halt_ != Halt::kRunning) return;
+  for (auto& ax : axes_) {
+    if (ax.proxy == nullptr || ax.proxy->config().consumer_heartbeat_ms == 0) continue;  // not armed
+    auto& sdo = buses_[static_cast<std::size_t>(ax.bus)].network->master().sdo(ax.proxy->node());
+    (void)sdo.download_value<std::uint32_t>(0x1016, 1, 0, kDisarmTag);
+  }
+  halt_ = Halt::kDisarming;
+  halt_since_ns_ = now_ns;
+}
+
+// 5. Plan.
+void Controller::plan() noexcept {
   motion::Input in;
   in.cycle = cycle_index_;
   in.feedback = std::span<const motion::AxisFeedback>(fb_.data(), axes_.size());
-  in.requests = std::span<const motion::Request>(requests_.data(), nreq);
+  in.requests = std::span<const motion::Request>(requests_.data(), nreq_);
   motion::Output out;
   out.axes = std::span<motion::AxisOutput>(out_.data(), axes_.size());
   (void)planner_.update(in, out);
-  // 6 + 7. Drive state machines and RPDOs, then SYNC, per bus.
-  for (std::size_t a = 0; a < axes_.size(); ++a) apply(a, out_[a]);
+}
+
+// 7. RPDOs, then SYNC, per bus (the drive state machines stepped in apply()).
+void Controller::send_all(std::int64_t now_ns) noexcept {
   for (std::size_t b = 0; b < buses_.size() && halt_ != Halt::kHalted; ++b) {
     auto& sink = static_cast<RecordingSink&>(*buses_[b].sink);
     sink.now_ns = now_ns;
     buses_[b].network->cycle(now_ns, sink);
   }
-  if (halt_ == Halt::kDisarming) {
-    bool done = true;
-    for (auto& ax : axes_) {
-      if (ax.proxy == nullptr) continue;
-      auto& sdo = buses_[static_cast<std::size_t>(ax.bus)].network->master().sdo(ax.proxy->node());
-      canopen::SdoResult r;
-      while (sdo.poll_tag(kDisarmTag, r)) {
-      }
-      done = done && sdo.idle();
+}
+
+// The controlled stop, second step: once the 0x1016 writes are answered (or
+// after kDisarmTimeoutNs), NMT pre-operational after this cycle's SYNC, so
+// its TPDOs still come back; then silence.
+void Controller::advance_halt(std::int64_t now_ns) noexcept {
+  bool done = true;
+  for (auto& ax : axes_) {
+    if (ax.proxy == nullptr) continue;
+    auto& sdo = buses_[static_cast<std::size_t>(ax.bus)].network->master().sdo(ax.proxy->node());
+    canopen::SdoResult r;
+    while (sdo.poll_tag(kDisarmTag, r)) {
     }
-    if (done || now_ns - halt_since_ns_ > kDisarmTimeoutNs) {
-      // After this cycle's SYNC, so its TPDOs still come back; then silence.
-      for (auto& b : buses_) b.network->master().send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, *b.sink);
-      halt_ = Halt::kHalted;
-    }
+    done = done && sdo.idle();
   }
-  // 8. Publish.
-  publish(now_ns);
-  ++cycle_index_;
-  cycle_.store(cycle_index_, std::memory_order_release);
+  if (done || now_ns - halt_since_ns_ > kDisarmTimeoutNs) {
+    for (auto& b : buses_) b.network->master().send_nmt(canopen::NmtCommand::kEnterPreOperational, 0, *b.sink);
+    halt_ = Halt::kHalted;
+  }
 }
 
 void Controller::publish(std::int64_t now_ns) noexcept {
@@ -470,6 +497,7 @@ void Controller::publish(std::int64_t now_ns) noexcept {
   s.telemetry_dropped = telemetry_dropped_;
   s.commands_deferred = deferred_;
   s.halted = halt_ == Halt::kHalted;
+  s.mode = planner_.controller_mode();
   // Control tags handed out so far (requests can only name those).
   publish_nctl_ = controls_in_use_.load(std::memory_order_acquire);
   publish_pending_ = true;

@@ -3,15 +3,17 @@
 /// The Controller: one cycle of canmotion, joining the motion planner and the
 /// CANopen drive networks (DESIGN.md, "One cycle"):
 ///
-///   2. drain received frames on every bus (TPDOs, EMCY, heartbeats, SDO);
-///      heartbeat timeouts and node events reach the drive proxies
-///      (DriveNetwork::update), so the planner sees them this cycle
-///   3. convert drive feedback from counts to position units
-///   4. take pending instruction requests from the command ring
-///   5. plan: Planner::update (masters before slaves, inside the planner)
-///   6. step each drive's CiA 402 state machine and pack its RPDOs
-///   7. send the RPDOs, then SYNC, in one burst
-///   8. publish a status snapshot; queue trace and telemetry records
+///   2. receive_all()    drain received frames on every bus (TPDOs, EMCY,
+///                       heartbeats, SDO); heartbeat timeouts and node events
+///                       reach the drive proxies (DriveNetwork::update), so
+///                       the planner sees them this cycle
+///   3. feedback()       convert drive feedback from counts to position units
+///   4. take_commands()  take pending commands from the command ring
+///   5. plan()           Planner::update (masters before slaves, inside the planner)
+///   6. apply()          step each drive's CiA 402 state machine, pack its RPDOs
+///   7. send_all()       send the RPDOs, then SYNC, in one burst
+///      advance_halt()   (a controlled stop: NMT pre-operational after that SYNC)
+///   8. publish()        publish a status snapshot; queue trace and telemetry records
 ///
 /// cycle() is realtime-safe: no allocation, no locks, no logging, no
 /// exceptions. Everything it shares with other threads goes through SPSC
@@ -28,6 +30,8 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "fieldbus/can/transport.hpp"
@@ -122,34 +126,52 @@ struct ControllerSpec {
   std::vector<CoordSystemSpec> coordinate_systems;
 };
 
-/// A command to the RT thread. Trivially copyable (lives in an SPSC ring).
-struct Command {
-  enum class Kind : std::uint8_t {
-    kInstruction,   ///< execute `request` (one rung transition)
-    kResetControl,  ///< clear control tag `control` (prescan)
-    kEnableDrives,  ///< ask every drive to enable (outside the planner; tests, bring-up)
-    kPreOperational,  ///< controlled stop of the bus: disarm the drives' watch of the master's
-                      ///< heartbeat (0x1016:01 = 0), NMT pre-operational after the last SYNC,
-                      ///< then no more cyclic traffic (Status::halted)
-    kDirectCommand,   ///< MDS live command: write `value` to axis `axis`'s DirectCommandVelocity
-                      ///< (direct_torque false) or DirectCommandTorque (true); no effect without an active MDS
-    kWriteArray,    ///< a program writes one array element (Controller::write_array); applied in
-                    ///< program order: never in the same cycle after an instruction
-  };
-  Kind kind = Kind::kInstruction;
+/// The commands a non-RT thread gives the RT thread (Controller::submit),
+/// one small trivially copyable struct each.
+namespace cmd {
+/// Execute `request` (one rung transition).
+struct Instruction {
   motion::Request request{};
+};
+/// Clear control tag `control` (prescan).
+struct ResetControl {
   motion::ControlId control = motion::kNoControl;
-  std::uint64_t seq = 0;  ///< set by submit(); echoed as Status::done_seq
-  std::uint16_t axis = 0;     ///< kDirectCommand
-  bool direct_torque = false; ///< kDirectCommand
-  double value = 0.0;         ///< kDirectCommand: units/s or torque units; kWriteArray: the value
-  // kWriteArray: element `element` of array `array` (ArrayRef::id of `array_type`;
-  // for REAL the flat element index offset + i), CAM member 0 Master, 1 Slave, 2 SegmentType.
-  ArraySpec::Type array_type = ArraySpec::Type::kReal;
+};
+/// Ask every drive to enable (outside the planner; tests, bring-up).
+struct EnableDrives {};
+/// Controlled stop of the buses: disarm the drives' watch of the master's
+/// heartbeat (0x1016:01 = 0), NMT pre-operational after the last SYNC, then
+/// no more cyclic traffic (Status::halted).
+struct PreOperational {};
+/// MDS live command: write `value` (units/s or torque units) to axis
+/// `axis`'s DirectCommandVelocity (`torque` false) or DirectCommandTorque
+/// (true); no effect without an active MDS.
+struct DirectCommand {
+  std::uint16_t axis = 0;
+  bool torque = false;
+  double value = 0.0;
+};
+/// A program writes one array element (Controller::write_array): element
+/// `element` of array `array` (ArrayRef::id of `type`; for REAL the flat
+/// element index offset + i), CAM `member` 0 Master, 1 Slave, 2 SegmentType.
+/// Applied in program order: never in the same cycle after an instruction.
+struct WriteArray {
+  ArraySpec::Type type = ArraySpec::Type::kReal;
   std::uint8_t member = 0;
   std::uint16_t array = 0;
   std::uint32_t element = 0;
+  double value = 0.0;
 };
+/// Logix Run / Program mode (Planner::set_controller_mode, issue 16).
+struct ControllerMode {
+  motion::ControllerMode mode = motion::ControllerMode::Run;
+};
+}  // namespace cmd
+
+/// A command to the RT thread: one of the structs of `cmd`.
+using Command = std::variant<cmd::Instruction, cmd::ResetControl, cmd::EnableDrives, cmd::PreOperational,
+                             cmd::DirectCommand, cmd::WriteArray, cmd::ControllerMode>;
+static_assert(std::is_trivially_copyable_v<Command>, "a Command travels through an SPSC ring by copy");
 
 /// Something the RT thread reports. Trivially copyable.
 struct Event {
@@ -225,7 +247,8 @@ struct Status {
   std::uint64_t trace_dropped = 0;
   std::uint64_t telemetry_dropped = 0;
   std::uint64_t commands_deferred = 0;  ///< cycles in which requests had to wait for the next cycle
-  bool halted = false;  ///< after kPreOperational: nodes pre-operational, no PDO or SYNC sent any more
+  bool halted = false;  ///< after cmd::PreOperational: nodes pre-operational, no PDO or SYNC sent any more
+  motion::ControllerMode mode = motion::ControllerMode::Run;  ///< cmd::ControllerMode (issue 16)
   /// CAM_PROFILE[0].Status of each cam profile (0 not calculated, 1 calculating,
   /// 2 calculated, n = in use by n - 2 cams).
   std::array<std::int32_t, motion::kMaxCamProfiles> cam_status{};
@@ -256,10 +279,10 @@ class Controller {
   void cycle(std::int64_t now_ns) noexcept;
 
   // ---- non-RT side ----------------------------------------------------------
-  /// Queue a command; returns its sequence number, or 0 when the ring is
-  /// full. Thread-safe among producers (a producer-side mutex; the RT side
-  /// never takes it).
-  std::uint64_t submit(Command c);
+  /// Queue a command; returns its sequence number (Status::done_seq reaches
+  /// it when the command was taken), or 0 when the ring is full. Thread-safe
+  /// among producers (a producer-side mutex; the RT side never takes it).
+  std::uint64_t submit(const Command& c);
   /// Newest status (copy). Any non-RT thread (with set_deferred_publish():
   /// the thread that runs cycle(), between cycles).
   /// Returns false before the first cycle.
@@ -339,16 +362,36 @@ class Controller {
     bool homing_out = false;  ///< the planner's homing_start as last handed to the proxy (its edges start/cancel)
   };
   class RecordingSink;
+  /// A command in the ring with its sequence number (submit()).
+  struct Queued {
+    Command command{};
+    std::uint64_t seq = 0;
+  };
 
+  // The steps of cycle(), in order (RT).
+  void receive_all(std::int64_t now_ns) noexcept;
   void receive(std::size_t b, std::int64_t now_ns) noexcept;
   void feedback(std::size_t a) noexcept;
+  void take_commands(std::int64_t now_ns) noexcept;
+  void plan() noexcept;
   void apply(std::size_t a, const motion::AxisOutput& out) noexcept;
+  void send_all(std::int64_t now_ns) noexcept;
+  void advance_halt(std::int64_t now_ns) noexcept;
+  // take_commands(): whether a command waits for the next cycle, and one
+  // handler per command (RT).
+  bool must_wait(const Command& c) const noexcept;
+  void take(const cmd::Instruction& c, std::int64_t now_ns) noexcept;
+  void take(const cmd::ResetControl& c, std::int64_t now_ns) noexcept;
+  void take(const cmd::EnableDrives& c, std::int64_t now_ns) noexcept;
+  void take(const cmd::PreOperational& c, std::int64_t now_ns) noexcept;
+  void take(const cmd::DirectCommand& c, std::int64_t now_ns) noexcept;
+  void take(const cmd::WriteArray& c, std::int64_t now_ns) noexcept;  ///< controller_arrays.cpp
+  void take(const cmd::ControllerMode& c, std::int64_t now_ns) noexcept;
   void publish(std::int64_t now_ns) noexcept;
   void finish_publish() const noexcept;  ///< the copies of publish() that read_status() may defer
   void record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noexcept;
   void emit(const Event& e) noexcept;
   void build_arrays();                              ///< controller_arrays.cpp (constructor)
-  void apply_write(const Command& c) noexcept;      ///< controller_arrays.cpp (RT)
 
   ControllerSpec spec_;
   motion::Planner planner_;
@@ -366,9 +409,10 @@ class Controller {
   std::array<can::TimedFrame, kRxBatch> rx_{};
   std::array<can::BusEvent, 16> bus_ev_{};  ///< receive()'s bus events (a member: not re-initialised each call)
   std::array<double, motion::kMaxAxes> max_err_{};
-  std::optional<Command> held_;  ///< a command popped but deferred to the next cycle
-  Command popped_{};  ///< cycle()'s current command (a member: not re-initialised every cycle)
-  /// Controlled stop of the buses (Command::kPreOperational).
+  std::size_t nreq_ = 0;  ///< requests_ taken this cycle (take_commands() -> plan())
+  std::optional<Queued> held_;  ///< a command popped but deferred to the next cycle
+  Queued popped_{};  ///< take_commands()' current command (a member: not re-initialised every cycle)
+  /// Controlled stop of the buses (cmd::PreOperational).
   enum class Halt : std::uint8_t { kRunning, kDisarming, kHalted };
   Halt halt_ = Halt::kRunning;
   std::int64_t halt_since_ns_ = 0;
@@ -388,7 +432,7 @@ class Controller {
   mutable bool publish_pending_ = false;  ///< publish() left its copies to finish_publish()
   std::size_t publish_nctl_ = 0;          ///< control tags in use at the last publish()
 
-  SpscRing<Command, kCommandCapacity> commands_;
+  SpscRing<Queued, kCommandCapacity> commands_;
   SpscRing<Event, kEventCapacity> events_;
   SpscRing<TraceRecord, kTraceCapacity> trace_;
   SpscRing<Sample, kTelemetryCapacity> telemetry_;

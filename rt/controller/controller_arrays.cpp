@@ -7,7 +7,7 @@
 //    the planner (attach_cam_array / attach_cam_profile / attach_real_array);
 //    nothing is resized afterwards;
 //  * a program's write (script `pts[3].Master := 2;`, canmotionctl SET) goes
-//    through the command ring as Command::kWriteArray, like an instruction
+//    through the command ring as cmd::WriteArray, like an instruction
 //    request, and the RT thread applies it in program order (cycle step 4);
 //  * CAM arrays are written only by programs, so the non-RT side keeps its own
 //    copy (cam_shadow_) for reads; REAL arrays are also written by the planner
@@ -26,6 +26,13 @@ bool same_name(std::string_view a, std::string_view b) {
   for (std::size_t i = 0; i < a.size(); ++i)
     if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
   return true;
+}
+
+/// CAM member 0 Master, 1 Slave, 2 SegmentType of `p` := `value` (both copies).
+void set_cam_member(motion::cam::CamPoint& p, std::uint8_t member, double value) noexcept {
+  if (member == 0) p.master = value;
+  else if (member == 1) p.slave = value;
+  else p.segment_type = static_cast<std::int32_t>(value);
 }
 
 }  // namespace
@@ -96,22 +103,15 @@ std::optional<ArrayRef> Controller::find_array(std::string_view name) const {
 
 std::uint64_t Controller::write_array(const ArrayRef& a, std::uint32_t element, std::uint8_t member, double value) {
   if (element >= a.size || a.type == ArraySpec::Type::kCamProfile) return 0;
-  Command c;
-  c.kind = Command::Kind::kWriteArray;
-  c.array_type = a.type;
-  c.array = a.id;
-  c.element = a.type == ArraySpec::Type::kReal ? a.offset + element : element;
-  c.member = member;
-  c.value = value;
+  cmd::WriteArray w;
+  w.type = a.type;
+  w.array = a.id;
+  w.element = a.type == ArraySpec::Type::kReal ? a.offset + element : element;
+  w.member = member;
+  w.value = value;
   std::lock_guard lock(names_mu_);
-  c.seq = next_seq_;
-  if (!commands_.try_push(c)) return 0;
-  if (a.type == ArraySpec::Type::kCam && a.id < cam_shadow_.size()) {
-    motion::cam::CamPoint& p = cam_shadow_[a.id][element];
-    if (member == 0) p.master = value;
-    else if (member == 1) p.slave = value;
-    else p.segment_type = static_cast<std::int32_t>(value);
-  }
+  if (!commands_.try_push(Queued{w, next_seq_})) return 0;
+  if (a.type == ArraySpec::Type::kCam && a.id < cam_shadow_.size()) set_cam_member(cam_shadow_[a.id][element], member, value);
   return next_seq_++;
 }
 
@@ -122,17 +122,14 @@ double Controller::read_cam_point(const ArrayRef& a, std::uint32_t element, std:
   return member == 0 ? p.master : (member == 1 ? p.slave : static_cast<double>(p.segment_type));
 }
 
-void Controller::apply_write(const Command& c) noexcept {
-  if (c.array_type == ArraySpec::Type::kReal) {
+void Controller::take(const cmd::WriteArray& c, std::int64_t) noexcept {
+  if (c.type == ArraySpec::Type::kReal) {
     if (c.element < real_store_.size()) real_store_[c.element] = c.value;
     return;
   }
-  if (c.array_type != ArraySpec::Type::kCam || c.array >= cam_arrays_.size() || c.element >= cam_arrays_[c.array].size())
+  if (c.type != ArraySpec::Type::kCam || c.array >= cam_arrays_.size() || c.element >= cam_arrays_[c.array].size())
     return;
-  motion::cam::CamPoint& p = cam_arrays_[c.array][c.element];
-  if (c.member == 0) p.master = c.value;
-  else if (c.member == 1) p.slave = c.value;
-  else p.segment_type = static_cast<std::int32_t>(c.value);
+  set_cam_member(cam_arrays_[c.array][c.element], c.member, c.value);
 }
 
 }  // namespace canmotion::rt

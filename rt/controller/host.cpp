@@ -75,10 +75,16 @@ std::optional<std::string> ControllerHost::check_tag(std::string_view tag, bool 
 }
 
 std::optional<std::string> ControllerHost::execute(std::string_view call, std::string* control_tag) {
-  Command c;
-  c.kind = Command::Kind::kInstruction;
+  cmd::Instruction c;
   if (auto e = bind(call, c.request, control_tag)) return e;
   const std::uint64_t seq = c_.submit(c);
+  if (seq == 0) return std::string("the command queue to the RT thread is full; try again");
+  last_seq_ = seq;
+  return std::nullopt;
+}
+
+std::optional<std::string> ControllerHost::set_mode(motion::ControllerMode m) {
+  const std::uint64_t seq = c_.submit(cmd::ControllerMode{m});
   if (seq == 0) return std::string("the command queue to the RT thread is full; try again");
   last_seq_ = seq;
   return std::nullopt;

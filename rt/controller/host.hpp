@@ -28,6 +28,9 @@ class ControllerHost final : public script::ScriptHost {
   bool settled() override;
   std::optional<double> read(std::string_view tag, std::string* error) override;
   std::optional<std::string> write(std::string_view tag, double value) override;
+  /// Switch the controller to Run or Program (a command to the RT thread;
+  /// settled() waits for it). An error when the command queue is full.
+  std::optional<std::string> set_mode(motion::ControllerMode m);
   void declare(std::string_view tag) override;
 
   /// Sequence number of the last command queued (0 = none).

@@ -372,11 +372,7 @@ std::optional<std::string> TagTable::write(std::string_view name, double value, 
   if (t && !t->writable) return fmt::format("tag '{}' is read-only", name);
   if (t && t->kind == TagRef::Kind::kAxis) {  // MDS live command (DirectCommandVelocity / DirectCommandTorque)
     if (!std::isfinite(value)) return fmt::format("tag '{}' needs a finite number", name);
-    Command c;
-    c.kind = Command::Kind::kDirectCommand;
-    c.axis = t->index;
-    c.direct_torque = t->member == kDirectCommandTorque;
-    c.value = value;
+    const cmd::DirectCommand c{t->index, t->member == kDirectCommandTorque, value};
     if (c_.submit(c) == 0) return std::string("the controller's command queue is full; try again");
     direct_[(static_cast<std::uint32_t>(t->index) << 8) | t->member] = value;
     return std::nullopt;

@@ -64,7 +64,7 @@ class TagTable {
   std::optional<double> read(const Status& s, std::string_view name, std::string* error);
   /// Write a writable tag: a user tag (created when `create` is true), an
   /// axis's DirectCommandVelocity / DirectCommandTorque (queued for the RT
-  /// thread; acts on an active MDS, see Command::Kind::kDirectCommand), or an
+  /// thread; acts on an active MDS, see cmd::DirectCommand), or an
   /// array element (queued to the RT thread; see last_write_seq()).
   std::optional<std::string> write(std::string_view name, double value, bool create);
   /// True when `name` can be a user numeric tag: a letter or '_' followed by

@@ -93,6 +93,13 @@ TEST(DirectControlConfig, LoadsAndBecomesDriveWritesInCounts) {
   EXPECT_TRUE(has_write(wt, obj::kSlatTimeDelay, 0, 2, 7));
   for (const auto& w : wt) EXPECT_NE(w.index, obj::kProfileAcceleration) << "ramps not given are not written";
   EXPECT_TRUE(direct_control_writes(c.axes[2]).empty());
+  // issue 16: MDS is validated only on an axis with direct_control: (ERR 86
+  // otherwise), and SLAT makes MDS's Speed the velocity command
+  EXPECT_TRUE(v.axis.direct_control);
+  EXPECT_FALSE(v.axis.direct_slat);
+  EXPECT_TRUE(t.axis.direct_control);
+  EXPECT_TRUE(t.axis.direct_slat);
+  EXPECT_FALSE(c.axes[2].axis.direct_control);
   // The writes and the mode-switch timeout reach the drive proxy's configuration.
   const cia402::DriveConfig d = drive_config(v, c.buses[0], 0.002);
   EXPECT_EQ(d.mode_switch_timeout_ns, 40'000'000);

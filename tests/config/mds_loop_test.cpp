@@ -230,7 +230,7 @@ TEST(MdsLoop, VelocityRampsAndSlat1And2EndToEnd) {
 
   // ---- torque, SLAT 1 (min speed/torque) ------------------------------------
   SlatChecker s1{et, 1, 2'000, 5};
-  l.exec("MDS(T, mt, 0, UnitsPerSec)");
+  l.exec("MDS(T, mt, 8, UnitsPerSec)");  // SLAT: Speed is the velocity command (issue 16, seed 002)
   for (int i = 0; i < 3000 && l.read("mt.DN") == 0.0; ++i) s1.step(l);
   ASSERT_EQ(l.read("mt.DN"), 1.0) << "ERR " << l.read("mt.ERR");
   EXPECT_EQ(l.read("T.DirectTorqueControlStatus"), 1.0);
@@ -248,8 +248,12 @@ TEST(MdsLoop, VelocityRampsAndSlat1And2EndToEnd) {
 
   // ---- torque, SLAT 2 (max speed/torque) ------------------------------------
   SlatChecker s2{ew, 2, 1'000, 3};
-  l.exec("MDS(W, mw, 30, %ofMaximum)");  // 300 per mille
+  l.exec("MDS(W, mw, 5, %ofMaximum)");  // SLAT: 5 % of max_speed 100 = the velocity command 5 units/s
+  s2.step(l);
+  ASSERT_EQ(l.host.write("W.DirectCommandTorque", 300.0), std::nullopt);  // 300 per mille, written live
   for (int i = 0; i < 3000 && l.read("mw.DN") == 0.0; ++i) s2.step(l);
+  EXPECT_EQ(l.read("W.DirectVelocityControlStatus"), 1.0);  // SLAT: both bits [seed 002]
+  EXPECT_EQ(l.read("W.DirectTorqueControlStatus"), 1.0);
   ASSERT_EQ(l.read("mw.DN"), 1.0) << "ERR " << l.read("mw.ERR");
   for (int i = 0; i < 800; ++i) s2.step(l);
   EXPECT_EQ(s2.to_speed, 1);  // above 5 000 + 1 000 for 3 ms

@@ -18,7 +18,7 @@ constexpr std::int64_t kPeriod = test::SimController::kPeriod;
 
 struct Rig : test::SimController {
   motion::ControlId submit(Instr instr, const std::string& control, std::vector<motion::Operand> ops) {
-    Command c;
+    cmd::Instruction c;
     c.request.instr = instr;
     c.request.control = *ctl->control_id(control);
     c.request.count = static_cast<std::uint8_t>(ops.size());
@@ -179,9 +179,7 @@ TEST(ControllerLoop, ControlledStopDisarmsHeartbeatWatchAndHalts) {
   Rig r;
   ASSERT_TRUE(r.run_until([](const Status& s) { return s.axes[1].phase == cia402::Phase::kOperational; }, 5000));
   r.ctl->set_trace(true);
-  Command stop;
-  stop.kind = Command::Kind::kPreOperational;
-  ASSERT_NE(r.ctl->submit(stop), 0u);
+  ASSERT_NE(r.ctl->submit(cmd::PreOperational{}), 0u);
   ASSERT_TRUE(r.run_until([](const Status& s) { return s.halted; }, 500));
   EXPECT_EQ(r.world.drive(0).nmt_state(), canopen::NmtState::kPreOperational);
   EXPECT_EQ(r.world.drive(0).read_int(0x1016, 1), 0) << "the drive still watches the master's heartbeat";

@@ -192,3 +192,48 @@ TEST(Canmotionctl, WatchAndRun) {
 
 }  // namespace
 }  // namespace canmotion::rt::ctltest
+
+namespace canmotion::rt::ctltest {
+namespace {
+
+// Issue 16 item 9: `canmotionctl mode program|run` (protocol MODE). A mode
+// change (Run <-> Program) breaks every MDAC link [seed 000] and stops the
+// motion (cams [seed 004], gears, moves) by each axis' Programmed Stop Mode;
+// in Program mode instructions that start motion answer ERR 24 (Illegal
+// Controller Mode); `mode` alone prints the mode.
+TEST(Canmotionctl, ModeProgramStopsMotionAndRefusesItUntilRun) {
+  Rig r;
+  r.boot();
+  const std::string& d = r.dir.path;
+  EXPECT_EQ(ctl(&r, d, {"-s", r.sock, "mode"}).out, "run\n");
+  ASSERT_EQ(ctl(&r, d, {"-s", r.sock, "MSO(X, mso1)"}).status, 0);
+  const auto id = *r.ctl->find_control("mso1");
+  ASSERT_TRUE(r.run_until([&] { return r.status().controls[id].dn(); }, 3000));
+  ASSERT_EQ(ctl(&r, d, {"-s", r.sock, "MDAC(X, Master, l1, all, command)"}).status, 0);
+  const Result jog = ctl(&r, d, {"-s", r.sock, "MAJ(X, j1, 0, 10, unitspersec, 1000, unitspersec2, 1000, unitspersec2, "
+                                              "trapezoidal, 100, 100, %oftime, disabled, programmed, 0, none)"});
+  ASSERT_EQ(jog.status, 0) << jog.err;
+  r.step();
+  const Result prog = ctl(&r, d, {"-s", r.sock, "mode", "program"});
+  EXPECT_EQ(prog.status, 0) << prog.err;
+  EXPECT_EQ(prog.out, "program\n");
+  EXPECT_EQ(r.status().mode, motion::ControllerMode::Program);
+  EXPECT_FALSE(r.status().controls[*r.ctl->find_control("l1")].ip());  // link broken
+  EXPECT_FALSE(r.status().controls[*r.ctl->find_control("j1")].ip());  // jog ended (FastStop ramp)
+  EXPECT_EQ(ctl(&r, d, {"-s", r.sock, "mode"}).out, "program\n");
+  const Result refused = ctl(&r, d, {"-s", r.sock, "MAJ(X, j2, 0, 10, unitspersec, 1000, unitspersec2, 1000, "
+                                                  "unitspersec2, trapezoidal, 100, 100, %oftime, disabled, programmed, 0, none)"});
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_TRUE(contains(refused.err, " ERR=24 ")) << refused.err;
+  EXPECT_TRUE(contains(refused.err, "Illegal Controller Mode")) << refused.err;
+  EXPECT_EQ(ctl(&r, d, {"-s", r.sock, "mode", "run"}).out, "run\n");
+  const Result again = ctl(&r, d, {"-s", r.sock, "MAJ(X, j3, 0, 10, unitspersec, 1000, unitspersec2, 1000, "
+                                                "unitspersec2, trapezoidal, 100, 100, %oftime, disabled, programmed, 0, none)"});
+  EXPECT_EQ(again.status, 0) << again.err;
+  const Result bad = ctl(&r, d, {"-s", r.sock, "mode", "remote"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(contains(bad.err, "'remote' is not run or program")) << bad.err;
+}
+
+}  // namespace
+}  // namespace canmotion::rt::ctltest

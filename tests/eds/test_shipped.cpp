@@ -82,6 +82,9 @@ TEST(EdsShipped, EmulatorEdsDescribesExactlyTheEmulatorDictionary) {
     SCOPED_TRACE(fmt::format("node {}", node));
     emulator::EmulatorConfig cfg;
     cfg.node = node;
+    // The shipped EDS describes the permissive dictionary (every object,
+    // the master's PDO1 mapping); a strict EDS is future work.
+    cfg.behaviour = emulator::EmulatorBehaviour::permissive();
     const emulator::Emulator emu(cfg);
     const auto dict = emu.dictionary();
     std::set<std::pair<std::uint16_t, std::uint8_t>> served;

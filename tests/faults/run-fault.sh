@@ -135,7 +135,11 @@ case $scn in
     ;;
   emcy)
     start_daemon "$script" ""
-    start_emu emu-1.log
+    # --fault-cause-syncs 0: the master sends one fault-reset edge and no
+    # other while a strict drive refuses it (the loop profile's injected
+    # fault cause lasts 20 SYNCs), so the drive would stay in Fault (issue 15,
+    # master side; as FieldbusLoop.InjectedFaultEmcyResetReenable).
+    start_emu emu-1.log --fault-cause-syncs 0
     wait_tag Step 1 60
     sleep 0.5
     mark inject
@@ -180,7 +184,11 @@ case $scn in
     ;;
   master)
     start_daemon "$script" ""
-    start_emu emu-1.log --heartbeat-reaction fault
+    # --error-behaviour false: without 0x1029 the drive stays NMT operational
+    # when it loses the master's heartbeat, which is what this scenario checks
+    # (the restarted master puts an operational node into pre-operational).
+    # With 0x1029 (loop profile) the drive is already pre-operational.
+    start_emu emu-1.log --heartbeat-reaction fault --error-behaviour false
     wait_tag Step 1 60
     sleep 0.5
     mark kill

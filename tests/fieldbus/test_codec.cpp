@@ -191,6 +191,10 @@ TEST(FieldbusGolden, EmulatorBootHeartbeatSdoTpdoEmcy) {
   emulator::EmulatorConfig ec;
   ec.node = 2;
   ec.initial_position = 0x01020304;
+  // Permissive: these golden bytes are the lenient drive's (PDO1 = statusword
+  // + position at type 1, instant boot, same-call SDO replies); the strict
+  // drive's frames: test_emulator_strict.cpp.
+  ec.behaviour = emulator::EmulatorBehaviour::permissive();
   emulator::Emulator emu(ec);
   VecSink out;
   emu.power_on(0, out);
@@ -240,9 +244,10 @@ TEST(FieldbusGolden, EmulatorRpdoLengthErrorGivesEmcy8210) {
   emu.power_on(0, out);
   emu.on_frame(can::TimedFrame{frame("000#0100"), 0}, out);  // start all
   out.clear();
-  emu.on_frame(can::TimedFrame{frame("202#0F00"), 0}, out);
+  emu.on_frame(can::TimedFrame{frame("202#0F"), 0}, out);  // RPDO1 = controlword (2 bytes)
   ASSERT_EQ(out.frames.size(), 1u);
-  EXPECT_EQ(hex(out.frames[0]), "082#1082000000000000");
+  // Error register generic + communication (it was 00 before issue 15).
+  EXPECT_EQ(hex(out.frames[0]), "082#1082110000000000");
 }
 
 // ---- CiA 402 state table, transition by transition ---------------------------

@@ -26,6 +26,10 @@ struct Link {
   emulator::Emulator emu{[] {
     emulator::EmulatorConfig c;
     c.node = 2;
+    // Permissive: this link hands frames over without stepping the drive's
+    // clock, so the strict drive's delayed replies would never go out (the
+    // delay itself: EmulatorStrict.SdoReplyNotInTheSameCall).
+    c.behaviour = emulator::EmulatorBehaviour::permissive();
     return c;
   }()};
   VecSink to_server, to_client;
@@ -339,6 +343,7 @@ TEST(FieldbusSdo, EmulatorAbortPaths) {
   for (const auto& c : cases) {
     emulator::EmulatorConfig cfg;
     cfg.node = 2;
+    cfg.behaviour = emulator::EmulatorBehaviour::permissive();  // replies in the same call (no clock here)
     emulator::Emulator emu(cfg);
     VecSink out;
     emu.power_on(0, out);

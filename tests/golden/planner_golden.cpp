@@ -40,9 +40,13 @@ namespace {
 /// was 0x717dc2ed1a35fc20. Issue 14 made the coordinated instructions
 /// executable: the sequences' MCSD on the coordinate system `cs`, which has no
 /// configuration here, answers ERR 11 (not configured) instead of ERR 75 (not
-/// supported). With ERR 75 kept for it the run still gives the old hash
-/// (checked on the issue 14 branch), so nothing else changed.
-constexpr std::uint64_t kExpected = 0xd2351390b0ae92a0ull;
+/// supported); with ERR 75 kept for it the run still gave the old hash
+/// (checked on the issue 14 branch): 0xd2351390b0ae92a0. Issue 16's fidelity
+/// fixes changed it on their own branch to 0x5985f33de2b9a1ac (MAG reversed
+/// pairs and UINT32 counts, MAS tune/test refused, MDAC reference change with
+/// another master, MATC pending mode/lock rules, exceptions breaking links,
+/// MCD modes, MDS SLAT, homing cancel resync). Both together, on main:
+constexpr std::uint64_t kExpected = 0xfbeb3153a8a46f2cull;
 constexpr std::uint64_t kSeed = 13;
 constexpr int kRuns = 40;
 constexpr int kOpsPerRun = 90;
@@ -171,11 +175,13 @@ struct World {
     c.homing.sequence = HomingConfig::Sequence::Switch;
     c.homing.home_position = 10;
     c.max_torque = 500;
+    c.direct_control = true;  // the axis has direct_control: (MDS allowed since issue 16)
     AxisConfig d = a;  // CIP, CST direct mode, passive immediate homing, FastDisable
     d.type = AxisType::CipDrive;
     d.conversion_constant = 4096.0 / 360.0;
     d.direct_mode = AxisConfig::DirectMode::Torque;
     d.direct_velocity_command = 20;
+    d.direct_control = true;
     d.homing.mode = HomingConfig::Mode::Passive;
     d.programmed_stop_mode = ProgrammedStopMode::FastDisable;
     d.exception_actions = {ExceptionAction::Alarm, ExceptionAction::Shutdown, ExceptionAction::FaultStatusOnly,

@@ -28,6 +28,7 @@ inline AxisConfig cip_direct(AxisConfig::DirectMode mode, double velocity_comman
   c.max_torque = 1000;
   c.direct_mode = mode;
   c.direct_velocity_command = velocity_command;
+  c.direct_control = true;  // the configuration has direct_control: (MDS allowed)
   return c;
 }
 

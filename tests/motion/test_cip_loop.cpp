@@ -161,3 +161,47 @@ TEST(CipLoop, EnableTimeoutIsServoMessageFailure) {
   EXPECT_EQ(L.r.tag("mso").err, 12);
   EXPECT_EQ(L.r.tag("mso").exerr, 16);
 }
+
+// Issue 16 item 8. MAS StopType 4 home, 5 tune, 6 test [reference §2.6]: "stops
+// only the named kind of motion; other kinds keep running". Home: the drive
+// homing (mode 6) is cancelled: the MAH loses IP (no PC), HomingStatus
+// clears, the drive returns to CSP at its actual position, not homed; MAS
+// gets DN and PC (the drive stops at once in CSP). Tune and test: canmotion
+// runs no tune or test process, so MAS refuses them clearly (ERR 13, EXERR 2 =
+// StopType) and a running move is not touched.
+TEST(CipLoop, MasHomeCancelsDriveHomingTuneAndTestAreRefused) {
+  Loop L(cip());
+  ASSERT_EQ(L.r.exec("MSO(D, on);"), Err::None);
+  L.run(10);
+  ASSERT_TRUE(L.r.tag("on").dn());
+  ASSERT_EQ(L.r.exec("MAH(D, mah);"), Err::None);
+  L.run(10);
+  ASSERT_EQ(L.r.out[0].mode, DriveMode::Homing);
+  ASSERT_TRUE(L.r.axis("D").motion(motion_status::HomingStatus));
+  const std::string mas = "MAS(D, s, home, no, 0, unitspersec2, no, 0, unitspersec3);";
+  ASSERT_EQ(L.r.exec(mas), Err::None);
+  EXPECT_TRUE(L.r.tag("s").dn() && L.r.tag("s").pc());
+  EXPECT_FALSE(L.r.tag("mah").ip());
+  EXPECT_FALSE(L.r.tag("mah").pc());
+  L.run(1);
+  EXPECT_EQ(L.r.out[0].mode, DriveMode::CyclicPosition);
+  EXPECT_DOUBLE_EQ(L.r.out[0].position, L.d.pos);  // from the actual position: no jump
+  EXPECT_FALSE(L.r.axis("D").motion(motion_status::HomingStatus));
+  EXPECT_FALSE(L.r.axis("D").motion(motion_status::AxisHomedStatus));
+  L.run(100);
+  EXPECT_FALSE(L.r.tag("mah").pc());  // the homing never completes
+  // tune / test: refused, the move goes on
+  ASSERT_EQ(L.r.exec(mam("D", "m", 1, 5, 10)), Err::None);
+  L.run(10);
+  for (const char* type : {"tune", "test", "5", "6"}) {
+    SCOPED_TRACE(type);
+    EXPECT_EQ(L.r.exec(std::string("MAS(D, t, ") + type + ", no, 0, unitspersec2, no, 0, unitspersec3);"),
+              Err::ParameterOutOfRange);
+    EXPECT_EQ(L.r.tag("t").exerr, 2);
+    EXPECT_FALSE(L.r.tag("t").dn());
+  }
+  L.run(1);
+  EXPECT_TRUE(L.r.tag("m").ip());
+  EXPECT_FALSE(L.r.axis("D").motion(motion_status::StoppingStatus));
+  EXPECT_NEAR(L.r.axis("D").command_velocity, 10.0, 1e-9);
+}

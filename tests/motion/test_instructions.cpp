@@ -455,7 +455,10 @@ TEST(Mcd, Errors) {
   EXPECT_EQ(r.tag("c").exerr, 6);
   EXPECT_EQ(r.exec("MCD(X,c,move,yes,-1,no,0,no,0,no,0,no,0,unitspersec,unitspersec2,unitspersec2,unitspersec3);"), Err::ParameterOutOfRange);
   EXPECT_EQ(r.tag("c").exerr, 4);
-  EXPECT_EQ(r.exec("MCD(X,c,move,yes,1,no,0,no,0,no,0,no,0,unitspermasterunit,unitspersec2,unitspersec2,unitspersec3);"), Err::MdscNotActivated);
+  // master-driven units on a time-driven move: a mode change, ERR 105 (issue 16, seed 001)
+  EXPECT_EQ(r.exec("MCD(X,c,move,yes,1,no,0,no,0,no,0,no,0,unitspermasterunit,unitspersec2,unitspersec2,unitspersec3);"), Err::MdscInvalidModeOrMasterChange);
+  // and with no jog to change and no MDAC link for jogs: ERR 93
+  EXPECT_EQ(r.exec("MCD(X,c,jog,yes,1,no,0,no,0,no,0,no,0,unitspermasterunit,unitspersec2,unitspersec2,unitspersec3);"), Err::MdscNotActivated);
   r.exec("MSF(X, f);");
   EXPECT_EQ(r.exec("MCD(X,c,move,yes,1,no,0,no,0,no,0,no,0,unitspersec,unitspersec2,unitspersec2,unitspersec3);"), Err::ServoOffState);
 }

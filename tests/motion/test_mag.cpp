@@ -114,8 +114,6 @@ TEST(Mag, MasterConflicts) {
   Rig r = geared_rig();
   EXPECT_EQ(r.exec("MAG(S, S, g, same, 1, 1, 1, command, real, disabled, 0, unitspersec2);"), Err::MasterAxisConflict);
   EXPECT_EQ(r.tag("g").err, 10);
-  ASSERT_EQ(r.exec(mag("g1", "same", 1)), Err::None);  // S follows M
-  EXPECT_EQ(r.exec("MAG(M, S, g2, same, 1, 1, 1, command, real, disabled, 0, unitspersec2);"), Err::MasterAxisConflict);
   Rig off;
   off.add_axis("M", cfg());
   off.add_axis("S", cfg());
@@ -228,19 +226,33 @@ TEST(Mag, MergedMoveCancelsGearing) {
   EXPECT_EQ(r.axis("S").command_position, 100.0);
 }
 
+// "Actual – slave axis motion is generated from the current position of the
+// master axis as measured by its encoder"; "Command – ... from the desired or
+// commanded position of the master axis" [seed 003]. The master is servo-on
+// (with the servo off its command would follow the actual position and the
+// two references could not be told apart, issue 16 item 10): its actual
+// position moves by 3 (a following error) while its command stays at 0. With
+// `actual` the slave follows to 3, with `command` it stays at 0.
 TEST(Mag, ActualMasterReferenceOnACipMaster) {
-  Rig r;
-  AxisConfig m = cfg();
-  m.type = AxisType::CipDrive;
-  r.add_axis("M", m);
-  r.add_axis("S", cfg());
-  r.fb[0].drive = DriveState::Enabled;
-  r.exec("MSO(S, b);");
-  r.step();
-  r.exec(mag("g", "same", 1.0, "disabled", 0, "real", 1, 1, "actual"));
-  r.fb[0].position = 3.0;  // the master moves by feedback only (servo off on M)
-  r.step();
-  EXPECT_DOUBLE_EQ(r.axis("S").command_position, 3.0);
+  for (const char* ref : {"actual", "command"}) {
+    SCOPED_TRACE(ref);
+    Rig r;
+    AxisConfig m = cfg();
+    m.type = AxisType::CipDrive;
+    r.add_axis("M", m);
+    r.add_axis("S", cfg());
+    r.fb[0].drive = DriveState::Enabled;
+    ASSERT_EQ(r.exec("MSO(M, a);"), Err::None);
+    ASSERT_EQ(r.exec("MSO(S, b);"), Err::None);
+    r.step();
+    ASSERT_TRUE(r.tag("a").dn());  // the master's servo is on: its command is the planner's
+    ASSERT_EQ(r.exec(mag("g", "same", 1.0, "disabled", 0, "real", 1, 1, ref)), Err::None);
+    r.fb[0].position = 3.0;  // the drive is pushed away: actual 3, command 0
+    r.step();
+    ASSERT_EQ(r.axis("M").command_position, 0.0);
+    ASSERT_EQ(r.axis("M").actual_position, 3.0);
+    EXPECT_DOUBLE_EQ(r.axis("S").command_position, std::string(ref) == "actual" ? 3.0 : 0.0);
+  }
 }
 
 // Property: while the clutch ramps the slave to gearing speed, its command
@@ -283,4 +295,44 @@ TEST(MagProperty, ClutchRampsRespectTheAccelRate) {
     EXPECT_NEAR(r.axis("S").command_velocity, ratio * v, 1e-6 * std::fabs(ratio * v) + 1e-9)
         << "seed=" << seed << " case " << k;
   }
+}
+
+// Issue 16 item 7. "if a Servo master axis and slave axis are reversed, the
+// axes become cross-coupled and unexpected motion may result. For example, if
+// you are gearing Axis 0 to Axis 1 ... and then want to change to gearing Axis
+// 1 to Axis 0, you must first disable gearing on Axis 0" [seed 003]: a warning,
+// not an error. The reversed MAG is allowed; both gears run, cross-coupled:
+// with 0.5 both ways an incremental move of 10 on M settles at M = 10 + S/2,
+// S = M/2, i.e. M = 40/3 (the "unexpected motion").
+TEST(Mag, ReversedPairIsAllowedAndCrossCoupled) {
+  Rig r = geared_rig();
+  ASSERT_EQ(r.exec(mag("g1", "same", 0.5)), Err::None);  // S follows M
+  ASSERT_EQ(r.exec("MAG(M, S, g2, same, 0.5, 1, 1, command, real, disabled, 0, unitspersec2);"), Err::None);
+  EXPECT_TRUE(r.tag("g1").ip() && r.tag("g2").ip());
+  r.step();
+  EXPECT_TRUE(r.axis("M").motion(motion_status::GearingStatus));
+  EXPECT_TRUE(r.axis("S").motion(motion_status::GearingStatus));
+  ASSERT_EQ(r.exec(mam("M", "mm", 1, 10, 50)), Err::None);
+  r.step(3000);
+  EXPECT_NEAR(r.axis("M").command_position, 40.0 / 3.0, 1e-6);
+  EXPECT_NEAR(r.axis("S").command_position, 20.0 / 3.0, 1e-6);
+}
+
+// Issue 16 item 7. "Slave Counts UINT32 ... Master Counts UINT32" [seed 003]:
+// 1 .. 4294967295 (not the DINT maximum 2147483647); 0 and 2^32 are ERR 13
+// with the operand index (5 SlaveCounts, 6 MasterCounts).
+TEST(Mag, FractionCountsAreUint32) {
+  Rig r = geared_rig();
+  const std::string frac = "fraction_slave_master_counts";
+  EXPECT_EQ(r.exec(mag("a", "same", 1, "disabled", 0, frac, 4294967295L, 3)), Err::None);
+  EXPECT_EQ(r.exec(mag("b", "same", 1, "disabled", 0, frac, 3, 4294967295L)), Err::None);
+  EXPECT_EQ(r.exec(mag("c", "same", 1, "disabled", 0, frac, 4294967296L, 3)), Err::ParameterOutOfRange);
+  EXPECT_EQ(r.tag("c").exerr, 5);
+  EXPECT_EQ(r.exec(mag("d", "same", 1, "disabled", 0, frac, 3, 4294967296L)), Err::ParameterOutOfRange);
+  EXPECT_EQ(r.tag("d").exerr, 6);
+  // exact: 4294967295 slave counts per 4294967295 master counts is 1:1
+  ASSERT_EQ(r.exec(mag("e", "same", 1, "disabled", 0, frac, 4294967295L, 4294967295L)), Err::None);
+  r.exec(mam("M", "mm", 1, 7, 50));
+  r.step(1000);
+  EXPECT_EQ(r.axis("S").command_position, r.axis("M").command_position);
 }

@@ -469,3 +469,99 @@ TEST(MatcMd, MasterWithAHigherAxisIdIsSteppedFirst) {
   }
   EXPECT_GT(m.pos("Y"), 0.0);
 }
+
+// Issue 16 item 6. "Both a pending CAM and the active CAM must be in the same
+// mode ... An instruction that pends a CAM to an active CAM in a different
+// mode (than the active CAM) will cause an error" and "All pending CAMs must
+// use the Immediate Forward or the Immediate Reverse Lock Direction" [seed 004].
+// (a) A pending cam preloaded without an active cam (seed 004: it "executes
+// but no camming motion occurs until another MATC instruction with a
+// non-pending Execution Schedule is initiated") in the other mode than that
+// immediate cam errs when the immediate cam starts (ERR 105, IP cleared,
+// TimeCamPendingStatus cleared) instead of running in the wrong mode; in the
+// same mode it takes over as before. (b) A master-driven pending cam with Lock
+// Direction None is LOCK_DIRECTION_CONFLICT (95).
+TEST(MatcMd, PreloadedPendingCamOfTheOtherModeErrsAndPendingNoneLockIsRefused) {
+  MdRig m;
+  ASSERT_EQ(m.r.exec("MDAC(Y, X, l, timecam, command);"), Err::None);
+  // (b)
+  EXPECT_EQ(m.r.exec(md_matc("n", "slow", 1, 1, "once", "pending", 0, "none")), Err::MdscLockDirConflict);
+  EXPECT_EQ(m.r.tag("n").err, 95);
+  EXPECT_FALSE(m.ms("Y", motion_status::TimeCamPendingStatus));
+  // (a) a master-driven pending cam preloaded, then a time-driven immediate cam
+  ASSERT_EQ(m.r.exec(md_matc("p", "slow", 1, 1, "once", "pending", 0, "immediateforwardonly")), Err::None);
+  EXPECT_TRUE(m.ms("Y", motion_status::TimeCamPendingStatus));
+  ASSERT_EQ(m.r.exec(md_matc("a", "fast", 1, 0.1, "once", "immediate", 0, "none", "same", "timedrivenmode")),
+            Err::None);
+  EXPECT_TRUE(m.r.tag("p").er());
+  EXPECT_EQ(m.r.tag("p").err, 105);
+  EXPECT_FALSE(m.r.tag("p").ip());
+  m.r.step();
+  EXPECT_FALSE(m.ms("Y", motion_status::TimeCamPendingStatus));
+  m.r.step_until([&] { return m.r.tag("a").pc(); });
+  m.r.step(10);
+  EXPECT_FALSE(m.ms("Y", motion_status::TimeCamStatus));  // no cam took over
+  EXPECT_NEAR(m.pos("Y"), 10.0, 1e-9);                    // the time-driven pass only
+  // the same mode: the preloaded cam takes over at the end of the pass
+  MdRig s;
+  ASSERT_EQ(s.r.exec(md_matc("p", "slow", 1, 1, "once", "pending", 0, "none", "same", "timedrivenmode")),
+            Err::None);
+  ASSERT_EQ(s.r.exec(md_matc("a", "fast", 1, 0.1, "once", "immediate", 0, "none", "same", "timedrivenmode")),
+            Err::None);
+  EXPECT_FALSE(s.r.tag("p").er());
+  s.r.step_until([&] { return s.r.tag("a").pc(); });
+  s.r.step();
+  EXPECT_TRUE(s.ms("Y", motion_status::TimeCamStatus));  // the pending cam runs
+  EXPECT_TRUE(s.r.tag("p").ip());
+}
+
+// Issue 16 item 9: the controller mode. "A mode change (Rem Run to Rem Prog
+// or Rem Prog to Rem Run) or an axis fault also breaks the MDAC link"
+// [seed 000]; "CAM motion must also stop when the ControlLogix processor
+// changes OS modes" [seed 004]; gearing is stopped like camming ("This
+// behavior should be identical to the MAS functionality that specifically
+// stops a gearing process" [seed 004]). Into Program mode every axis stops by
+// its Programmed Stop Mode (FastStop here: a ramp at the maximum decel); in
+// Program mode instructions that would start motion answer ERR 24 Illegal
+// Controller Mode while stops and servo off run; back in Run they run again.
+TEST(MatcMd, ProgramModeBreaksLinksAndStopsCamsGearsAndMoves) {
+  MdRig m;
+  ASSERT_EQ(m.r.exec("MDAC(Y, X, l, timecam, command);"), Err::None);
+  m.jog("X", "jx", 10);
+  ASSERT_EQ(m.r.exec(md_matc("c", "fast", 1, 1, "continuous", "immediate", 0, "immediateforwardonly")), Err::None);
+  ASSERT_EQ(m.r.exec(md_matc("p", "slow", 1, 1, "once", "pending", 0, "immediateforwardonly")), Err::None);
+  ASSERT_EQ(m.r.exec("MAG(Z, X, g, same, 1, 1, 1, command, real, disabled, 0, unitspersec2);"), Err::None);
+  m.r.step(100);
+  ASSERT_GT(m.vel("Y"), 0.0);
+  ASSERT_GT(m.vel("Z"), 0.0);
+  m.r.p->set_controller_mode(ControllerMode::Program);
+  EXPECT_EQ(m.r.p->controller_mode(), ControllerMode::Program);
+  EXPECT_FALSE(m.r.tag("l").ip());  // the link is broken
+  EXPECT_FALSE(m.r.tag("c").ip());  // the cam, the pending cam, the gear and the jog are ended
+  EXPECT_FALSE(m.r.tag("p").ip());
+  EXPECT_FALSE(m.r.tag("g").ip());
+  EXPECT_FALSE(m.r.tag("jx").ip());
+  for (const char* a : {"X", "Y", "Z"}) EXPECT_TRUE(m.ms(a, motion_status::StoppingStatus)) << a;  // FastStop ramps
+  m.r.step();
+  EXPECT_FALSE(m.ms("Y", motion_status::TimeCamStatus));
+  EXPECT_FALSE(m.ms("Y", motion_status::TimeCamPendingStatus));
+  EXPECT_FALSE(m.ms("Z", motion_status::GearingStatus));
+  m.r.step(1000);
+  for (const char* a : {"X", "Y", "Z"}) {
+    EXPECT_EQ(m.vel(a), 0.0) << a;
+    EXPECT_TRUE(m.r.axis(a).status(axis_status::ServoActionStatus)) << a;  // FastStop keeps the servo on
+  }
+  // Program mode: nothing starts motion; stops and servo off run
+  EXPECT_EQ(m.r.exec(maj("X", "j2", 0, 10)), Err::IllegalControllerMode);
+  EXPECT_EQ(m.r.tag("j2").err, 24);
+  EXPECT_EQ(m.r.exec("MDAC(Y, X, l2, timecam, command);"), Err::IllegalControllerMode);
+  EXPECT_EQ(m.r.exec("MAS(X, s, all, no, 0, unitspersec2, no, 0, unitspersec3);"), Err::None);
+  EXPECT_EQ(m.r.exec("MSF(Z, off);"), Err::None);
+  m.r.step();
+  EXPECT_EQ(m.vel("X"), 0.0);
+  // back to Run: motion runs again
+  m.r.p->set_controller_mode(ControllerMode::Run);
+  EXPECT_EQ(m.r.exec(maj("X", "j3", 0, 10)), Err::None);
+  m.r.step(10);
+  EXPECT_GT(m.vel("X"), 0.0);
+}

@@ -203,3 +203,129 @@ TEST(Mdac, MasterReferenceChangeOfAMovingSlaveErrs) {
   EXPECT_EQ(r.exec("MDAC(S, M, l2, jog, actual);"), Err::MdscInvalidModeOrMasterChange);
   EXPECT_TRUE(r.tag("l1").ip());  // the original stays
 }
+
+// Issue 16 item 1. MCD changes the dynamics of "the active jog or move on the
+// fly" [RM002H p.142]; in Master Driven mode the speed of a move is in units
+// per master unit, so an MCD in those units re-plans it over master travel.
+// Switching modes with a change-dynamics instruction is refused: "A runtime
+// MDSC_INVALID_MODE_OR_MASTER_CHANGE error will occur if you attempt to change
+// from Master Driven Mode to Time Driven Mode or vice versa with an MCCD
+// instruction" [seed 001]: MCD follows its coordinated counterpart (ERR 105).
+TEST(Mdac, McdOnAMasterDrivenMoveReplansPerMasterUnitWithoutAJump) {
+  Rig r = rig3();
+  ASSERT_EQ(r.exec("MDAC(Z, X, l, move, command);"), Err::None);
+  ASSERT_EQ(r.exec(md_mam("Z", "m", 1000, 0.5, 10)), Err::None);
+  r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+  r.step(500);  // the master runs at 10 u/s, the slave at 0.5 u/mu = 5 u/s
+  ASSERT_NEAR(r.axis("Z").command_velocity, 5.0, 1e-6);
+  const std::string mcd =
+      "MCD(Z, c1, move, yes, 1.0, no, 0, no, 0, no, 0, no, 0, unitspermasterunit, unitspermasterunit2, "
+      "unitspermasterunit2, unitspermasterunit3);";
+  ASSERT_EQ(r.exec(mcd), Err::None) << r.tag("c1").err;
+  EXPECT_TRUE(r.tag("c1").dn());
+  // 0.5 -> 1.0 u/mu at 10 u/mu^2: 0.05 mu = 5 ms of master travel; no jump:
+  // the slave moves at most what 1.0 u/mu of the master's 0.01 u per cycle gives
+  double prev = r.axis("Z").command_position;
+  for (int i = 0; i < 100; ++i) {
+    r.step();
+    const double p = r.axis("Z").command_position;
+    EXPECT_GE(p - prev, 0.005 - 1e-9) << "cycle " << i;
+    EXPECT_LE(p - prev, 0.010 + 1e-9) << "cycle " << i;
+    prev = p;
+  }
+  EXPECT_NEAR(r.axis("Z").command_velocity, 10.0, 1e-6);  // 1.0 u/mu x 10 u/s
+  EXPECT_TRUE(r.tag("m").ip());
+  // time-driven units on the master-driven move: a mode change, refused; the
+  // move keeps its speed
+  ASSERT_EQ(r.exec("MCD(Z, c2, move, yes, 3, no, 0, no, 0, no, 0, no, 0, unitspersec, unitspersec2, unitspersec2, "
+                   "unitspersec3);"),
+            Err::MdscInvalidModeOrMasterChange);
+  EXPECT_EQ(r.tag("c2").err, 105);
+  r.step(10);
+  EXPECT_NEAR(r.axis("Z").command_velocity, 10.0, 1e-6);
+  // and the reverse: master-driven units on a time-driven jog
+  ASSERT_EQ(r.exec(maj("Y", "jy", 0, 10, 1e6, 1e6)), Err::None);
+  ASSERT_EQ(r.exec("MCD(Y, c3, jog, yes, 1.0, no, 0, no, 0, no, 0, no, 0, unitspermasterunit, unitspermasterunit2, "
+                   "unitspermasterunit2, unitspermasterunit3);"),
+            Err::MdscInvalidModeOrMasterChange);
+}
+
+// Issue 16 item 4. "A mode change (Rem Run to Rem Prog or Rem Prog to Rem Run)
+// or an axis fault also breaks the MDAC link"; on the master "MASD, MCSD, and
+// MGSD ... MAS and MCS for any Stop Type, including All, do NOT break the MDAC
+// link" [seed 000]. An axis fault here is an exception whose action faults or
+// stops the axis: on the slave Stop Planner (a stop of all planned motion, as
+// MAS All), Stop Drive and Shutdown break its links; on the master Stop Drive
+// and Shutdown (the axis is faulted, as MASD) break its slaves' links, Stop
+// Planner (a stop, as MAS on the master) does not. Fault Status Only "set[s]
+// the associated bit ... but [does] otherwise not affect axis behavior"
+// [seed 002]: no link is broken. Triggered by a soft overtravel of the slave Y
+// or the master X, with each action configured for it.
+TEST(Mdac, FaultsBreakTheLinksByActionAndSide) {
+  struct Case {
+    const char* axis;
+    ExceptionAction action;
+    bool breaks;
+  };
+  const Case cases[] = {
+      {"Y", ExceptionAction::FaultStatusOnly, false}, {"Y", ExceptionAction::StopPlanner, true},
+      {"Y", ExceptionAction::StopDrive, true},        {"Y", ExceptionAction::Shutdown, true},
+      {"X", ExceptionAction::FaultStatusOnly, false}, {"X", ExceptionAction::StopPlanner, false},
+      {"X", ExceptionAction::StopDrive, true},        {"X", ExceptionAction::Shutdown, true},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.axis) + " action " + std::to_string(static_cast<int>(c.action)));
+    Rig r;
+    for (const char* a : {"X", "Y"}) {
+      AxisConfig k = cfg();
+      if (std::string(a) == c.axis) {
+        k.soft_limits_enabled = true;
+        k.soft_limit_pos = 0.5;
+        k.soft_limit_neg = -1e6;
+        k.exception_actions[static_cast<std::size_t>(ExceptionKind::SoftOvertravelPos)] = c.action;
+      }
+      r.add_axis(a, k);
+      ASSERT_EQ(r.exec(std::string("MSO(") + a + ", on" + a + ");"), Err::None);
+    }
+    r.step();
+    ASSERT_EQ(r.exec("MDAC(Y, X, l, all, command);"), Err::None);
+    ASSERT_EQ(r.exec(maj(c.axis, "j", 0, 10, 1e6, 1e6)), Err::None);
+    r.step(200);  // 2 units: past the soft limit
+    ASSERT_NE(r.axis(c.axis).axis_fault, 0u);  // the exception happened
+    EXPECT_EQ(r.tag("l").ip(), !c.breaks);
+    // a broken link can be given to another master at once; a kept one is an All conflict
+    r.add_axis("Z", cfg());
+    const bool y_shut_down = std::string(c.axis) == "Y" && c.action == ExceptionAction::Shutdown;  // ERR 7 first
+    if (!y_shut_down) {
+      EXPECT_EQ(r.exec("MDAC(Y, Z, l2, move, command);"), c.breaks ? Err::None : Err::MdscMdacAllConflict);
+    }
+  }
+}
+
+// Issue 16 item 5. "An error is generated if a MDAC instruction is executed
+// that changes the Master Reference of a slave axis that is in motion. The new
+// MDAC instruction will error and the original one will remain active"
+// [seed 000]: also when the new MDAC names another master (it would otherwise
+// be queued silently with the other reference). The same reference with
+// another master is queued as before.
+TEST(Mdac, MasterReferenceChangeWithAnotherMasterOfAMovingSlaveErrs) {
+  Rig r;
+  AxisConfig m = cfg();
+  m.type = AxisType::CipDrive;
+  r.add_axis("M", m);
+  r.add_axis("N", m);
+  r.add_axis("S", cfg());
+  r.fb[0].drive = r.fb[1].drive = DriveState::Enabled;
+  for (const char* a : {"M", "N", "S"}) ASSERT_EQ(r.exec(std::string("MSO(") + a + ", on" + a + ");"), Err::None);
+  r.step();
+  ASSERT_EQ(r.exec("MDAC(S, M, l1, jog, command);"), Err::None);
+  r.exec(maj("S", "j", 0, 10));  // slave moving (time driven)
+  r.step(10);
+  EXPECT_EQ(r.exec("MDAC(S, N, l2, jog, actual);"), Err::MdscInvalidModeOrMasterChange);
+  EXPECT_EQ(r.tag("l2").err, 105);
+  EXPECT_FALSE(r.tag("l2").ip());
+  EXPECT_TRUE(r.tag("l1").ip());  // the original stays
+  // the same reference with another master: queued (both IP) [seed 000]
+  EXPECT_EQ(r.exec("MDAC(S, N, l3, jog, command);"), Err::None);
+  EXPECT_TRUE(r.tag("l3").ip() && r.tag("l1").ip());
+}

@@ -249,3 +249,61 @@ TEST(MdsAudit, VelocityCommandSetterIsForTorqueModeOnly) {
   EXPECT_DOUBLE_EQ(r.out[0].velocity, 5.0);
   EXPECT_DOUBLE_EQ(r.out[0].torque, 0.0);
 }
+
+// Issue 16 item 2. "The MDS instruction is validated if the CIP drive device
+// supports the ramp attributes, including RampAcceleration, RampDeceleration,
+// RampVelocity - Positive, RampVelocity - Negative, RampJerk - Control"
+// [seed 002]. The ramps are the axis' direct_control: in the configuration
+// (written to the drive at boot); without it MDS is refused with ERR 86
+// Optional Attribute Not Supported, whose text names what to configure, and
+// nothing is applied (the drive stays in CSP, no status bit).
+TEST(MdsAudit, RefusedOnACipAxisWithoutDirectControlConfigured) {
+  Rig r;
+  AxisConfig c = cip();
+  c.direct_control = false;  // a CIP axis without direct_control:
+  r.add_axis("D", c);
+  r.fb[0].drive = DriveState::Enabled;
+  ASSERT_EQ(r.exec("MSO(D, on);"), Err::None);
+  r.step();
+  EXPECT_EQ(r.exec("MDS(D, m, 10, unitspersec);"), Err::OptionalAttributeNotSupported);
+  EXPECT_EQ(r.tag("m").err, 86);
+  EXPECT_FALSE(r.tag("m").ip());
+  EXPECT_NE(err_name(Err::OptionalAttributeNotSupported).find("direct_control:"), std::string_view::npos);
+  r.step();
+  EXPECT_EQ(r.out[0].mode, DriveMode::CyclicPosition);
+  EXPECT_FALSE(direct_status(r));
+  EXPECT_FALSE(vel_status(r));
+}
+
+// Issue 16 item 3. "A combination of the DirectVelocityControlStatus Command
+// attribute and the DirectTorqueControlStatus Command attribute can be applied
+// in applications that require Speed-limited Adjustable Torque (SLAT) modes";
+// "The DirectVelocityControlStatus Command attribute is applied by taking the
+// value in the speed field in the instruction configuration"; on MDS "the
+// DirectVelocityControlStatus bit ... is set" and "Also ... the
+// DirectTorqueControlStatus bit ... is set" [seed 002]. With SLAT configured
+// the instruction's Speed is the velocity command (the SLAT speed, % of the
+// maximum speed), the torque command is written live, and both bits are set.
+TEST(MdsAudit, SlatTakesTheVelocityCommandFromTheInstructionAndSetsBothBits) {
+  Rig r;
+  AxisConfig c = cip(AxisConfig::DirectMode::Torque);
+  c.direct_slat = true;  // direct_control.slat.configuration: SLAT Min Speed/Torque
+  running(r, c, "MDS(D, m, 40, %ofmaximum);");
+  EXPECT_EQ(r.out[0].mode, DriveMode::CyclicTorque);
+  EXPECT_DOUBLE_EQ(r.out[0].velocity, 80.0);  // 40 % of max_speed 200, not the configured 25
+  EXPECT_DOUBLE_EQ(r.out[0].torque, 0.0);     // until the program writes the torque command
+  EXPECT_TRUE(vel_status(r));
+  EXPECT_TRUE(trq_status(r));
+  EXPECT_TRUE(r.p->set_direct_command(0, 150.0));
+  r.step();
+  EXPECT_DOUBLE_EQ(r.out[0].torque, 150.0);
+  // a superseding MDS changes the speed and keeps the torque command
+  ASSERT_EQ(r.exec("MDS(D, m2, 12.5, unitspersec);"), Err::None);
+  r.step();
+  EXPECT_DOUBLE_EQ(r.out[0].velocity, 12.5);
+  EXPECT_DOUBLE_EQ(r.out[0].torque, 150.0);
+  ASSERT_EQ(r.exec("MAS(D, s, directcontrol, no, 0, unitspersec2, no, 0, unitspersec3);"), Err::None);
+  r.step();
+  EXPECT_FALSE(vel_status(r));
+  EXPECT_FALSE(trq_status(r));
+}

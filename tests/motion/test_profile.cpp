@@ -68,6 +68,32 @@ Limits random_limits(Rng& r, bool scurve) {
   return l;
 }
 
+// A StopAtTarget plan from k by dist: never past the target, never backing
+// up, and the segments themselves end on the target at rest (no jump when
+// the sampling ends). Empty when all holds.
+std::string check_no_jump(const Profile& p, const Kin& k, double dist, const Limits& lim) {
+  std::ostringstream os;
+  const double sg = dist > 0 ? 1 : -1;
+  const double tol = 1e-9 * std::max({1.0, std::fabs(dist), std::fabs(k.p)});
+  Kin e = k;
+  for (int i = 0; i < p.size(); ++i) {
+    const Segment& s = p.segment(i);
+    for (int q = 0; q <= 16; ++q) {
+      const double t = s.dt * q / 16;
+      const double pos = p.origin() + s.p + s.v * t + s.a * t * t / 2 + s.j * t * t * t / 6;
+      const double vel = s.v + s.a * t + s.j * t * t / 2;
+      if (sg * (pos - (k.p + dist)) > tol) os << "passes the target at seg " << i << "; ";
+      if (sg * vel < -1e-9 * std::max(1.0, lim.v)) os << "backs up at seg " << i << " (v=" << vel << "); ";
+    }
+    const double t = s.dt;
+    e.p = p.origin() + s.p + s.v * t + s.a * t * t / 2 + s.j * t * t * t / 6;
+    e.v = s.v + s.a * t + s.j * t * t / 2;
+  }
+  if (std::fabs(e.p - (k.p + dist)) > 1e-7 * std::max({1.0, std::fabs(dist), std::fabs(k.p)}))
+    os << "the segments end at " << e.p << ", the target is " << k.p + dist << " (a jump at the end); ";
+  if (std::fabs(e.v) > 1e-6 * std::max(1.0, lim.v)) os << "end velocity " << e.v << "; ";
+  return os.str();
+}
 }  // namespace
 
 TEST(Profile, RestToRestExactTargetTrapezoidal) {
@@ -207,20 +233,11 @@ TEST(ProfileProperty, LimitDropMidMoveNeverPassesTarget) {
     if (scurve) { low.ja *= r.logu(1e-3, 1); low.jd *= r.logu(1e-3, 1); }
     Profile p;
     ASSERT_TRUE(plan_move(p, k, dist - k.p, low, Overshoot::StopAtTarget));
-    const double sg = dist > 0 ? 1 : -1;
     std::ostringstream ctx;
     ctx << "seed=" << seed << " n=" << n << " dist=" << dist << " k={" << k.p << "," << k.v << "," << k.a << "}";
-    // analytic extrema of position and velocity per segment
-    for (int i = 0; i < p.size(); ++i) {
-      const Segment& s = p.segment(i);
-      for (int q = 0; q <= 16; ++q) {
-        const double t = s.dt * q / 16;
-        const double pos = p.origin() + s.p + s.v * t + s.a * t * t / 2 + s.j * t * t * t / 6;
-        const double vel = s.v + s.a * t + s.j * t * t / 2;
-        ASSERT_LE(sg * (pos - dist), 1e-9 * std::max(1.0, std::fabs(dist))) << ctx.str() << " passes the target";
-        ASSERT_GE(sg * vel, -1e-9 * std::max(1.0, lim.v)) << ctx.str() << " reverses";
-      }
-    }
+    // analytic extrema of position and velocity per segment, and the segments' end
+    const std::string why = check_no_jump(p, k, dist - k.p, lim);
+    ASSERT_TRUE(why.empty()) << ctx.str() << ": " << why;
     int h2 = 0;
     // origin + remaining may differ from dist by an ulp; the planner sets the exact target (instruction tests)
     ASSERT_NEAR(p.sample(p.duration(), h2).p, dist, 1e-12 * std::max(1.0, std::fabs(dist))) << ctx.str();
@@ -228,4 +245,60 @@ TEST(ProfileProperty, LimitDropMidMoveNeverPassesTarget) {
       ASSERT_NEAR(p.segment(0).v, k.v, 1e-9 * std::max(1.0, lim.v)) << ctx.str();
     }
   }
+}
+
+// plan_move with Overshoot::StopAtTarget from a braking acceleration the
+// decel jerk cannot ramp out before the velocity reaches zero (MCD lowered
+// the decel jerk while braking). The profile must reach the target through
+// its own segments: the integrated end of the last segment is the target
+// (no jump when the sampling ends), it never backs up and never passes the
+// target. Repro found by a property test: Kin{0, 8.59837, -850.878}, distance
+// 0.16531, limits {118.431, 1979.87, 1051.89, 28122.6, 42100.6}: the scaled
+// stop ended at 0.058 and the sample jumped to 0.165 at the end.
+// Branch coord (4097b59) fixed the same case inside the path generator.
+
+TEST(Profile, StopAtTargetUnrampableBrakingReachesTargetWithoutJump) {
+  const Kin k{0, 8.59837, -850.878};
+  const Limits lim{118.431, 1979.87, 1051.89, 28122.6, 42100.6};
+  Profile p;
+  ASSERT_TRUE(plan_move(p, k, 0.16531, lim, Overshoot::StopAtTarget));
+  EXPECT_EQ(check_no_jump(p, k, 0.16531, lim), "");
+}
+
+TEST(ProfileProperty, StopAtTargetUnrampableBrakingNeverJumps) {
+  const std::uint64_t seed = canmotion::motion::test::prop_seed() + 3;
+  const std::uint64_t count = canmotion::motion::test::prop_count(120000) / 4;
+  Rng r(seed);
+  std::uint64_t failures = 0;
+  for (std::uint64_t n = 0; n < count && failures < 5; ++n) {
+    Limits lim = random_limits(r, true);
+    const double sg = r.coin() ? 1.0 : -1.0;
+    // moving towards the target with a braking acceleration a: unrampable when
+    // v < a^2 / (2 jd); v from just below to well below that bound
+    const double a = r.logu(1e-3, 1.0) * lim.d;
+    const double vb = a * a / (2 * lim.jd);
+    const double v = vb * r.uni(0.01, 1.0);  // needs a jerk at most 100 x jd
+    lim.v = std::max(lim.v, v);
+    const Kin k{r.uni(-10, 10), sg * v, -sg * a};
+    // 2v^2/(3a): the stop distance with the smallest jerk that ramps a out
+    // before v = 0 (a^2/(2v)); shorter distances need a harder stop, longer
+    // ones stop short and go on from rest
+    const double dstar = 2 * v * v / (3 * a);
+    const double dist = sg * dstar * r.logu(0.5, 1e3);
+    Profile p;
+    std::ostringstream ctx;
+    ctx << "seed=" << seed << " n=" << n << " k={" << k.p << "," << k.v << "," << k.a << "} dist=" << dist
+        << " lim={" << lim.v << "," << lim.a << "," << lim.d << "," << lim.ja << "," << lim.jd << "}";
+    if (!plan_move(p, k, dist, lim, Overshoot::StopAtTarget)) {
+      ADD_FAILURE() << ctx.str() << ": plan_move failed (rerun with CANMOTION_SEED=" << seed << ")";
+      ++failures;
+      continue;
+    }
+    const std::string why = check_no_jump(p, k, dist, lim);
+    if (!why.empty()) {
+      ADD_FAILURE() << ctx.str() << ": " << why << " (rerun with CANMOTION_SEED=" << seed << ")";
+      ++failures;
+    }
+  }
+  EXPECT_EQ(failures, 0u) << "seed " << seed;
 }

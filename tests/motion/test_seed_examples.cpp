@@ -115,15 +115,40 @@ TEST(Seed000Mdac, ReassignAfterAllNeedsABreakingInstruction) {
   }
 }
 
-// "The Shutdown instructions (MGSD, MASD, MCSD) never go IP."
+// "The Shutdown instructions (MGSD, MASD, MCSD) never go IP." Issue 16 item
+// 10: on moving axes (a stop could have a ramp in process), checked in the
+// executing scan and over the cycles after it, and the shutdown must have
+// happened (ShutdownStatus, the link broken, the motion ended) so that a
+// no-op instruction fails too.
 TEST(Seed000Mdac, ShutdownInstructionsNeverGoIp) {
-  Rig r = rig({"X", "Y"});
-  r.exec("MDAC(Y, X, l, all, command);");
+  Rig r = rig({"X", "Y", "Z"});
+  ASSERT_EQ(r.exec("MDAC(Y, X, l, all, command);"), Err::None);
+  for (const char* a : {"X", "Y", "Z"}) jog(r, a, std::string("j") + a, 10);
+  r.step(50);
+  ASSERT_NE(vel(r, "Y"), 0.0);
   ASSERT_EQ(r.exec("MASD(Y, sd);"), Err::None);
   EXPECT_TRUE(r.tag("sd").dn());
   EXPECT_FALSE(r.tag("sd").ip());
+  EXPECT_FALSE(r.tag("l").ip());  // the link is broken
+  EXPECT_FALSE(r.tag("jY").ip());  // the jog ended at once
+  for (int i = 0; i < 20; ++i) {
+    r.step();
+    EXPECT_FALSE(r.tag("sd").ip()) << "cycle " << i;
+  }
+  EXPECT_TRUE(r.axis("Y").status(axis_status::ShutdownStatus));
+  EXPECT_EQ(vel(r, "Y"), 0.0);
+  ASSERT_NE(vel(r, "X"), 0.0);
   ASSERT_EQ(r.exec("MGSD(g, gsd);"), Err::None);
+  EXPECT_TRUE(r.tag("gsd").dn());
   EXPECT_FALSE(r.tag("gsd").ip());
+  for (int i = 0; i < 20; ++i) {
+    r.step();
+    EXPECT_FALSE(r.tag("gsd").ip()) << "cycle " << i;
+  }
+  for (const char* a : {"X", "Z"}) {
+    EXPECT_TRUE(r.axis(a).status(axis_status::ShutdownStatus)) << a;
+    EXPECT_EQ(vel(r, a), 0.0) << a;
+  }
 }
 
 // "The same Slave axis can be assigned to 2 different Master axes ... X can be
@@ -312,10 +337,16 @@ TEST(Seed000Mdac, VerificationErrorsAreRuntimeErrors) {
   ASSERT_TRUE(r.tag("home").ip());  // drive homing in progress
   EXPECT_EQ(r.exec("MDAC(Y, H, e, move, command);"), Err::HomeInProcess);
   EXPECT_EQ(r.exec("MDAC(H, Y, e, move, command);"), Err::HomeInProcess);
-  // MRP completes in the scan it runs in (DN, no IP): a redefine is never "in
-  // progress" when the next instruction runs, so MDAC after MRP succeeds.
+  // MRP completes in the scan it runs in (DN, no IP, the position already
+  // redefined before any cycle ran): a redefine is never "in progress" when
+  // the next instruction runs, so MDAC after MRP succeeds. Issue 16 item 10:
+  // the redefinition itself is checked, so an MRP that did nothing or only
+  // later would fail here.
+  const double before = r.axis("X").command_position;
   ASSERT_EQ(r.exec("MRP(X, mrp, relative, command, 3);"), Err::None);
+  EXPECT_TRUE(r.tag("mrp").dn());
   EXPECT_FALSE(r.tag("mrp").ip());
+  EXPECT_EQ(r.axis("X").command_position, before + 3.0);
   EXPECT_EQ(r.exec("MDAC(Y, X, ok, move, command);"), Err::None);
   EXPECT_TRUE(r.tag("ok").ip());
 }

@@ -45,6 +45,9 @@ Commands:
   run SCRIPT               run a motion script (file, or - for stdin), printing its
                            PRINT lines; exit status 1 if the script fails
   stats                    controller and cycle statistics
+  mode [run|program]       print or set the controller mode: program stops every
+                           axis by its Programmed Stop Mode, breaks the MDAC links
+                           and refuses instructions that start motion (ERR 24)
   send 'LINE'              send one raw protocol line and print the response
 
 Options:
@@ -63,6 +66,7 @@ Examples:
   canmotionctl watch X.ActualPosition X.ActualVelocity --interval 0.5
   canmotionctl run config/examples/demo.script
   canmotionctl --socket /tmp/canmotiond.sock stats
+  canmotionctl mode program
 
 Exit status: 0 when canmotiond answered OK, 1 on ERR (the message goes to
 stderr), on a connection failure or a timeout, 2 on bad arguments.
@@ -345,6 +349,16 @@ int run(const std::string& socket_path, double timeout, std::optional<double> us
       fmt::print("{}\n", out);
       std::fflush(stdout);
     });
+    return 0;
+  }
+  if (verb == "mode") {
+    if (cmd.size() > 2) throw CLI::ValidationError("mode: give run or program, or nothing to print the mode");
+    if (cmd.size() == 2 && cmd[1] != "run" && cmd[1] != "program")
+      throw CLI::ValidationError("mode: '" + cmd[1] + "' is not run or program");
+    Connection c(socket_path, timeout);
+    c.send_line(cmd.size() == 2 ? "MODE " + cmd[1] : std::string("MODE"));
+    const std::string ok = c.response();
+    fmt::print("{}\n", ok.substr(ok.find('=') + 1));
     return 0;
   }
   if (verb == "send") {

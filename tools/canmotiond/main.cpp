@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -17,9 +18,12 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "config/config.hpp"
+#include "config/eds_check.hpp"
 #include "config/runtime.hpp"
+#include "fieldbus/eds/dcf.hpp"
 #include "fieldbus/can/candump_format.hpp"
 #include "fieldbus/canopen/emcy.hpp"
 #include "rt/clock.hpp"
@@ -50,7 +54,46 @@ struct Options {
   bool quiet = false;
   double sim_rate = -1;  // --sim-rate; < 0 = default (1 with --socket, else 0 = flat out)
   bool check_args = false;  // --check-args: parse and validate, then exit (tests/docs)
+  std::string write_dcf;    // --write-dcf DIR: one DCF per node of the boot writes, then exit
 };
+
+/// --write-dcf: DIR/<axis>.dcf per CIP axis, the SDO writes of its boot
+/// configuration (config::boot_writes, the proxy's own list). 0, or 1 when a
+/// file cannot be written.
+int write_dcfs(const config::Config& cfg, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  for (std::size_t i = 0; i < cfg.axes.size(); ++i) {
+    const config::AxisSettings& a = cfg.axes[i];
+    const config::BusSettings* bus = cfg.find_bus(a.bus);
+    if (a.axis.type != motion::AxisType::CipDrive || bus == nullptr) continue;
+    const std::vector<cia402::BootWrite> writes = config::boot_writes(a, *bus, cfg.controller.period_s, i);
+    const cia402::DriveConfig dc = config::drive_config(a, *bus, cfg.controller.period_s, i);
+    eds::DcfSpec spec;
+    spec.node_id = a.node;
+    spec.baudrate_kbit = static_cast<std::uint16_t>(bus->bitrate / 1000);
+    spec.node_name = a.name;
+    spec.eds = a.drive.eds_data.get();
+    std::size_t written = 0;
+    for (const cia402::BootWrite& w : writes) {
+      if (w.is_read()) continue;  // the boot's checks (0x1000, 0x6502, 0x6061, ...) are not configuration
+      ++written;
+      const std::string* key = cia402::write_hint_key(dc.hints, w);
+      spec.writes.push_back({w.w.index, w.w.sub, w.w.size, w.w.value, key != nullptr ? *key : std::string()});
+    }
+    const std::string path = (std::filesystem::path(dir) / (a.name + ".dcf")).string();
+    std::ofstream f(path);
+    f << eds::format_dcf(spec);
+    f.close();
+    if (!f) {
+      fmt::print(stderr, "canmotiond: --write-dcf: cannot write {}\n", path);
+      return 1;
+    }
+    fmt::print("canmotiond: {}: node {}, {} boot writes{}\n", path, a.node, written,
+               a.drive.eds.empty() ? "" : " (checked against " + a.drive.eds + ")");
+  }
+  return 0;
+}
 
 /// Writes the trace and CSV files and prints events; drained from the
 /// controller's rings on a non-RT thread (or inline in --sim).
@@ -170,9 +213,7 @@ class Shutdown {
         for (std::size_t a = 0; a < c.axis_count(); ++a)
           enabled |= s.axes[a].drive_state == cia402::State::kOperationEnabled;
         if ((!enabled && h_.settled()) || now - since_ > kDisableTimeout) {
-          rt::Command cmd;
-          cmd.kind = rt::Command::Kind::kPreOperational;
-          (void)c.submit(cmd);
+          (void)c.submit(rt::cmd::PreOperational{});
           phase_ = Phase::kPreOp;
           since_ = now;
         }
@@ -247,52 +288,250 @@ void print_progress(rt::ControllerHost& host) {
   std::fflush(stdout);
 }
 
-int run(const Options& o) {
-  // 1. Configuration: everything is validated before any bus is touched.
+/// A step of run() that ends the run early; it printed why.
+struct Exit {
+  int status;
+};
+
+/// 1. Configuration: everything is validated before any bus is touched.
+config::Config load_config(const Options& o) {
   config::Config cfg;
   try {
     cfg = config::load_file(o.config);
   } catch (const config::ConfigError& e) {
     fmt::print(stderr, "{}\ncanmotiond: configuration has errors; nothing was sent on any bus\n", e.what());
-    return 2;
+    throw Exit{2};
   } catch (const std::exception& e) {
     fmt::print(stderr, "canmotiond: {}\n", e.what());
-    return 2;
+    throw Exit{2};
   }
   for (const auto& w : cfg.warnings) fmt::print(stderr, "{}\n", w.str());
+  if (!o.write_dcf.empty() && !o.check_args) throw Exit{write_dcfs(cfg, o.write_dcf)};  // nothing opened
+  {
+    // Without drive.eds the master cannot know which optional objects a drive has: say once what it does.
+    std::vector<std::string> blind;
+    for (const auto& a : cfg.axes)
+      if (a.axis.type == motion::AxisType::CipDrive && a.drive.eds.empty()) blind.push_back(a.name);
+    if (!blind.empty() && !o.quiet)
+      fmt::print(stderr,
+                 "canmotiond: axes without drive.eds ({}): optional objects (PDOs not used, 0x1016 when "
+                 "master_heartbeat_timeout_ms is not set) are written anyway, and a drive without them (SDO abort "
+                 "0x06020000 / 0x06090011) is accepted\n",
+                 fmt::join(blind, ", "));
+  }
+  return cfg;
+}
 
-  // 2. Buses and controller.
-  config::Runtime rt;
+/// 2. Buses and controller (--check-args: simulated buses, nothing opened).
+config::Runtime open_runtime(const Options& o, const config::Config& cfg) {
   try {
-    rt = config::build_runtime(cfg, o.sim || o.check_args);  // --check-args: simulated buses, nothing opened
+    config::Runtime rt = config::build_runtime(cfg, o.sim || o.check_args);
+    for (const auto& n : rt.notes) fmt::print(stderr, "canmotiond: {}\n", n);  // e.g. a raised txqueuelen
+    return rt;
   } catch (const std::exception& e) {
     fmt::print(stderr, "canmotiond: {}\n", e.what());
-    return 1;
+    throw Exit{1};
   }
-  for (const auto& n : rt.notes) fmt::print(stderr, "canmotiond: {}\n", n);
-  rt::Controller& ctl = *rt.controller;
-  rt::ControllerHost host(ctl);
-  // The cycle statistics as tags (Controller.latency_max_ns, ...), registered
-  // before the script is checked; they read the executive once it exists.
-  rt::CyclicExecutive* exec_for_tags = nullptr;
-  for (std::string_view name : rt::stat_tag_names())
-    host.tags().add_statistic(std::string(name), [&exec_for_tags, name] {
-      return exec_for_tags == nullptr
-                 ? 0.0
-                 : static_cast<double>(rt::stat_tag_value(exec_for_tags->statistics().snapshot(), name).value_or(0));
-    });
-  const bool sim = o.sim;  // virtual time only with --sim; `interface: sim` alone runs in real time
+}
 
-  // 3. Script, checked against the controller before anything runs.
-  std::optional<rt::script::Script> script;
-  if (!o.script.empty()) {
-    try {
-      script = rt::script::load_file(o.script, host);
-    } catch (const std::exception& e) {
-      fmt::print(stderr, "canmotiond: {}\n", e.what());
-      return 2;
+/// The cycle statistics as tags (Controller.latency_max_ns, ...), registered
+/// before the script is checked; they read the executive once `exec` is set.
+void add_statistic_tags(rt::ControllerHost& host, rt::CyclicExecutive* const& exec) {
+  for (std::string_view name : rt::stat_tag_names())
+    host.tags().add_statistic(std::string(name), [&exec, name] {
+      return exec == nullptr ? 0.0
+                             : static_cast<double>(rt::stat_tag_value(exec->statistics().snapshot(), name).value_or(0));
+    });
+}
+
+/// 3. The script, checked against the controller before anything runs.
+std::optional<rt::script::Script> load_script(const Options& o, rt::ControllerHost& host) {
+  if (o.script.empty()) return std::nullopt;
+  try {
+    return rt::script::load_file(o.script, host);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "canmotiond: {}\n", e.what());
+    throw Exit{2};
+  }
+}
+
+/// The cyclic executive's settings: the configuration's real-time settings,
+/// none with --sim (virtual time only with --sim; `interface: sim` alone runs
+/// in real time).
+rt::ExecutiveConfig executive_config(const config::Config& cfg, std::chrono::nanoseconds period, bool sim) {
+  rt::ExecutiveConfig ec;
+  ec.period = period;
+  ec.rt = sim ? rt::RtSettings::none()
+              : rt::RtSettings{cfg.controller.lock_memory, cfg.controller.lock_memory ? 256u * 1024u : 0u,
+                               cfg.controller.priority, cfg.controller.cpu, cfg.controller.cpu_dma_latency_us};
+  ec.warn = [](std::string_view w) { fmt::print(stderr, "canmotiond: WARNING: {}\n", w); };
+  return ec;
+}
+
+/// canmotionctl's socket (rt/controller/command_server.hpp), served from
+/// housekeeping; null without --socket.
+std::unique_ptr<rt::CommandServer> open_socket(const Options& o, rt::Controller& ctl, rt::ControllerHost& host,
+                                               rt::CyclicExecutive& exec) {
+  if (o.socket.empty()) return nullptr;
+  rt::CommandServerOptions so;
+  so.path = o.socket;
+  so.group = o.socket_group;
+  so.io_interval_s = o.sim ? 0.001 : 0.0;  // --sim: housekeeping runs every cycle; poll the socket once per ms
+  so.log = [](const std::string& l) { fmt::print(stderr, "canmotiond: socket: {}\n", l); };
+  if (!o.sim) so.cycle_stats = [&exec] { return exec.statistics().snapshot(); };
+  so.shared_host = &host;  // clients and --script share user tags
+  try {
+    return std::make_unique<rt::CommandServer>(ctl, std::move(so));
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "canmotiond: {}\n", e.what());
+    throw Exit{1};
+  }
+}
+
+/// The non-RT work of one step (between cycles in --sim, every millisecond
+/// on the housekeeping thread in real time): outputs, socket, script,
+/// progress, the end of the run and the controlled stop.
+class Housekeeping {
+ public:
+  Housekeeping(const Options& o, rt::ControllerHost& host, rt::CyclicExecutive& exec, Outputs& out,
+               rt::CommandServer* server, rt::script::Runner* runner)
+      : o_(o), host_(host), exec_(exec), out_(out), server_(server), runner_(runner), shutdown_(host),
+        period_s_(host.controller().period_s()),
+        per_second_(static_cast<std::uint64_t>(std::llround(1.0 / period_s_))),
+        next_progress_(per_second_),
+        // --sim pacing: at most sim_rate x real time (0 = as fast as possible).
+        sim_rate_(o.sim_rate >= 0 ? o.sim_rate : (server ? 1.0 : 0.0)) {}
+
+  /// One step at `cycle`; returns true when the run is over.
+  bool operator()(std::uint64_t cycle) {
+    const double now = static_cast<double>(cycle) * period_s_;
+    if (o_.sim && sim_rate_ > 0)
+      std::this_thread::sleep_until(wall0_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                 std::chrono::duration<double>(now / sim_rate_)));
+    out_.drain(o_.quiet);
+    if (server_) server_->poll(now);
+    step_script(now);
+    if (o_.duration > 0 && now >= o_.duration) shutdown_.begin(now);
+    if (g_signal.load() != 0 && shutdown_.phase() == Shutdown::Phase::kNone) {
+      fmt::print(stderr, "canmotiond: signal {}: stopping axes, disabling drives\n", g_signal.load());
+      shutdown_.begin(now);
+    }
+    if (server_ && !refusing_ && shutdown_.phase() != Shutdown::Phase::kNone) {
+      refusing_ = true;  // no new motion from clients once the controlled stop has begun
+      server_->refuse_motion("canmotiond is stopping (controlled stop): motion instructions and scripts are refused");
+    }
+    if (!o_.quiet && cycle >= next_progress_) {
+      next_progress_ += per_second_;
+      print_progress(host_);
+      if (o_.stats && !o_.sim) fmt::print("{}\n", rt::format_line(exec_.statistics().snapshot()));
+    }
+    return shutdown_.step(now);
+  }
+  /// 1 once the script failed (or a step threw), else 0.
+  int status() const noexcept { return status_; }
+  void fail() noexcept { status_ = 1; }
+  std::chrono::steady_clock::time_point wall0() const noexcept { return wall0_; }
+
+ private:
+  void step_script(double now) {
+    if (!runner_ || shutdown_.phase() != Shutdown::Phase::kNone) return;
+    const auto st = runner_->step(now);
+    if (st == rt::script::Runner::Status::kFailed) {
+      fmt::print(stderr, "canmotiond: script failed: {}\n", runner_->error());
+      status_ = 1;
+      shutdown_.begin(now);
+    } else if (st == rt::script::Runner::Status::kDone && o_.duration <= 0) {
+      shutdown_.begin(now);
     }
   }
+
+  const Options& o_;
+  rt::ControllerHost& host_;
+  rt::CyclicExecutive& exec_;
+  Outputs& out_;
+  rt::CommandServer* server_;
+  rt::script::Runner* runner_;
+  Shutdown shutdown_;
+  const std::chrono::steady_clock::time_point wall0_ = std::chrono::steady_clock::now();
+  const double period_s_;
+  const std::uint64_t per_second_;
+  std::uint64_t next_progress_;
+  const double sim_rate_;
+  bool refusing_ = false;
+  int status_ = 0;
+};
+
+/// --sim: the same cycle code on a virtual clock, with the non-RT work inline
+/// between cycles so that runs are deterministic. Every status read (script,
+/// socket, progress) runs on this thread between cycles, so the controller
+/// copies its snapshot only for cycles that are read.
+int run_simulated(config::Runtime& rt, rt::CyclicExecutive& exec, Housekeeping& hk, std::chrono::nanoseconds period) {
+  rt::Controller& ctl = *rt.controller;
+  ctl.set_deferred_publish(true);
+  exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
+    const auto t = static_cast<std::int64_t>(info.cycle) * period.count();
+    if (rt.sim) rt.sim->begin_cycle(t);  // null when the configuration has no buses (virtual axes only)
+    ctl.cycle(t);
+    if (rt.sim) rt.sim->end_cycle(t);
+    bool ended = true;
+    try {
+      ended = hk(info.cycle + 1);
+    } catch (...) {
+      hk.fail();
+    }
+    return ended ? rt::CycleResult::stop : rt::CycleResult::run_on;
+  });
+  if (auto e = exec.run(); e) {
+    fmt::print(stderr, "canmotiond: cannot run the cycle: {}\n", e.message());
+    return 1;
+  }
+  return 0;
+}
+
+/// Real time: the cycle on the RT thread, housekeeping on this one every
+/// millisecond, systemd readiness and watchdog.
+int run_real_time(const Options& o, config::Runtime& rt, rt::CyclicExecutive& exec, Housekeeping& hk) {
+  rt::Controller& ctl = *rt.controller;
+  exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
+    const std::int64_t t = info.wake.count();
+    if (rt.sim) rt.sim->begin_cycle(t);
+    ctl.cycle(t);
+    if (rt.sim) rt.sim->end_cycle(t);
+  });
+  if (auto e = exec.start(); e) {
+    fmt::print(stderr, "canmotiond: cannot start the cyclic thread: {}\n", exec.setup_report().error_message());
+    return 1;
+  }
+  if (o.stats) {  // what the RT set-up got (mlockall, SCHED_FIFO, cpu_dma_latency, ...), one line
+    std::string steps = exec.setup_report().describe();
+    for (std::size_t p; (p = steps.find('\n')) != std::string::npos;)
+      steps.replace(p, 1, p + 1 < steps.size() ? "; " : "");
+    fmt::print("canmotiond: real-time set-up: {}\n", steps);
+  }
+  rt::SdNotifier::ready();
+  std::unique_ptr<rt::WatchdogThread> wd;
+  if (auto iv = rt::SdNotifier::watchdog_interval()) {
+    wd = std::make_unique<rt::WatchdogThread>([&exec] { return exec.cycle_count(); }, *iv / 2);
+    wd->start();
+  }
+  for (bool ended = false; !ended;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ended = hk(ctl.cycles());
+  }
+  rt::SdNotifier::stopping();
+  if (wd) wd->stop();
+  exec.stop();
+  return 0;
+}
+
+int run(const Options& o) {
+  const config::Config cfg = load_config(o);  // 1
+  config::Runtime rt = open_runtime(o, cfg);  // 2
+  rt::Controller& ctl = *rt.controller;
+  rt::ControllerHost host(ctl);
+  rt::CyclicExecutive* exec_for_tags = nullptr;
+  add_statistic_tags(host, exec_for_tags);
+  const std::optional<rt::script::Script> script = load_script(o, host);  // 3
   if (o.check_args) {
     fmt::print("canmotiond: arguments, configuration{} OK ({} axes, {} buses); nothing was run\n",
                script ? " and script" : "", ctl.axis_count(), cfg.buses.size());
@@ -303,7 +542,6 @@ int run(const Options& o) {
       fmt::print("{}\n", l);
       std::fflush(stdout);
     });
-
   std::unique_ptr<Outputs> out;
   try {
     out = std::make_unique<Outputs>(o, rt, cfg);
@@ -318,146 +556,29 @@ int run(const Options& o) {
   sigaction(SIGTERM, &sa, nullptr);
 
   const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(std::llround(ctl.period_s() * 1e9)));
-  rt::ExecutiveConfig ec;
-  ec.period = period;
-  ec.rt = sim ? rt::RtSettings::none()
-              : rt::RtSettings{cfg.controller.lock_memory, cfg.controller.lock_memory ? 256u * 1024u : 0u,
-                               cfg.controller.priority, cfg.controller.cpu, cfg.controller.cpu_dma_latency_us};
-  ec.warn = [](std::string_view w) { fmt::print(stderr, "canmotiond: WARNING: {}\n", w); };
   rt::VirtualClock vclock;
   rt::MonotonicClock mclock;
-  rt::Clock& clock = sim ? static_cast<rt::Clock&>(vclock) : static_cast<rt::Clock&>(mclock);
-  rt::CyclicExecutive exec(ec, clock);
+  rt::Clock& clock = o.sim ? static_cast<rt::Clock&>(vclock) : static_cast<rt::Clock&>(mclock);
+  rt::CyclicExecutive exec(executive_config(cfg, period, o.sim), clock);
   exec_for_tags = &exec;
-
-  // canmotionctl's socket (rt/controller/command_server.hpp), served from housekeeping.
-  std::unique_ptr<rt::CommandServer> server;
-  if (!o.socket.empty()) {
-    rt::CommandServerOptions so;
-    so.path = o.socket;
-    so.group = o.socket_group;
-    so.io_interval_s = sim ? 0.001 : 0.0;  // --sim: housekeeping runs every cycle; poll the socket once per ms
-    so.log = [](const std::string& l) { fmt::print(stderr, "canmotiond: socket: {}\n", l); };
-    if (!sim) so.cycle_stats = [&exec] { return exec.statistics().snapshot(); };
-    so.shared_host = &host;  // clients and --script share user tags
-    try {
-      server = std::make_unique<rt::CommandServer>(ctl, std::move(so));
-    } catch (const std::exception& e) {
-      fmt::print(stderr, "canmotiond: {}\n", e.what());
-      return 1;
-    }
-  }
+  const std::unique_ptr<rt::CommandServer> server = open_socket(o, ctl, host, exec);
 
   fmt::print("canmotiond: {} axes, {} buses ({}), period {} ms{}\n", ctl.axis_count(), cfg.buses.size(),
-             sim ? "simulated, virtual time" : "real time", ctl.period_s() * 1e3,
+             o.sim ? "simulated, virtual time" : "real time", ctl.period_s() * 1e3,
              script ? ", script " + o.script : std::string());
-  const auto wall0 = std::chrono::steady_clock::now();
-  Shutdown shutdown(host);
-  int status = 0;
-  const std::uint64_t per_second = static_cast<std::uint64_t>(std::llround(1.0 / ctl.period_s()));
-  std::uint64_t next_progress = per_second;
-  bool ended = false;
+  Housekeeping hk(o, host, exec, *out, server.get(), runner.get());
+  if (rt.sim) rt.sim->power_on(o.sim ? 0 : clock.now().count());  // boot-up frames at the run's start time
+  if (const int e = o.sim ? run_simulated(rt, exec, hk, period) : run_real_time(o, rt, exec, hk); e != 0) return e;
 
-  // The non-RT work of one step: outputs, script, progress, end of run.
-  // --sim pacing: at most sim_rate x real time (0 = as fast as possible).
-  const double sim_rate = o.sim_rate >= 0 ? o.sim_rate : (server ? 1.0 : 0.0);
-  bool refusing = false;
-  auto housekeeping = [&](std::uint64_t cycle) -> bool {
-    const double now = static_cast<double>(cycle) * ctl.period_s();
-    if (sim && sim_rate > 0)
-      std::this_thread::sleep_until(wall0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                std::chrono::duration<double>(now / sim_rate)));
-    out->drain(o.quiet);
-    if (server) server->poll(now);
-    if (runner && shutdown.phase() == Shutdown::Phase::kNone) {
-      const auto st = runner->step(now);
-      if (st == rt::script::Runner::Status::kFailed) {
-        fmt::print(stderr, "canmotiond: script failed: {}\n", runner->error());
-        status = 1;
-        shutdown.begin(now);
-      } else if (st == rt::script::Runner::Status::kDone && o.duration <= 0) {
-        shutdown.begin(now);
-      }
-    }
-    if (o.duration > 0 && now >= o.duration) shutdown.begin(now);
-    if (g_signal.load() != 0 && shutdown.phase() == Shutdown::Phase::kNone) {
-      fmt::print(stderr, "canmotiond: signal {}: stopping axes, disabling drives\n", g_signal.load());
-      shutdown.begin(now);
-    }
-    if (server && !refusing && shutdown.phase() != Shutdown::Phase::kNone) {
-      refusing = true;  // no new motion from clients once the controlled stop has begun
-      server->refuse_motion("canmotiond is stopping (controlled stop): motion instructions and scripts are refused");
-    }
-    if (!o.quiet && cycle >= next_progress) {
-      next_progress += per_second;
-      print_progress(host);
-      if (o.stats && !sim) fmt::print("{}\n", rt::format_line(exec.statistics().snapshot()));
-    }
-    return shutdown.step(now);
-  };
-
-  if (rt.sim) rt.sim->power_on(sim ? 0 : clock.now().count());  // boot-up frames at the run's start time
-  if (sim) {
-    // --sim: the same cycle code on a virtual clock, with the non-RT work
-    // inline between cycles so that runs are deterministic. Every status
-    // read (script, socket, progress) runs on this thread between cycles, so
-    // the controller copies its snapshot only for cycles that are read.
-    ctl.set_deferred_publish(true);
-    exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
-      const auto t = static_cast<std::int64_t>(info.cycle) * period.count();
-      if (rt.sim) rt.sim->begin_cycle(t);  // null when the configuration has no buses (virtual axes only)
-      ctl.cycle(t);
-      if (rt.sim) rt.sim->end_cycle(t);
-      try {
-        ended = housekeeping(info.cycle + 1);
-      } catch (...) {
-        ended = true;
-        status = 1;
-      }
-      return ended ? rt::CycleResult::stop : rt::CycleResult::run_on;
-    });
-    if (auto e = exec.run(); e) {
-      fmt::print(stderr, "canmotiond: cannot run the cycle: {}\n", e.message());
-      return 1;
-    }
-  } else {
-    exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
-      const std::int64_t t = info.wake.count();
-      if (rt.sim) rt.sim->begin_cycle(t);
-      ctl.cycle(t);
-      if (rt.sim) rt.sim->end_cycle(t);
-    });
-    if (auto e = exec.start(); e) {
-      fmt::print(stderr, "canmotiond: cannot start the cyclic thread: {}\n", exec.setup_report().error_message());
-      return 1;
-    }
-    if (o.stats) {  // what the RT set-up got (mlockall, SCHED_FIFO, cpu_dma_latency, ...), one line
-      std::string steps = exec.setup_report().describe();
-      for (std::size_t p; (p = steps.find('\n')) != std::string::npos;)
-        steps.replace(p, 1, p + 1 < steps.size() ? "; " : "");
-      fmt::print("canmotiond: real-time set-up: {}\n", steps);
-    }
-    rt::SdNotifier::ready();
-    std::unique_ptr<rt::WatchdogThread> wd;
-    if (auto iv = rt::SdNotifier::watchdog_interval()) {
-      wd = std::make_unique<rt::WatchdogThread>([&exec] { return exec.cycle_count(); }, *iv / 2);
-      wd->start();
-    }
-    while (!ended) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      ended = housekeeping(ctl.cycles());
-    }
-    rt::SdNotifier::stopping();
-    if (wd) wd->stop();
-    exec.stop();
-  }
+  // The end: the rest of the outputs, the summary, a script that did not finish.
+  int status = hk.status();
   out->drain(true);
   if (const std::string err = out->close(); !err.empty()) {
     fmt::print(stderr, "canmotiond: {}\n", err);
     status = 1;
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  if (!o.quiet || o.stats) print_summary(o, rt, host, exec.statistics().snapshot(), wall, !sim);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - hk.wall0()).count();
+  if (!o.quiet || o.stats) print_summary(o, rt, host, exec.statistics().snapshot(), wall, !o.sim);
   if (o.stats) fmt::print("{}\n", rt::format_summary(exec.statistics().snapshot()));
   if (runner && runner->status() == rt::script::Runner::Status::kRunning && status == 0) {
     fmt::print(stderr, "canmotiond: the run ended before the script did (statement {} of {})\n",
@@ -496,9 +617,13 @@ int main(int argc, char** argv) {
   app.add_flag("--check-args", o.check_args,
                "parse the arguments, load and check the configuration and the --script, then exit (0 = valid); "
                "opens no bus or socket");
+  app.add_option("--write-dcf", o.write_dcf,
+                 "write DIR/<axis>.dcf per CANopen axis: the SDO writes of its boot configuration (PDOs, 0x60C2, "
+                 "heartbeats, sdo_writes) as a CiA 306 DCF for review, then exit; opens no bus");
   app.footer(
       "Examples:\n"
       "  canmotiond --config config/examples/demo.yaml --sim --script config/examples/demo.script\n"
+      "  canmotiond --config config/examples/demo.yaml --write-dcf dcf/\n"
       "  canmotiond --config /etc/canmotion/canmotiond.yaml --stats\n"
       "Exit status: 0 ok, 1 run-time failure (script failed, bus error), 2 bad configuration or arguments.");
   try {
@@ -506,5 +631,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
-  return run(o);
+  try {
+    return run(o);
+  } catch (const Exit& e) {
+    return e.status;
+  }
 }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fieldbus/can/socketcan_bus.hpp"
+#include "fieldbus/eds/eds.hpp"
 #include "fieldbus/trace/analyzer.hpp"
 #include "fieldbus/trace/decoder.hpp"
 #include "fieldbus/trace/format.hpp"
@@ -58,6 +59,9 @@ Options:
                              applied N SYNCs earlier (default 0; 1 for drives that sample
                              their position at SYNC before applying the new target)
          -n, --count N       stop after N frames
+             --eds NODE=FILE name node NODE's objects (SDO transfers, PDO mappings) from
+                             its EDS or DCF (CiA 306) and type their values by it;
+                             repeat per node (default: the CiA 301/402 names)
              --check-args    check the options and exit (0 = valid); reads no input
          -h, --help          show this help
 
@@ -71,6 +75,8 @@ Examples:
   cantrace -s --csv out --plot out/run.png -c axes.yaml trace.log
   cantrace --live vcan0 -s                    decode a live bus, summary at CTRL-C
   cantrace -j -s -q trace.log | jq .buses     summary for scripts
+  cantrace --eds 2=config/examples/minimal-drive.eds trace.log
+                                              node 2's objects by its EDS's names
 )";
 
 volatile std::sig_atomic_t g_stop = 0;
@@ -92,6 +98,7 @@ struct Options {
   std::uint32_t lag = 0;
   std::uint64_t count = 0;
   bool check_args = false;
+  std::vector<std::pair<int, std::string>> eds;  // --eds NODE=FILE
 };
 
 [[noreturn]] void usage_error(const std::string& msg) {
@@ -123,6 +130,14 @@ Options parse_args(int argc, char** argv) {
       o.live = value();
     } else if (a == "-c" || a == "--config") {
       o.config = value();
+    } else if (a == "--eds") {
+      const std::string v = value();
+      const std::size_t eq = v.find('=');
+      char* end = nullptr;
+      const long node = eq == std::string::npos ? 0 : std::strtol(v.c_str(), &end, 0);
+      if (eq == std::string::npos || end != v.c_str() + eq || node < 1 || node > 127 || eq + 1 == v.size())
+        usage_error("--eds '" + v + "': want NODE=FILE with NODE 1..127 (e.g. 2=drive.eds)");
+      o.eds.emplace_back(static_cast<int>(node), v.substr(eq + 1));
     } else if (a == "-s" || a == "--summary") {
       o.summary = true;
     } else if (a == "-q" || a == "--quiet") {
@@ -197,6 +212,8 @@ class App {
   std::optional<tr::TraceConfig> config_;
   std::vector<std::unique_ptr<Bus>> buses_;
   tr::FormatOptions fmt_opt_;
+  std::vector<std::unique_ptr<canmotion::canopen::DeviceDictionary>> dictionaries_;  // --eds
+  tr::NodeDictionaries names_{};
   tr::LineReader reader_{false};
   fmt::memory_buffer out_;
   fmt::memory_buffer csv_buf_;
@@ -479,6 +496,17 @@ int App::finish() {
 }
 
 int App::run() {
+  for (const auto& [node, file] : opt_.eds) {
+    try {
+      dictionaries_.push_back(std::make_unique<canmotion::canopen::DeviceDictionary>(
+          canmotion::eds::device_dictionary(canmotion::eds::load(file))));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "cantrace: --eds %d=%s:\n%s\n", node, file.c_str(), e.what());
+      return 1;
+    }
+    names_[static_cast<std::size_t>(node)] = dictionaries_.back().get();
+    fmt_opt_.names = &names_;
+  }
   if (!opt_.config.empty()) {
     try {
       config_ = tr::load_trace_config(opt_.config);

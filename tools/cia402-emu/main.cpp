@@ -6,11 +6,13 @@
 #include <time.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,8 @@
 #include "fieldbus/canopen/frame_sink.hpp"
 #include "fieldbus/canopen/nmt.hpp"
 #include "fieldbus/cia402/cia402.hpp"
+#include "fieldbus/eds/eds.hpp"
+#include "fieldbus/emulator/eds_dictionary.hpp"
 #include "fieldbus/emulator/emulator.hpp"
 
 using namespace canmotion;
@@ -49,19 +53,60 @@ constexpr const char* kFooter = R"(Examples:
       0x6061 never follows 0x6060: the master's mode-switch timeout fires
   cia402-emu -i vcan0 -n 2 --without-object 0x1016 --without-object 0x1403 --without-object 0x1603
       a drive without the optional 0x1016 and without RPDO4 (SDO aborts 0x06020000)
+  cia402-emu -i vcan0 -n 2 --eds config/examples/minimal-drive.eds
+      a drive with exactly the objects of that EDS (no 0x1016, 2 RPDOs, 2 TPDOs),
+      its PDO mapping flags, access types and defaults
+  cia402-emu -i vcan0 -n 2 --profile permissive
+      the lenient drive: every object, instant boot, same-call SDO replies
+  cia402-emu -i vcan0 -n 2 --boot-ms 2000 --sdo-delay-ms 5 --no-remote
+      strict, 2 s of DC bus charging, SDO replies 5 ms late, local control
+
+Profiles (--profile; a flag changes one behaviour of the profile):
+  strict      what a real drive does: 0x1016 and 0x2010..0x2022 absent
+              (--optional-objects-absent), 0x60C2:2 read-only (--ip-index-ro), PDO
+              changes only in Pre-operational (--remap-preop-only), CiA 402
+              predefined PDO1 = controlword/statusword, type 255
+              (--cia402-pdos), over-long RPDO EMCY 8220h (--long-rpdo-emcy),
+              SYNC length checked against 0x1019, EMCY 8240h (--sync-length),
+              0x1029 error behaviour (--error-behaviour), 100 ms in Not ready
+              to switch on (--boot-ms), SDO replies a call later
+              (--sdo-delay-ms), one transition per SYNC (--one-transition),
+              fault cause lasts 20 SYNCs (--fault-cause-syncs), 0x6061 follows
+              0x6060 2 SYNCs later (--mode-switch-syncs), modes outside 0x6502
+              refused (--refuse-unsupported-modes), homing moves per method
+              (--homing-model)
+  permissive  none of the above (each flag's off/0 value)
+  loop        (default) strict, but 0x1016, 0x2010..0x2022 present and
+              0x60C2:2 writable: today's master writes them to every drive
+              (the loop and vcan tests' profile until it no longer does)
+Both: TPDO types 0/1..240/254/255 and RPDO 254/255 per CiA 301, EMCY 8210h
+once with error register bits 0 and 4, 0000h when it clears.
 
 The drive waits in NMT pre-operational until a master configures it over SDO
-and starts it (NMT 0x000 01 <node>). It sends its TPDOs on each SYNC (0x080)
-and moves only on SYNC, by the period in 0x60C2. Object dictionary, PDO
+and starts it (NMT 0x000 01 <node>). It sends its TPDOs per their transmission
+type (0x18xx:2) and moves only on SYNC (0x080), by the period in 0x60C2. Object dictionary, PDO
 mapping and fault injection: see fieldbus/README.md.
 
 Exit status: 0 after SIGINT/SIGTERM or --duration, 1 on error.)";
 
-std::uint16_t parse_code(const std::string& s) {
+/// A whole string as an unsigned number (decimal, 0x hex or 0 octal); nullopt
+/// if it is not one.
+std::optional<unsigned long> parse_unsigned(const std::string& s) {
   std::size_t pos = 0;
-  const unsigned long v = std::stoul(s, &pos, 0);
-  if (pos != s.size() || v > 0xFFFF) throw CLI::ValidationError("--fail-code", "'" + s + "' is not a 16-bit EMCY code (e.g. 0x2310)");
-  return static_cast<std::uint16_t>(v);
+  unsigned long v = 0;
+  try {
+    v = std::stoul(s, &pos, 0);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (pos != s.size() || s.empty() || s[0] == '-') return std::nullopt;
+  return v;
+}
+
+std::uint16_t parse_code(const std::string& s) {
+  const std::optional<unsigned long> v = parse_unsigned(s);
+  if (!v || *v > 0xFFFF) throw CLI::ValidationError("--fail-code", "'" + s + "' is not a 16-bit EMCY code (e.g. 0x2310)");
+  return static_cast<std::uint16_t>(*v);
 }
 }  // namespace
 
@@ -82,6 +127,12 @@ int main(int argc, char** argv) {
   double rated_torque_accel = 0.0, load_torque = 0.0, viscous = 0.0;
   bool refuse_mode = false;
   std::vector<std::string> absent;
+  std::string profile = "loop";
+  std::optional<bool> f_optional, f_ip_ro, f_remap, f_pdos, f_long, f_sync, f_errb, f_one, f_modes, f_homing;
+  std::optional<double> boot_ms, sdo_delay_ms;
+  std::optional<std::uint32_t> fault_cause_syncs, mode_switch_syncs;
+  bool no_remote = false;
+  std::string supported_modes;
   app.add_option("-i,--interface", iface, "CAN interface (vcan0, can0)")->required();
   app.add_option("-n,--node", nodes, "node-ID of an emulated drive (1..127); repeat for several drives")
       ->required()
@@ -106,6 +157,38 @@ int main(int argc, char** argv) {
   app.add_option("--without-object", absent,
                  "emulate a drive without this object (index, e.g. 0x1016); SDO access aborts with 0x06020000; repeat "
                  "for several");
+  std::string eds_file;
+  app.add_option("--eds", eds_file,
+                 "serve exactly the objects of this EDS or DCF (CiA 306): absent objects abort 0x06020000, PDO "
+                 "counts, mapping flags, access types and defaults from the file")
+      ->check(CLI::ExistingFile);
+  app.add_option("--profile", profile,
+                 "strict (a real drive's behaviours), permissive (the lenient drive) or loop (strict but for the two "
+                 "master gaps, see below)")
+      ->check(CLI::IsMember({"strict", "permissive", "loop"}))
+      ->default_val("loop");
+  auto flag_opt = [&app](const char* name, std::optional<bool>& v, const char* what) {
+    app.add_option(name, v, std::string(what) + " (true/false; default: the profile's)");
+  };
+  flag_opt("--optional-objects-absent", f_optional, "0x1016 and 0x2010..0x2022 absent (abort 0x06020000)");
+  flag_opt("--ip-index-ro", f_ip_ro, "0x60C2:2 read-only (abort 0x06010002)");
+  flag_opt("--remap-preop-only", f_remap, "PDO parameters change only in Pre-operational (abort 0x08000022)");
+  flag_opt("--cia402-pdos", f_pdos, "CiA 402 predefined PDO1 (controlword / statusword, type 255) at power-on");
+  flag_opt("--long-rpdo-emcy", f_long, "an over-long RPDO sends EMCY 8220h");
+  flag_opt("--sync-length", f_sync, "SYNC length checked against 0x1019 (EMCY 8240h)");
+  flag_opt("--error-behaviour", f_errb, "0x1029 exists and acts on a lost master heartbeat");
+  flag_opt("--one-transition", f_one, "one commanded transition per SYNC (3 and 4 in two SYNCs)");
+  flag_opt("--refuse-unsupported-modes", f_modes, "an RPDO's mode outside 0x6502 is not taken");
+  flag_opt("--homing-model", f_homing, "homing moves per method family over several SYNCs");
+  app.add_option("--boot-ms", boot_ms, "time in Not ready to switch on after power-on, ms (strict 100)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--sdo-delay-ms", sdo_delay_ms, "SDO reply delay, ms (0 = at once; strict: the next call)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--fault-cause-syncs", fault_cause_syncs, "SYNCs an injected fault's cause lasts (strict 20)");
+  app.add_option("--mode-switch-syncs", mode_switch_syncs, "SYNCs until 0x6061 shows a new 0x6060 (strict 2)");
+  app.add_flag("--no-remote", no_remote, "statusword bit 9 = 0: local control, the bus's controlword is ignored");
+  app.add_option("--supported-modes", supported_modes,
+                 "0x6502 (e.g. 0x3A0 = HM, CSP, CSV, CST; the default); 0x6060 outside it is refused");
   app.add_option("--duration", duration, "exit after this many seconds (0 = run until SIGINT/SIGTERM)");
   app.add_flag("-v,--verbose", verbose, "print NMT and CiA 402 state changes");
   bool check_args = false;
@@ -125,19 +208,52 @@ int main(int argc, char** argv) {
   }
   std::vector<std::uint16_t> absent_objects;
   for (const std::string& a : absent) {
-    std::size_t pos = 0;
-    unsigned long v = 0;
-    try {
-      v = std::stoul(a, &pos, 0);
-    } catch (const std::exception&) {
-      pos = 0;
-    }
-    if (pos != a.size() || v < 0x1000 || v > 0xFFFF) {
+    const std::optional<unsigned long> v = parse_unsigned(a);
+    if (!v || *v < 0x1000 || *v > 0xFFFF) {
       std::fprintf(stderr, "cia402-emu: --without-object '%s' is not an object index 0x1000..0xFFFF (e.g. 0x1016)\n",
                    a.c_str());
       return 1;
     }
-    absent_objects.push_back(static_cast<std::uint16_t>(v));
+    absent_objects.push_back(static_cast<std::uint16_t>(*v));
+  }
+  std::optional<eds::Eds> description;
+  if (!eds_file.empty()) {
+    try {
+      description = eds::load(eds_file);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "cia402-emu: --eds: %s\n", e.what());
+      return 1;
+    }
+  }
+  emulator::EmulatorBehaviour behaviour = profile == "strict"       ? emulator::EmulatorBehaviour::strict()
+                                          : profile == "permissive" ? emulator::EmulatorBehaviour::permissive()
+                                                                    : emulator::EmulatorBehaviour::loop_default();
+  auto apply = [](bool& field, const std::optional<bool>& v) {
+    if (v) field = *v;
+  };
+  apply(behaviour.optional_objects_absent, f_optional);
+  apply(behaviour.ip_index_read_only, f_ip_ro);
+  apply(behaviour.remap_preoperational_only, f_remap);
+  apply(behaviour.cia402_default_pdos, f_pdos);
+  apply(behaviour.rpdo_too_long_emcy, f_long);
+  apply(behaviour.check_sync_length, f_sync);
+  apply(behaviour.error_behaviour, f_errb);
+  apply(behaviour.one_transition_per_sync, f_one);
+  apply(behaviour.refuse_unsupported_modes, f_modes);
+  apply(behaviour.homing_takes_time, f_homing);
+  if (boot_ms) behaviour.boot_ns = static_cast<std::int64_t>(*boot_ms * 1e6);
+  if (sdo_delay_ms) behaviour.sdo_reply_delay_ns = std::max<std::int64_t>(static_cast<std::int64_t>(*sdo_delay_ms * 1e6), 0);
+  if (fault_cause_syncs) behaviour.fault_cause_syncs = *fault_cause_syncs;
+  if (mode_switch_syncs) behaviour.mode_switch_syncs = *mode_switch_syncs;
+  std::uint32_t modes_mask = emulator::EmulatorConfig{}.supported_modes;
+  if (!supported_modes.empty()) {
+    const std::optional<unsigned long> v = parse_unsigned(supported_modes);
+    if (!v || *v > 0xFFFFFFFFul) {
+      std::fprintf(stderr, "cia402-emu: --supported-modes '%s' is not a 32-bit 0x6502 value (e.g. 0x3A0)\n",
+                   supported_modes.c_str());
+      return 1;
+    }
+    modes_mask = static_cast<std::uint32_t>(*v);
   }
   for (std::size_t i = 0; i < nodes.size(); ++i)
     for (std::size_t j = i + 1; j < nodes.size(); ++j)
@@ -172,6 +288,10 @@ int main(int argc, char** argv) {
     c.viscous_friction = viscous;
     c.refuse_mode_switch = refuse_mode;
     c.absent_objects = absent_objects;
+    if (description) c.served = emulator::served_objects(*description, c.node);
+    c.behaviour = behaviour;
+    c.remote = !no_remote;
+    c.supported_modes = modes_mask;
     c.heartbeat_loss_reaction = hb_reaction == "fault"       ? emulator::HeartbeatLossReaction::kFault
                                 : hb_reaction == "quickstop" ? emulator::HeartbeatLossReaction::kQuickStop
                                                              : emulator::HeartbeatLossReaction::kNone;

@@ -1,0 +1,157 @@
+#include "config/eds_check.hpp"
+
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "config/runtime.hpp"
+#include "fieldbus/canopen/master.hpp"
+#include "fieldbus/canopen/pdo.hpp"  // sign_extend
+
+namespace canmotion::config {
+
+namespace {
+using Severity = Diagnostic::Severity;
+
+/// The proxy's boot writes for `d` (a sans-IO master and proxy, no bus).
+std::vector<cia402::BootWrite> proxy_writes(const cia402::DriveConfig& d, const BusSettings& bus) {
+  canopen::MasterConfig mc;
+  mc.node_id = bus.master_node;
+  mc.heartbeat_period_ms = bus.master_heartbeat_ms;
+  canopen::Master master(mc);
+  const cia402::DriveProxy proxy(d, master);
+  return {proxy.boot_writes().begin(), proxy.boot_writes().end()};
+}
+}  // namespace
+
+std::vector<cia402::BootWrite> boot_writes(const AxisSettings& a, const BusSettings& bus, double period_s,
+                                           std::size_t axis_index) {
+  return proxy_writes(drive_config(a, bus, period_s, axis_index), bus);
+}
+
+eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& bus, double period_s,
+                                     std::size_t axis_index) {
+  cia402::DriveConfig d = drive_config(a, bus, period_s, axis_index);
+  d.dictionary.reset();  // every write the master may make, the optional ones included
+  if (d.consumer_heartbeat_optional && d.consumer_heartbeat_ms == 0)
+    d.consumer_heartbeat_ms = bus.master_heartbeat_ms > 0 ? a.drive.master_heartbeat_timeout_ms : 0;
+  eds::Requirements req;
+  req.node_id = a.node;
+  req.pdo_key = d.hints.pdo;
+  const eds::Eds* e = a.drive.eds_data.get();
+  for (const cia402::BootWrite& w : proxy_writes(d, bus)) {
+    if (w.check == cia402::BootCheck::kSupportedModes) continue;  // with its mode bits below
+    eds::Use u;
+    u.index = w.w.index;
+    u.sub = w.w.sub;
+    u.optional = w.optional;
+    if (w.is_read()) {  // the boot's checks: 0x1000, 0x1018 as configured, 0x6061
+      u.usage = eds::Usage::kRead;
+      // A read the configuration asks for names drive.identity; the others
+      // (0x1000's profile, 0x6061) are the master's own (the EDS key then).
+      if (w.check != cia402::BootCheck::kModeDisplay &&
+          (w.check != cia402::BootCheck::kDeviceType || d.identity.has_device_type))
+        u.key = d.hints.identity;
+      req.uses.push_back(std::move(u));
+      continue;
+    }
+    u.usage = eds::Usage::kWrite;
+    u.size = w.w.size;
+    // The value as the object's type reads it (INTEGERn sign-extended).
+    const eds::SubObject* s = e != nullptr ? e->find(w.w.index, w.w.sub) : nullptr;
+    const bool is_signed = s != nullptr && canopen::data_type_signed(s->type);
+    u.value = is_signed ? canopen::sign_extend(w.w.value, 8u * w.w.size) : static_cast<std::int64_t>(w.w.value);
+    if (const std::string* k = cia402::write_hint_key(d.hints, w); k != nullptr) u.key = *k;
+    else if (w.origin == cia402::WriteOrigin::kUnusedPdo) u.key = d.hints.pdo;
+    req.uses.push_back(std::move(u));
+  }
+  const cia402::DrivePdoSet pdos = cia402::default_drive_pdos(d.pdo_profile, d.node);
+  req.rpdos = pdos.rpdo_count;
+  req.tpdos = pdos.tpdo_count;
+  auto map = [&](const canopen::PdoMap& m, eds::Usage usage) {
+    for (std::uint8_t i = 0; i < m.count; ++i)
+    {
+      eds::Use u;
+      u.index = m.entries[i].index;
+      u.sub = m.entries[i].sub;
+      u.usage = usage;
+      u.size = static_cast<std::uint8_t>(m.entries[i].bits / 8);
+      u.key = d.hints.pdo;
+      req.uses.push_back(std::move(u));
+    }
+  };
+  for (std::uint8_t p = 0; p < pdos.rpdo_count; ++p) map(pdos.rpdo[p], eds::Usage::kMapRpdo);
+  for (std::uint8_t p = 0; p < pdos.tpdo_count; ++p) map(pdos.tpdo[p], eds::Usage::kMapTpdo);
+  // 0x6502: CSP always; CSV and CST when the PDO profile carries their targets.
+  std::uint64_t modes = cia402::supported_mode_bit(cia402::Mode::kCsp);
+  if (d.pdo_profile == cia402::PdoProfile::kCspCsvCst)
+    modes |= cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst);
+  eds::Use m;
+  m.index = cia402::obj::kSupportedDriveModes;
+  m.usage = eds::Usage::kRead;
+  m.required_bits = modes;
+  m.optional = true;
+  m.key = d.hints.pdo;
+  req.uses.push_back(m);
+  // The other modes the proxy checks 0x6502 for at boot (MDS, homing), each
+  // with the key that needs it.
+  for (const cia402::ModeNeed& need : d.needed_modes) {
+    const std::uint64_t bit = cia402::supported_mode_bit(need.mode);
+    if ((modes & bit) != 0) continue;
+    modes |= bit;
+    m.required_bits = bit;
+    m.key = need.key;
+    req.uses.push_back(m);
+  }
+  return req;
+}
+
+void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
+  std::map<std::string, std::pair<std::shared_ptr<const eds::Eds>, std::shared_ptr<const canopen::DeviceDictionary>>> files;
+  for (std::size_t ai = 0; ai < cfg.axes.size(); ++ai) {
+    AxisSettings& a = cfg.axes[ai];
+    DriveSettings& ds = a.drive;
+    if (a.axis.type != motion::AxisType::CipDrive || ds.eds_path.empty()) continue;
+    const std::string who = fmt::format("axis '{}' (node {})", a.name, a.node);
+    auto it = files.find(ds.eds_path);
+    if (it == files.end()) {
+      try {
+        auto parsed = std::make_shared<const eds::Eds>(eds::load(ds.eds_path));
+        auto dict = std::make_shared<const canopen::DeviceDictionary>(eds::device_dictionary(*parsed));
+        it = files.emplace(ds.eds_path, std::make_pair(std::move(parsed), std::move(dict))).first;
+      } catch (const eds::ParseError& e) {
+        diags.push_back({Severity::kError, cfg.path, ds.eds_where, ds.eds_key,
+                         fmt::format("{}: the drive's EDS cannot be used:\n{}", who, e.what())});
+        files.emplace(ds.eds_path, std::make_pair(nullptr, nullptr));
+        continue;
+      }
+    }
+    if (!it->second.first) continue;  // unreadable: said once
+    ds.eds_data = it->second.first;
+    ds.dictionary = it->second.second;
+    const BusSettings* bus = cfg.find_bus(a.bus);
+    if (bus == nullptr) continue;  // cross_check reported it
+    const eds::CheckResult r = eds::check(*ds.eds_data, drive_requirements(a, *bus, cfg.controller.period_s, ai));
+    for (const eds::Refusal& x : r.refusals)
+      diags.push_back({Severity::kError, cfg.path, ds.eds_where, x.key.empty() ? ds.eds_key : x.key,
+                       // "file:line: message"; the key is the diagnostic's own.
+                       fmt::format("{}: {}{}: {}", who, x.file, x.line > 0 ? fmt::format(":{}", x.line) : "", x.message)});
+    bool said_modes = false;  // 0x6502 may be wanted by several keys: said once
+    for (const eds::Use& u : r.skipped) {
+      if (u.index == 0x1016)
+        diags.push_back({Severity::kWarning, cfg.path, ds.eds_where, u.key,
+                         fmt::format("{}: {} has no 0x{:04X}:{:02X}: the write is left out and the drive does not "
+                                     "watch the master's heartbeat (set {} to 0 to say so)",
+                                     who, ds.eds, u.index, u.sub, u.key)});
+      else if (u.index == cia402::obj::kSupportedDriveModes && !std::exchange(said_modes, true))
+        diags.push_back({Severity::kWarning, cfg.path, ds.eds_where, ds.eds_key,
+                         fmt::format("{}: {} has no 0x6502 (supported drive modes): the modes the master uses "
+                                     "are not checked",
+                                     who, ds.eds)});
+    }
+  }
+}
+
+}  // namespace canmotion::config

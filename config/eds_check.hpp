@@ -1,0 +1,40 @@
+#pragma once
+/// \file
+/// The configuration against the drives' EDS files (`drive.eds:`, CiA 306):
+/// before any bus is touched, what the master will write and map for each
+/// CIP axis (its boot configuration, built by cia402::DriveProxy itself) is
+/// checked with fieldbus/eds's checker. Each refusal names the axis, the
+/// object, the EDS file and line, and the YAML key to change.
+///
+/// Not realtime: set-up only (allocates, reads files).
+
+#include <cstddef>
+#include <vector>
+
+#include "config/config.hpp"
+#include "fieldbus/cia402/drive_proxy.hpp"
+#include "fieldbus/eds/check.hpp"
+
+namespace canmotion::config {
+
+/// The boot SDO writes the master makes to CIP axis `a`'s drive, in order
+/// (cia402::DriveProxy's own list for drive_config(a, ...)); optional writes
+/// to objects the axis's EDS lacks are not in it.
+[[nodiscard]] std::vector<cia402::BootWrite> boot_writes(const AxisSettings& a, const BusSettings& bus, double period_s,
+                                                         std::size_t axis_index);
+
+/// What the master intends for CIP axis `a`'s drive, for eds::check(): every
+/// boot write (optional ones marked so), every mapped object, the PDO
+/// counts, the modes it needs in 0x6502 (optional: an EDS without 0x6502 is
+/// not refused for it). Keys are the YAML keys (DriveConfig::hints).
+[[nodiscard]] eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& bus, double period_s,
+                                                   std::size_t axis_index);
+
+/// Load each CIP axis's `drive.eds` (each file once), fill eds_data and
+/// dictionary, and check drive_requirements() against it: refusals and
+/// unreadable files are errors, optional objects left out (0x1016, 0x6502)
+/// warnings, appended to `diags`. Called by load_file / load_string once
+/// the configuration has no other error.
+void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags);
+
+}  // namespace canmotion::config
