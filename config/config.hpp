@@ -81,6 +81,7 @@ struct DriveTimeouts {
   std::uint32_t boot_ms = 5000;        ///< boot-up through configuration to NMT operational
   std::uint32_t transition_ms = 1000;  ///< one CiA 402 state transition
   std::uint32_t mode_switch_ms = 500;  ///< 0x6061 following a 0x6060 change
+  std::uint32_t homing_ms = 60'000;    ///< MAH on the drive (mode 6): start to homing completed; 0 = no limit
 };
 
 /// One extra SDO download done at boot, after canmotion's own configuration.
@@ -92,6 +93,14 @@ struct SdoWrite {
   Location where;
 };
 
+/// `drive.identity`: what 0x1000 and 0x1018:1..3 must read at boot (unset: not compared).
+struct DriveIdentitySettings {
+  std::optional<std::uint32_t> device_type;
+  std::optional<std::uint32_t> vendor_id;
+  std::optional<std::uint32_t> product_code;
+  std::optional<std::uint32_t> revision;
+};
+
 /// Drive settings: top-level `drives:` gives the defaults, an axis's own
 /// `drive:` block overrides them key by key.
 struct DriveSettings {
@@ -100,7 +109,9 @@ struct DriveSettings {
   std::uint16_t heartbeat_ms = 50;                ///< drive heartbeat producer (0x1017)
   std::uint16_t master_heartbeat_timeout_ms = 300;  ///< drive's consumer of the master's heartbeat (0x1016); 0 = off
   std::uint16_t following_error_window = 0;       ///< written to 0x6065 when non-zero (counts)
+  std::optional<std::int16_t> quick_stop_option;  ///< written to 0x605A when given (CiA 402: 0..8 or manufacturer-specific < 0)
   std::vector<SdoWrite> sdo_writes;
+  DriveIdentitySettings identity;
   /// master_heartbeat_timeout_ms is written in the file (not the default):
   /// then 0x1016 is required, else optional (left out for a drive whose EDS
   /// lacks it, accepted missing without an EDS).

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -41,12 +42,23 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
   req.pdo_key = d.hints.pdo;
   const eds::Eds* e = a.drive.eds_data.get();
   for (const cia402::BootWrite& w : proxy_writes(d, bus)) {
+    if (w.check == cia402::BootCheck::kSupportedModes) continue;  // with its mode bits below
     eds::Use u;
     u.index = w.w.index;
     u.sub = w.w.sub;
+    u.optional = w.optional;
+    if (w.is_read()) {  // the boot's checks: 0x1000, 0x1018 as configured, 0x6061
+      u.usage = eds::Usage::kRead;
+      // A read the configuration asks for names drive.identity; the others
+      // (0x1000's profile, 0x6061) are the master's own (the EDS key then).
+      if (w.check != cia402::BootCheck::kModeDisplay &&
+          (w.check != cia402::BootCheck::kDeviceType || d.identity.has_device_type))
+        u.key = d.hints.identity;
+      req.uses.push_back(std::move(u));
+      continue;
+    }
     u.usage = eds::Usage::kWrite;
     u.size = w.w.size;
-    u.optional = w.optional;
     // The value as the object's type reads it (INTEGERn sign-extended).
     const eds::SubObject* s = e != nullptr ? e->find(w.w.index, w.w.sub) : nullptr;
     const bool is_signed = s != nullptr && canopen::data_type_signed(s->type);
@@ -82,7 +94,17 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
   m.required_bits = modes;
   m.optional = true;
   m.key = d.hints.pdo;
-  req.uses.push_back(std::move(m));
+  req.uses.push_back(m);
+  // The other modes the proxy checks 0x6502 for at boot (MDS, homing), each
+  // with the key that needs it.
+  for (const cia402::ModeNeed& need : d.needed_modes) {
+    const std::uint64_t bit = cia402::supported_mode_bit(need.mode);
+    if ((modes & bit) != 0) continue;
+    modes |= bit;
+    m.required_bits = bit;
+    m.key = need.key;
+    req.uses.push_back(m);
+  }
   return req;
 }
 
@@ -116,13 +138,14 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
       diags.push_back({Severity::kError, cfg.path, ds.eds_where, x.key.empty() ? ds.eds_key : x.key,
                        // "file:line: message"; the key is the diagnostic's own.
                        fmt::format("{}: {}{}: {}", who, x.file, x.line > 0 ? fmt::format(":{}", x.line) : "", x.message)});
+    bool said_modes = false;  // 0x6502 may be wanted by several keys: said once
     for (const eds::Use& u : r.skipped) {
       if (u.index == 0x1016)
         diags.push_back({Severity::kWarning, cfg.path, ds.eds_where, u.key,
                          fmt::format("{}: {} has no 0x{:04X}:{:02X}: the write is left out and the drive does not "
                                      "watch the master's heartbeat (set {} to 0 to say so)",
                                      who, ds.eds, u.index, u.sub, u.key)});
-      else if (u.index == cia402::obj::kSupportedDriveModes)
+      else if (u.index == cia402::obj::kSupportedDriveModes && !std::exchange(said_modes, true))
         diags.push_back({Severity::kWarning, cfg.path, ds.eds_where, ds.eds_key,
                          fmt::format("{}: {} has no 0x6502 (supported drive modes): the modes the master uses "
                                      "are not checked",

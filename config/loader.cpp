@@ -283,17 +283,35 @@ class Loader {
   }
 
   void timeouts(const YAML::Node& n, const std::string& path, DriveTimeouts& t) {
-    if (!check_map(n, path, {"sdo_ms", "boot_ms", "transition_ms", "mode_switch_ms"})) return;
+    if (!check_map(n, path, {"sdo_ms", "boot_ms", "transition_ms", "mode_switch_ms", "homing_ms"})) return;
     scalar(n, path, "sdo_ms", t.sdo_ms, 1u, 60'000u, "ms");
     scalar(n, path, "boot_ms", t.boot_ms, 10u, 600'000u, "ms");
     scalar(n, path, "transition_ms", t.transition_ms, 1u, 60'000u, "ms");
     scalar(n, path, "mode_switch_ms", t.mode_switch_ms, 1u, 60'000u, "ms");
+    scalar(n, path, "homing_ms", t.homing_ms, 0u, 3'600'000u, "ms (0 = no limit)");
   }
 
   void drive(const YAML::Node& n, const std::string& path, DriveSettings& d) {
     if (!check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
-                             "following_error_window", "sdo_writes", "eds"}))
+                             "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds"}))
       return;
+    if (std::int16_t q = 0; scalar(n, path, "quick_stop_option", q, std::int16_t{-32768}, std::int16_t{8},
+                                   "(0x605A: 0 coast, 1/2 ramp then Switch on disabled, 5/6 ramp and stay in Quick stop "
+                                   "active, ...; < 0 manufacturer-specific)"))
+      d.quick_stop_option = q;
+    if (const YAML::Node id = n["identity"]) {
+      const std::string p = path + ".identity";
+      if (check_map(id, p, {"device_type", "vendor_id", "product_code", "revision"})) {
+        auto u32 = [&](std::string_view key, std::optional<std::uint32_t>& out) {
+          std::uint32_t v = 0;
+          if (id[std::string(key)] && scalar(id, p, key, v, 0u, 0xFFFFFFFFu)) out = v;
+        };
+        u32("device_type", d.identity.device_type);
+        u32("vendor_id", d.identity.vendor_id);
+        u32("product_code", d.identity.product_code);
+        u32("revision", d.identity.revision);
+      }
+    }
     if (n["master_heartbeat_timeout_ms"]) d.master_heartbeat_timeout_set = true;
     if (n["eds"] && string(n, path, "eds", d.eds)) {
       // Relative to the YAML file's folder, like a vendor's EDS shipped beside the configuration.
@@ -367,7 +385,8 @@ class Loader {
   }
 
   void homing(const YAML::Node& n, const std::string& path, motion::HomingConfig& h) {
-    if (!check_map(n, path, {"mode", "sequence", "position", "method", "speed_search", "speed_zero", "accel"})) return;
+    if (!check_map(n, path, {"mode", "sequence", "position", "method", "speed_search", "speed_zero", "accel", "offset"}))
+      return;
     using M = motion::HomingConfig::Mode;
     using S = motion::HomingConfig::Sequence;
     enumeration(n, path, "mode", h.mode, {{"Passive", M::Passive}, {"Active", M::Active}, {"Absolute", M::Absolute}});
@@ -380,6 +399,8 @@ class Loader {
     scalar(n, path, "speed_search", h.speed_search, 0.0, 1e12, "units/s");
     scalar(n, path, "speed_zero", h.speed_zero, 0.0, 1e12, "units/s");
     scalar(n, path, "accel", h.accel, 0.0, 1e15, "units/s^2");
+    // 0x607C is written only when configured (a drive keeps its own otherwise).
+    if (n["offset"] && scalar(n, path, "offset", h.offset, -1e12, 1e12, "units")) h.write_offset = true;
   }
 
   /// `direct_control:` of a CIP axis (MDS): direct command kind, drive ramps, SLAT.

@@ -1,6 +1,8 @@
 #include "config/runtime.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -8,6 +10,7 @@
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/canopen/receive_filters.hpp"
+#include "fieldbus/canopen/tx_queue.hpp"
 #include "fieldbus/emulator/eds_dictionary.hpp"
 
 namespace canmotion::config {
@@ -94,6 +97,26 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   d.hints.pdo = drive_key("pdo");
   d.hints.producer_heartbeat = drive_key("heartbeat_ms");
   d.hints.consumer_heartbeat = drive_key("master_heartbeat_timeout_ms");
+  d.hints.identity = fmt::format("{}.drive.identity", axis);
+  d.hints.mode_switch_timeout = drive_key("timeouts.mode_switch_ms");
+  const DriveIdentitySettings& id = a.drive.identity;
+  d.identity.has_device_type = id.device_type.has_value();
+  d.identity.device_type = id.device_type.value_or(0);
+  d.identity.has_vendor_id = id.vendor_id.has_value();
+  d.identity.vendor_id = id.vendor_id.value_or(0);
+  d.identity.has_product_code = id.product_code.has_value();
+  d.identity.product_code = id.product_code.value_or(0);
+  d.identity.has_revision = id.revision.has_value();
+  d.identity.revision = id.revision.value_or(0);
+  // Modes the axis may switch to besides CSP: checked against 0x6502 at boot.
+  if (a.direct.present) {
+    const bool torque = a.axis.direct_mode == motion::AxisConfig::DirectMode::Torque;
+    d.needed_modes.push_back({torque ? cia402::Mode::kCst : cia402::Mode::kCsv,
+                              fmt::format("{}.direct_control.mode: {} (MDS)", axis, torque ? "torque" : "velocity")});
+  }
+  if (a.axis.homing.mode == motion::HomingConfig::Mode::Active &&
+      a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate)
+    d.needed_modes.push_back({cia402::Mode::kHoming, fmt::format("{}.homing.sequence (MAH homes on the drive, mode 6)", axis)});
   d.node = a.node;
   d.mode = cia402::Mode::kCsp;
   d.cycle_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));
@@ -117,7 +140,14 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
     d.extra_writes.push_back(w);
     d.hints.extra.push_back(drive_key("following_error_window") + " (0 leaves it out)");
   }
+  if (a.drive.quick_stop_option) {
+    cia402::SdoWrite w = od_write(cia402::obj::kQuickStopOptionCode, 0);
+    w.value = static_cast<std::uint16_t>(*a.drive.quick_stop_option);
+    d.extra_writes.push_back(w);
+    d.hints.extra.push_back(drive_key("quick_stop_option") + " (leave it out to keep the drive's own)");
+  }
   d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
+  d.homing_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.homing_ms) * 1'000'000;
   for (const cia402::SdoWrite& w : direct_control_writes(a)) {
     d.extra_writes.push_back(w);
     d.hints.extra.push_back(fmt::format("{}.{}", axis, direct_control_key(w)));
@@ -170,6 +200,27 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       std::string why;
       auto sock = can::SocketCanBus::open(b.interface, filters, ec, &why);
       if (!sock) throw std::runtime_error(fmt::format("{}: bus '{}' (line {}): {}", cfg.path, b.name, b.where.line, why));
+      // The interface's transmit queue must hold one cycle's burst.
+      canopen::TxBurst burst;
+      burst.master_heartbeat = b.master_heartbeat_ms > 0;
+      for (const AxisSettings& a : cfg.axes) {
+        if (a.axis.type != motion::AxisType::CipDrive || a.bus != b.name) continue;
+        burst.rpdos += cia402::default_drive_pdos(a.drive.pdo, a.node).rpdo_count;
+        ++burst.sdo_nodes;
+      }
+      if (const std::int64_t qlen = sock->tx_queue_len(); qlen >= 0) {
+        const canopen::TxQueueCheck chk = canopen::check_tx_queue(static_cast<std::uint32_t>(qlen), burst, true);
+        if (chk.action == canopen::TxQueueCheck::Action::kRaise) {
+          if (const int err = sock->set_tx_queue_len(chk.needed); err != 0)
+            throw std::runtime_error(fmt::format("{}: bus '{}' (line {}): {} (raising it failed: {})", cfg.path, b.name,
+                                                 b.where.line, chk.message(b.interface), std::strerror(err)));
+          rt.notes.push_back(fmt::format("bus '{}': raised the txqueuelen of {} from {} to {} (one cycle's burst)",
+                                         b.name, b.interface, chk.current, chk.needed));
+        }
+        // The cycle keeps within the queue and a place for the SYNC.
+        // (0: no queue, no limit)
+        bs.network.tx_queue_frames = std::max(chk.current, chk.action == canopen::TxQueueCheck::Action::kRaise ? chk.needed : 0u);
+      }
       bs.transport = sock.get();
       rt.sockets.push_back(std::move(sock));
       rt.trace_names.push_back(b.interface);

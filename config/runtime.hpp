@@ -22,13 +22,19 @@ struct Runtime {
   std::unique_ptr<rt::Controller> controller;
   /// Name used for each bus in traces: the SocketCAN interface, or the bus name for simulated buses.
   std::vector<std::string> trace_names;
+  /// What build_runtime changed on the host, one sentence each (e.g. a
+  /// raised txqueuelen), for the daemon to log.
+  std::vector<std::string> notes;
 };
 
 /// Build the runtime. With `force_sim` every bus is simulated (`--sim`);
 /// otherwise buses with `interface: sim` are simulated and the others are
 /// SocketCAN interfaces, opened with receive filters for the COB-IDs in use.
 /// Throws std::runtime_error naming the bus and interface when a socket
-/// cannot be opened (nothing has been sent on any bus then).
+/// cannot be opened (nothing has been sent on any bus then), and when an
+/// interface's txqueuelen is shorter than one cycle's burst and cannot be
+/// raised (canopen::check_tx_queue: the message has the numbers and the
+/// command to run).
 [[nodiscard]] Runtime build_runtime(const Config& cfg, bool force_sim);
 
 /// The master-side drive configuration of a CIP axis (timeouts in ns, extra

@@ -23,6 +23,8 @@ struct HomingConfig {
   double speed_search = 10.0;           ///< 0x6099:01, user units/s
   double speed_zero = 1.0;              ///< 0x6099:02, user units/s
   double accel = 100.0;                 ///< 0x609A, user units/s^2
+  bool write_offset = false;            ///< write 0x607C home offset (only when configured: `homing.offset`)
+  double offset = 0.0;                  ///< 0x607C, user units
 };
 
 /// Static configuration of one axis (from the YAML config; validated there, and

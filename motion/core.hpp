@@ -59,6 +59,7 @@ struct Handshakes {
   OwnerRef mah{};              ///< MAH homing on the drive
   bool homing = false;         ///< drive homing (mode 6) in progress
   bool homing_started = false; ///< the homing request was sent
+  bool homing_clear = false;   ///< since the start, the feedback showed homing not attained (a stale bit is not completion)
   bool homed = false;          ///< AxisHomedStatus
   bool resync = false;         ///< a drive homing was cancelled: the command takes the next actual position
 };

@@ -70,7 +70,11 @@ struct AxisFeedback {
   bool node_lost = false;     ///< heartbeat / cyclic data lost
   bool bus_off = false;       ///< the CAN interface is bus-off
   bool homing_attained = false;  ///< statusword bit 12 in homing mode
-  bool homing_error = false;     ///< statusword bit 13 in homing mode
+  bool homing_error = false;     ///< statusword bit 13 in homing mode, a homing timeout or a refused homing parameter
+  /// EXERR of the MAH's ERR 12 when homing_error: 16 (device in wrong state:
+  /// the drive's homing error or the runtime's homing timeout), 3 (invalid
+  /// value: the drive refused a homing parameter).
+  std::int8_t homing_exerr = 16;
   DriveLink link = DriveLink::Up;
   /// The drive did not make a requested state transition within the
   /// runtime's transition timeout (enabling, fault reset): a pending MSO,
@@ -84,6 +88,8 @@ struct HomingRequest {
   double speed_search = 0.0;  ///< 0x6099:01, user units/s
   double speed_zero = 0.0;    ///< 0x6099:02, user units/s
   double accel = 0.0;         ///< 0x609A, user units/s^2
+  bool write_offset = false;  ///< write 0x607C (home offset)
+  double offset = 0.0;        ///< 0x607C, user units
 };
 
 /// Per-axis output for one cycle.

@@ -10,6 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <vector>
@@ -89,6 +90,20 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(std::string_view ifname, std::s
   if (::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) return fail("bind", errno);
   ec.clear();
   return bus;
+}
+
+std::int64_t SocketCanBus::tx_queue_len() const noexcept {
+  ifreq ifr{};
+  std::memcpy(ifr.ifr_name, name_.data(), std::min(name_.size(), sizeof ifr.ifr_name - 1));
+  if (::ioctl(fd_, SIOCGIFTXQLEN, &ifr) < 0) return -errno;
+  return ifr.ifr_qlen;
+}
+
+int SocketCanBus::set_tx_queue_len(std::uint32_t frames) noexcept {
+  ifreq ifr{};
+  std::memcpy(ifr.ifr_name, name_.data(), std::min(name_.size(), sizeof ifr.ifr_name - 1));
+  ifr.ifr_qlen = static_cast<int>(frames);
+  return ::ioctl(fd_, SIOCSIFTXQLEN, &ifr) < 0 ? errno : 0;
 }
 
 SocketCanBus::SocketCanBus(int fd, std::string name) noexcept : fd_(fd), name_(std::move(name)) {}
@@ -221,6 +236,39 @@ void SocketCanBus::handle_error_frame(std::uint32_t err_class, std::span<const s
   }
   const std::uint32_t other = err_class & ~static_cast<std::uint32_t>(CAN_ERR_BUSOFF | CAN_ERR_RESTARTED | CAN_ERR_CRTL);
   if (other != 0) push_event(BusEvent{BusEvent::Kind::kErrorFrame, state_, other, t_ns});
+}
+
+std::string SocketCanBus::error_classes_text(std::uint32_t err_class) {
+  static constexpr struct {
+    std::uint32_t bit;
+    const char* text;
+  } kClasses[] = {
+      {CAN_ERR_TX_TIMEOUT, "TX timeout (by the netdevice driver)"},
+      {CAN_ERR_LOSTARB, "lost arbitration"},
+      {CAN_ERR_CRTL, "controller problem (error counters, overflow)"},
+      {CAN_ERR_PROT, "protocol violation (bit, form, stuff or CRC error: wiring, termination or bitrate)"},
+      {CAN_ERR_TRX, "transceiver problem (CAN_H/CAN_L open or short)"},
+      {CAN_ERR_ACK, "no ACK (no other node acknowledged: all drives off or unplugged, or another bitrate)"},
+      {CAN_ERR_BUSOFF, "bus-off"},
+      {CAN_ERR_BUSERROR, "bus error"},
+      {CAN_ERR_RESTARTED, "controller restarted"},
+  };
+  std::string s;
+  for (const auto& c : kClasses) {
+    if ((err_class & c.bit) == 0) continue;
+    if (!s.empty()) s += "; ";
+    s += c.text;
+  }
+  if (s.empty()) s = "unknown error class";
+  return s;
+}
+
+std::string SocketCanBus::bus_off_advice(std::string_view ifname) {
+  const std::string i(ifname);
+  return "SocketCAN keeps " + i + " off until it is restarted: now `ip link set " + i +
+         " type can restart`, or for an automatic restart (restart-ms is 0 by default) `ip link set " + i +
+         " down && ip link set " + i + " type can restart-ms 100 && ip link set " + i +
+         " up`; canmotiond re-boots the drives when the bus is back, then MASR and MSO";
 }
 
 void SocketCanBus::set_state(BusState s, std::int64_t t_ns) noexcept {

@@ -74,9 +74,22 @@ class SocketCanBus final : public Transport {
 
   /// The socket, for poll()/epoll in non-RT tools that want to block.
   [[nodiscard]] int fd() const noexcept { return fd_; }
+  /// The interface's transmit queue length (txqueuelen, SIOCGIFTXQLEN), or
+  /// -errno. Start-up only.
+  [[nodiscard]] std::int64_t tx_queue_len() const noexcept;
+  /// Set txqueuelen (SIOCSIFTXQLEN; needs CAP_NET_ADMIN). 0 or errno
+  /// (EPERM without the capability). Start-up only.
+  int set_tx_queue_len(std::uint32_t frames) noexcept;
   /// errno of the last failed send (0 if none). Realtime-safe.
   [[nodiscard]] int last_errno() const noexcept { return last_errno_; }
 
+  /// The error classes of an error frame (CAN_ERR_* bits) in words, e.g.
+  /// "no ACK (no other node acknowledged: all drives off or unplugged, or a
+  /// wrong bitrate)". Not realtime (allocates).
+  static std::string error_classes_text(std::uint32_t err_class);
+  /// What to do about a bus-off on `ifname` (SocketCAN keeps a bus-off
+  /// interface off until it is restarted; the kernel's default restart-ms is 0).
+  static std::string bus_off_advice(std::string_view ifname);
   /// Turn one error frame (id with CAN_ERR_FLAG stripped, payload) into
   /// events, updating the bus state. Exposed for golden tests. Realtime-safe.
   void handle_error_frame(std::uint32_t err_class, std::span<const std::uint8_t> data,

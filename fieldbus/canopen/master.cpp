@@ -114,7 +114,12 @@ void Master::check_heartbeats(std::int64_t now_ns) noexcept {
 }
 
 void Master::step_sdo(std::int64_t now_ns, FrameSink& out) noexcept {
-  for (auto& c : sdo_) c->step(now_ns, out);
+  // The clients take turns at the front: when the transmit queue has room
+  // for fewer requests than there are clients (see tx_queue.hpp), each waits
+  // a cycle in turn and none starves.
+  const std::size_t n = sdo_.size();
+  const std::size_t first = n > 0 ? static_cast<std::size_t>(sdo_turn_++ % n) : 0;
+  for (std::size_t i = 0; i < n; ++i) sdo_[(first + i) % n]->step(now_ns, out);
 }
 
 void Master::send_sync(FrameSink& out) noexcept {

@@ -144,6 +144,7 @@ class Master {
   bool heartbeat_started_ = false;
   std::uint64_t syncs_ = 0;
   std::uint8_t counter_ = 0;
+  std::uint64_t sdo_turn_ = 0;  // step_sdo(): the client that goes first this cycle
 };
 
 }  // namespace canmotion::canopen

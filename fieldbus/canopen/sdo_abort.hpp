@@ -59,6 +59,13 @@ inline constexpr std::array<SdoAbort, 31> kAllSdoAborts = {
 
 /// The CiA 301 text of an abort code; "unknown SDO abort code" for anything
 /// else. Realtime-safe (returns static text).
+/// True for the aborts by which a server says the object (or sub-index) does
+/// not exist (CiA 301): what a master with a fallback for an optional object
+/// tolerates.
+[[nodiscard]] constexpr bool object_absent(SdoAbort a) noexcept {
+  return a == SdoAbort::kNoObject || a == SdoAbort::kNoSubindex;
+}
+
 [[nodiscard]] constexpr std::string_view sdo_abort_text(std::uint32_t code) noexcept {
   switch (code) {
     case 0x00000000: return "no abort";

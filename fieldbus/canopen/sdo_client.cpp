@@ -57,6 +57,8 @@ void SdoClient::start(const Request& r, std::int64_t now_ns) noexcept {
   res_.upload = r.upload;
   res_.abort = SdoAbort::kNone;
   res_.aborted_by_server = false;
+  res_.abort_index = 0;
+  res_.abort_sub = 0;
   res_.segmented = false;
   res_.started_ns = now_ns;
   res_.size = 0;
@@ -121,7 +123,12 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
   }
   const sdo::SdoFrame s = sdo::decode(f, true);
   if (s.kind == sdo::SdoFrameKind::kAbort) {
-    if (s.index == cur_.index && s.sub == cur_.sub) finish(static_cast<SdoAbort>(s.abort_code), true, now_ns);
+    // One transfer at a time per server: an abort now is for it, whatever
+    // index/sub it names (some servers name another or none). Its code is
+    // the answer, not a timeout later; what it named is kept.
+    res_.abort_index = s.index;
+    res_.abort_sub = s.sub;
+    finish(static_cast<SdoAbort>(s.abort_code), true, now_ns);
     return;
   }
   switch (phase_) {
@@ -193,9 +200,20 @@ void SdoClient::step(std::int64_t now_ns, FrameSink& out) noexcept {
     start(r, now_ns);
   }
   if (tx_pending_) {
-    out.send(tx_);
-    tx_pending_ = false;
-    last_tx_ns_ = now_ns;
+    // A frame the transmit queue refused (full) is tried again next cycle;
+    // the transfer times out when it could not be sent for the SDO timeout.
+    if (out.send(tx_)) {
+      tx_pending_ = false;
+      last_tx_ns_ = now_ns;
+      tx_refused_since_ns_ = -1;
+    } else if (tx_refused_since_ns_ < 0) {
+      tx_refused_since_ns_ = now_ns;
+    } else if (now_ns - tx_refused_since_ns_ > timeout_ns_ && phase_ != Phase::kIdle) {
+      tx_pending_ = false;
+      finish(SdoAbort::kTimeout, false, now_ns);  // (the server never got the request: no abort frame)
+    } else if (now_ns - tx_refused_since_ns_ > timeout_ns_) {
+      tx_pending_ = false;  // an abort frame of ours that cannot go out: dropped
+    }
   }
 }
 

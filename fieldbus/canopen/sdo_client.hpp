@@ -36,6 +36,8 @@ struct SdoResult {
   bool upload = false;
   SdoAbort abort = SdoAbort::kNone;  ///< kNone = success
   bool aborted_by_server = false;    ///< true: the server sent the abort; false: the client aborted (timeout, protocol)
+  std::uint16_t abort_index = 0;     ///< aborted_by_server: the index/sub the abort frame named (may differ from index/sub)
+  std::uint8_t abort_sub = 0;
   bool segmented = false;
   std::int64_t started_ns = 0;
   std::int64_t finished_ns = 0;
@@ -122,6 +124,7 @@ class SdoClient {
   void queue_tx(const can::Frame& f) noexcept {
     tx_ = f;
     tx_pending_ = true;
+    tx_refused_since_ns_ = -1;
   }
   void send_next_download_segment() noexcept;
 
@@ -143,6 +146,7 @@ class SdoClient {
   bool size_known_ = false;
   std::int64_t last_tx_ns_ = 0;
   bool tx_pending_ = false;
+  std::int64_t tx_refused_since_ns_ = -1;  // the pending frame's first refused send (-1: none)
   bool cancel_pending_ = false;
   can::Frame tx_{};
   std::uint64_t completed_ = 0;

@@ -33,6 +33,9 @@ inline double round_half_away(double x) noexcept {
 // ============================================================================
 // Object indices (CiA 402-2)
 // ============================================================================
+/// Device profile number of a CiA 402 drive in 0x1000 bits 0..15.
+inline constexpr std::uint32_t kDeviceProfile402 = 402;
+
 namespace obj {
 inline constexpr std::uint16_t kErrorCode = 0x603F;
 inline constexpr std::uint16_t kControlword = 0x6040;
@@ -78,6 +81,8 @@ inline constexpr std::uint16_t kFollowingErrorActualValue = 0x60F4;
 inline constexpr std::uint16_t kDigitalInputs = 0x60FD;
 inline constexpr std::uint16_t kTargetVelocity = 0x60FF;
 inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
+inline constexpr std::uint16_t kDeviceType = 0x1000;  ///< CiA 301; bits 0..15 the device profile number
+inline constexpr std::uint16_t kIdentity = 0x1018;    ///< CiA 301; sub1 vendor, sub2 product, sub3 revision, sub4 serial
 
 // ---- MDS drive-side ramps and SLAT (Logix seed 002) --------------------------
 // Standard objects carry the ramp accelerations: RampAcceleration ->
@@ -445,8 +450,15 @@ struct PlanStep {
     }
   }
   if (target == S::kQuickStopActive) {
-    if (current == S::kOperationEnabled) return PlanStep{Command::kQuickStop, 11, target};
-    return std::nullopt;  // quick stop is only defined from Operation enabled
+    // The Quick stop command is defined from Ready to switch on (7) and
+    // Switched on (10), both to Switch on disabled, and from Operation
+    // enabled (11) to Quick stop active.
+    switch (current) {
+      case S::kOperationEnabled: return PlanStep{Command::kQuickStop, 11, target};
+      case S::kReadyToSwitchOn: return PlanStep{Command::kQuickStop, 7, S::kSwitchOnDisabled};
+      case S::kSwitchedOn: return PlanStep{Command::kQuickStop, 10, S::kSwitchOnDisabled};
+      default: return std::nullopt;
+    }
   }
   // Upwards (towards Operation enabled) or down to Switched on / Ready.
   switch (current) {

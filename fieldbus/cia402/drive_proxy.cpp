@@ -14,13 +14,6 @@ namespace canmotion::cia402 {
 
 namespace {
 
-/// Aborts by which a drive says it has no such PDO (CiA 301: the
-/// communication or mapping object, or the sub-index, does not exist): fine
-/// for a PDO the master does not use.
-constexpr bool no_such_object(canopen::SdoAbort a) noexcept {
-  return a == canopen::SdoAbort::kNoObject || a == canopen::SdoAbort::kNoSubindex;
-}
-
 /// The sentence that follows a refused write in Failure::describe: where its
 /// value comes from (`key`, may be null) and what to do.
 int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key) noexcept {
@@ -45,6 +38,8 @@ int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key)
                : std::snprintf(out, size, "; set the drive's consumer_heartbeat_ms to 0 to leave this write out");
     case WriteOrigin::kExtra:
       return std::snprintf(out, size, "; the write comes from %s: correct or remove it", k ? key : "the extra configuration writes");
+    case WriteOrigin::kCheck:
+      return std::snprintf(out, size, "; canmotiond reads it at boot to check the drive (CiA 301 mandatory object)");
   }
   return 0;
 }
@@ -58,7 +53,8 @@ const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) n
     case WriteOrigin::kConsumerHeartbeat: return &hints.consumer_heartbeat;
     case WriteOrigin::kExtra: return w.extra < hints.extra.size() ? &hints.extra[w.extra] : nullptr;
     case WriteOrigin::kMode:
-    case WriteOrigin::kUnusedPdo: return nullptr;
+    case WriteOrigin::kUnusedPdo:
+    case WriteOrigin::kCheck: return nullptr;
   }
   return nullptr;
 }
@@ -92,8 +88,8 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
       char why[320] = "";
       write_hint(why, sizeof why, sdo_origin, hint);
       n = std::snprintf(out.data(), out.size(),
-                        "node %u: configuration write to 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms: %s%s",
-                        node, sdo_index, sdo_sub, static_cast<int>(name.size()), name.data(), sdo_abort,
+                        "node %u: configuration %s 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms: %s%s",
+                        node, sdo_origin == WriteOrigin::kCheck ? "read of" : "write to", sdo_index, sdo_sub, static_cast<int>(name.size()), name.data(), sdo_abort,
                         static_cast<int>(text.size()), text.data(), waited_ms,
                         sdo_abort == static_cast<std::uint32_t>(canopen::SdoAbort::kTimeout) ? "the drive did not answer"
                                                                                              : "the drive refused it",
@@ -113,10 +109,15 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
       const auto to = transition < kTransitions.size() ? state_name(kTransitions[transition].to) : wn;
       n = std::snprintf(out.data(), out.size(),
                         "node %u: transition %u (%.*s -> %.*s) towards %.*s timed out after %.1f ms: drive is in %.*s, "
-                        "statusword 0x%04X%s",
+                        "statusword 0x%04X%s%s",
                         node, transition, static_cast<int>(from.size()), from.data(), static_cast<int>(to.size()),
                         to.data(), static_cast<int>(wn.size()), wn.data(), waited_ms, static_cast<int>(sn.size()),
-                        sn.data(), statusword, emcy);
+                        sn.data(), statusword, emcy,
+                        // Statusword bit 9 (remote) clear: the drive ignores the controlword.
+                        (statusword & sw::kRemote) == 0 && reached != State::kUnknown && reached != State::kNotReadyToSwitchOn
+                            ? "; the drive is under local control (statusword bit 9 remote = 0: it does not process "
+                              "the controlword): switch it to bus/remote control on the drive"
+                            : "");
       break;
     }
     case FailureKind::kDriveFault:
@@ -144,6 +145,52 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                         "configured again)%s",
                         node, static_cast<int>(phase_name(phase).size()), phase_name(phase).data(), emcy);
       break;
+    case FailureKind::kBootCheck: {
+      const bool k = hint != nullptr && hint[0] != '\0';
+      switch (check) {
+        case BootCheck::kDeviceType:
+          n = k ? std::snprintf(out.data(), out.size(), "node %u: 0x1000 (Device type) is 0x%08" PRIX32 ", %s expects 0x%08" PRIX32,
+                                node, read_value, hint, expected)
+                : std::snprintf(out.data(), out.size(),
+                                "node %u: 0x1000 (Device type) is 0x%08" PRIX32 ": device profile %" PRIu32
+                                ", not 402 (CiA 402 drive); canmotiond drives CiA 402 drives only",
+                                node, read_value, read_value & 0xFFFFu);
+          break;
+        case BootCheck::kVendorId:
+        case BootCheck::kProductCode:
+        case BootCheck::kRevision: {
+          const char* what = check == BootCheck::kVendorId ? "1 (Vendor-ID)" : check == BootCheck::kProductCode ? "2 (Product code)" : "3 (Revision number)";
+          const char* sub = check == BootCheck::kVendorId ? "vendor_id" : check == BootCheck::kProductCode ? "product_code" : "revision";
+          n = std::snprintf(out.data(), out.size(),
+                            "node %u: identity 0x1018:%s is 0x%08" PRIX32 ", the configuration expects 0x%08" PRIX32
+                            " (%s%s%s): another drive than configured is on this node",
+                            node, what, read_value, expected, k ? hint : "drive.identity", ".", sub);
+          break;
+        }
+        case BootCheck::kSupportedModes: {
+          const auto mn = mode_name(static_cast<std::int8_t>(expected));
+          n = std::snprintf(out.data(), out.size(),
+                            "node %u: the drive does not support mode %d (%.*s): 0x6502 (Supported drive modes) is 0x%08" PRIX32
+                            "; the mode is needed by %s",
+                            node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(mn.size()), mn.data(),
+                            read_value, k ? hint : "the drive's configured mode");
+          break;
+        }
+        case BootCheck::kModeDisplay: {
+          const auto rq = mode_name(static_cast<std::int8_t>(expected));
+          const auto sh = mode_name(static_cast<std::int8_t>(read_value));
+          n = std::snprintf(out.data(), out.size(),
+                            "node %u: 0x6060 = %d (%.*s) written, but 0x6061 (Modes of operation display) still shows %d (%.*s) "
+                            "after %.1f ms (%s): the drive does not run the mode it accepted",
+                            node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(rq.size()), rq.data(),
+                            static_cast<int>(static_cast<std::int8_t>(read_value)), static_cast<int>(sh.size()), sh.data(),
+                            waited_ms, k ? hint : "mode switch timeout");
+          break;
+        }
+        case BootCheck::kNone: n = std::snprintf(out.data(), out.size(), "node %u: boot check failed", node); break;
+      }
+      break;
+    }
     case FailureKind::kNmtState: {
       const auto st = canopen::nmt_state_name(nmt_state);
       n = std::snprintf(out.data(), out.size(),
@@ -211,58 +258,6 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
   build_configuration();
 }
 
-void DriveProxy::build_configuration() {
-  writes_.clear();
-  auto add = [this](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) {
-    const bool optional =
-        o == WriteOrigin::kUnusedPdo || (o == WriteOrigin::kConsumerHeartbeat && cfg_.consumer_heartbeat_optional);
-    // An optional write to an object the drive's EDS lacks is left out.
-    if (optional && cfg_.dictionary && cfg_.dictionary->has(w.index, w.sub) == canopen::Presence::kAbsent) return;
-    writes_.push_back(BootWrite{w, o, extra, optional});
-  };
-  add(WriteOrigin::kMode,
-      SdoWrite{obj::kModesOfOperation, 0, 1, static_cast<std::uint8_t>(static_cast<std::int8_t>(cfg_.mode))});
-  const auto ip = *encode_interpolation_period(cfg_.cycle_ns);
-  add(WriteOrigin::kInterpolationPeriod, SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value});
-  add(WriteOrigin::kInterpolationPeriod,
-      SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)});
-  // PDOs: the CiA 301 procedure for the used ones, COB-ID invalid for PDO 1..4 not used.
-  auto add_map = [&](const canopen::PdoMap& m) {
-    const std::uint32_t cob = m.cob_id & 0x7FFu;
-    add(WriteOrigin::kPdo, SdoWrite{m.comm_index(), 1, 4, cob | canopen::kPdoInvalid});
-    add(WriteOrigin::kPdo, SdoWrite{m.map_index(), 0, 1, 0});
-    for (std::uint8_t i = 0; i < m.count; ++i)
-      add(WriteOrigin::kPdo, SdoWrite{m.map_index(), static_cast<std::uint8_t>(i + 1), 4, m.entries[i].raw()});
-    add(WriteOrigin::kPdo, SdoWrite{m.map_index(), 0, 1, m.count});
-    add(WriteOrigin::kPdo, SdoWrite{m.comm_index(), 2, 1, m.transmission_type});
-    add(WriteOrigin::kPdo, SdoWrite{m.comm_index(), 1, 4, cob});
-  };
-  for (std::uint8_t n = 1; n <= 4; ++n) {
-    if (n <= pdos_.rpdo_count) {
-      add_map(pdos_.rpdo[n - 1]);
-    } else {
-      add(WriteOrigin::kUnusedPdo, SdoWrite{static_cast<std::uint16_t>(0x1400 + n - 1), 1, 4,
-                                            canopen::cob::rpdo(n, cfg_.node) | canopen::kPdoInvalid});
-    }
-  }
-  for (std::uint8_t n = 1; n <= 4; ++n) {
-    if (n <= pdos_.tpdo_count) {
-      add_map(pdos_.tpdo[n - 1]);
-    } else {
-      add(WriteOrigin::kUnusedPdo, SdoWrite{static_cast<std::uint16_t>(0x1800 + n - 1), 1, 4,
-                                            canopen::cob::tpdo(n, cfg_.node) | canopen::kPdoInvalid});
-    }
-  }
-  add(WriteOrigin::kProducerHeartbeat, SdoWrite{0x1017, 0, 2, cfg_.producer_heartbeat_ms});
-  // 0x1016 is optional (CiA 301): written only when the drive is to watch
-  // the master's heartbeat.
-  if (cfg_.consumer_heartbeat_ms > 0)
-    add(WriteOrigin::kConsumerHeartbeat,
-        SdoWrite{0x1016, 1, 4, (static_cast<std::uint32_t>(master_.config().node_id) << 16) | cfg_.consumer_heartbeat_ms});
-  for (std::size_t i = 0; i < cfg_.extra_writes.size(); ++i)
-    add(WriteOrigin::kExtra, cfg_.extra_writes[i], static_cast<std::uint16_t>(i));
-}
-
 void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept {
   failure_.kind = k;
   failure_.node = cfg_.node;
@@ -275,39 +270,6 @@ void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, s
   failure_.waited_ns = waited;
   failure_.timeout_ns = timeout;
   failure_.t_ns = now_ns;
-}
-
-void DriveProxy::forget_drive(std::int64_t now_ns) noexcept {
-  tpdo_seen_ = expect_tpdo_ = got_tpdo_ = false;
-  state_ = State::kUnknown;
-  wanted_ = State::kSwitchOnDisabled;
-  in_flight_ = false;
-  reset_requested_ = homing_requested_ = false;
-  mode_switch_pending_ = false;
-  nmt_left_ = false;
-  mode_ = cfg_.mode;  // configured again with the boot mode
-  next_write_ = done_writes_ = tolerated_ = 0;
-  master_.sdo(cfg_.node).cancel_all();
-  // A rebooted drive sends no heartbeat until 0x1017 is written again: the
-  // consumer is armed again when the configuration is done.
-  master_.set_heartbeat_timeout(cfg_.node, 0, now_ns);
-}
-
-void DriveProxy::restart() noexcept {
-  forget_drive(now_ns_);
-  phase_ = Phase::kWaitBoot;
-  started_ = false;
-  failure_ = Failure{};
-}
-
-void DriveProxy::reboot(std::int64_t now_ns) noexcept {
-  ++reboots_;
-  forget_drive(now_ns);
-  follow_actual();
-  // A boot-up leaves the node pre-operational: configure it at once.
-  phase_ = Phase::kConfiguring;
-  phase_since_ns_ = now_ns;
-  started_ = true;
 }
 
 bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
@@ -332,6 +294,7 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
     if (trq_slot_.pdo == p) fb_.torque = static_cast<std::int16_t>(canopen::sign_extend(get(trq_slot_), 16));
     if (mdisp_slot_.pdo == p) fb_.mode_display = static_cast<std::int8_t>(canopen::sign_extend(get(mdisp_slot_), 8));
     if (p == 0) {
+      homing_fresh_ = homing_fresh_ || homing_sync_;
       ++fb_.tpdo_count;
       fb_.last_tpdo_ns = tf.t_ns;
       got_tpdo_ = true;
@@ -402,98 +365,6 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
   }
 }
 
-void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
-  const canopen::NodeStatus& st = master_.status(cfg_.node);
-  canopen::SdoClient& sdo = master_.sdo(cfg_.node);
-  switch (phase_) {
-    case Phase::kWaitBoot:
-      if (cfg_.reset_node_first && !st.booted) {
-        master_.send_nmt(canopen::NmtCommand::kResetNode, cfg_.node, out);
-        phase_ = Phase::kResetWait;
-        phase_since_ns_ = now_ns;
-      } else if (st.seen) {
-        if (st.state == canopen::NmtState::kOperational || st.state == canopen::NmtState::kStopped) {
-          master_.send_nmt(canopen::NmtCommand::kEnterPreOperational, cfg_.node, out);
-        }
-        phase_ = Phase::kConfiguring;
-        phase_since_ns_ = now_ns;
-      } else if (now_ns - phase_since_ns_ > cfg_.boot_timeout_ns) {
-        master_.send_nmt(canopen::NmtCommand::kResetNode, cfg_.node, out);
-        phase_ = Phase::kResetWait;
-        phase_since_ns_ = now_ns;
-      }
-      return;
-    case Phase::kResetWait:
-      if (st.booted) {
-        phase_ = Phase::kConfiguring;
-        phase_since_ns_ = now_ns;
-      } else if (now_ns - phase_since_ns_ > cfg_.boot_timeout_ns) {
-        fail(FailureKind::kBootTimeout, now_ns, now_ns - phase_since_ns_, cfg_.boot_timeout_ns);
-        phase_ = Phase::kFailed;
-      }
-      return;
-    case Phase::kConfiguring: {
-      canopen::SdoResult r;
-      while (sdo.poll(r)) {
-        if (r.tag == kModeWriteTag) continue;
-        const BootWrite* bw = r.tag < writes_.size() ? &writes_[r.tag] : nullptr;
-        if (!r.ok() && bw != nullptr && bw->optional && no_such_object(r.abort)) {
-          ++tolerated_;  // the drive lacks an optional object (fewer PDOs than 4, no 0x1016)
-        } else if (!r.ok()) {
-          // Both times are on the cycle's clock (the response's receive stamp, or the timeout's cycle).
-          const std::int64_t waited = r.finished_ns >= r.started_ns ? r.finished_ns - r.started_ns : now_ns - r.started_ns;
-          fail(FailureKind::kSdoAbort, now_ns, waited, r.abort == canopen::SdoAbort::kTimeout ? sdo.timeout() : 0);
-          failure_.sdo_index = r.index;
-          failure_.sdo_sub = r.sub;
-          failure_.sdo_abort = static_cast<std::uint32_t>(r.abort);
-          if (bw != nullptr) {
-            failure_.sdo_origin = bw->origin;
-            const std::string* key = write_hint_key(cfg_.hints, *bw);
-            failure_.hint = key != nullptr && !key->empty() ? key->c_str() : nullptr;
-          }
-          sdo.cancel_all();
-          phase_ = Phase::kFailed;
-          return;
-        }
-        ++done_writes_;
-      }
-      while (next_write_ < writes_.size() && sdo.queued() < canopen::SdoClient::kQueueCapacity) {
-        const SdoWrite& w = writes_[next_write_].w;
-        std::uint8_t b[4];
-        for (int i = 0; i < 4; ++i) b[i] = static_cast<std::uint8_t>(w.value >> (8 * i));
-        if (!sdo.download(w.index, w.sub, std::span<const std::uint8_t>(b, w.size), static_cast<std::uint32_t>(next_write_))) {
-          break;
-        }
-        ++next_write_;
-      }
-      if (done_writes_ == writes_.size()) {
-        if (cfg_.producer_heartbeat_ms > 0) {
-          const std::int64_t hb = cfg_.heartbeat_timeout_ns > 0 ? cfg_.heartbeat_timeout_ns
-                                                                : 3 * static_cast<std::int64_t>(cfg_.producer_heartbeat_ms) * 1'000'000;
-          master_.set_heartbeat_timeout(cfg_.node, hb, now_ns);
-        }
-        master_.send_nmt(canopen::NmtCommand::kStart, cfg_.node, out);
-        phase_ = Phase::kStarting;
-        phase_since_ns_ = now_ns;
-      }
-      return;
-    }
-    case Phase::kStarting:
-      if (tpdo_seen_) {
-        phase_ = Phase::kOperational;
-        phase_since_ns_ = now_ns;
-        mode_switch_since_ns_ = now_ns;  // a set_mode() before this waits from here
-        state_ = decode_state(fb_.statusword);
-        follow_actual();
-      } else if (now_ns - phase_since_ns_ > cfg_.start_timeout_ns) {
-        fail(FailureKind::kStartTimeout, now_ns, now_ns - phase_since_ns_, cfg_.start_timeout_ns);
-        phase_ = Phase::kFailed;
-      }
-      return;
-    default: return;
-  }
-}
-
 void DriveProxy::follow_actual() noexcept {
   target_position_ = fb_.position;
   target_velocity_ = 0;
@@ -528,15 +399,70 @@ void DriveProxy::fault_reset() noexcept {
   if (state_ == State::kFault || state_ == State::kFaultReactionActive) set_wanted(State::kSwitchOnDisabled);
 }
 
-bool DriveProxy::start_homing() noexcept {
-  if (mode_ != Mode::kHoming) return false;
-  homing_requested_ = true;
+bool DriveProxy::start_homing(const HomingParams& hp) noexcept {
+  if (phase_ != Phase::kOperational || homing_writes_ > 0) return false;  // (the last start's writes still out)
+  canopen::SdoClient& sdo = master_.sdo(cfg_.node);
+  const std::size_t need = (hp.write_offset ? 5u : 4u) + (mode_ != Mode::kHoming && mode_slot_.pdo < 0 ? 1u : 0u);
+  if (sdo.queued() + need > canopen::SdoClient::kQueueCapacity) return false;
+  if (mode_ != Mode::kHoming && !set_mode(Mode::kHoming)) return false;
+  bool ok = sdo.download_value<std::int8_t>(obj::kHomingMethod, 0, hp.method, kHomingWriteTag);
+  ok = ok && sdo.download_value<std::uint32_t>(obj::kHomingSpeeds, 1, hp.speed_search, kHomingWriteTag);
+  ok = ok && sdo.download_value<std::uint32_t>(obj::kHomingSpeeds, 2, hp.speed_zero, kHomingWriteTag);
+  ok = ok && sdo.download_value<std::uint32_t>(obj::kHomingAcceleration, 0, hp.accel, kHomingWriteTag);
+  if (hp.write_offset) ok = ok && sdo.download_value<std::int32_t>(obj::kHomeOffset, 0, hp.offset, kHomingWriteTag);
+  // (room was checked above: every write is queued)
+  homing_writes_ = static_cast<std::uint8_t>(hp.write_offset ? 5 : 4);
+  homing_step_ = ok ? HomingStep::kWriting : HomingStep::kIdle;
+  homing_result_ = ok ? HomingResult::kBusy : HomingResult::kRefused;
+  homing_sync_ = homing_fresh_ = false;
+  homing_since_ns_ = now_ns_;
+  homing_abort_ = ok ? 0 : static_cast<std::uint32_t>(canopen::SdoAbort::kOutOfMemory);
+  homing_abort_object_ = 0;
   return true;
+}
+
+void DriveProxy::cancel_homing() noexcept {
+  homing_step_ = HomingStep::kIdle;
+  homing_result_ = HomingResult::kIdle;
+  homing_sync_ = homing_fresh_ = false;
+}
+
+void DriveProxy::end_homing(HomingResult r) noexcept {
+  homing_step_ = HomingStep::kIdle;  // bit 4 back to 0 (on a timeout: aborts the drive's homing)
+  homing_result_ = r;
+  homing_sync_ = homing_fresh_ = false;
+}
+
+void DriveProxy::step_homing(std::int64_t now_ns) noexcept {
+  // The parameter writes' answers (also after a cancel or a refusal: all of
+  // them are collected before the next start).
+  if (homing_writes_ > 0 && master_.sdo(cfg_.node).results() > 0) {
+    canopen::SdoResult r;
+    while (homing_writes_ > 0 && master_.sdo(cfg_.node).poll_tag(kHomingWriteTag, r)) {
+      --homing_writes_;
+      if (!r.ok() && homing_step_ == HomingStep::kWriting) {
+        homing_abort_ = static_cast<std::uint32_t>(r.abort);
+        homing_abort_object_ = (static_cast<std::uint32_t>(r.index) << 8) | r.sub;
+        end_homing(HomingResult::kRefused);
+      }
+    }
+  }
+  if (homing_step_ == HomingStep::kIdle) return;
+  if (homing_step_ == HomingStep::kWriting && homing_writes_ == 0) homing_step_ = HomingStep::kWaitMode;
+  if (cfg_.homing_timeout_ns > 0 && now_ns - homing_since_ns_ > cfg_.homing_timeout_ns) {
+    end_homing(HomingResult::kTimeout);
+    return;
+  }
+  if (homing_step_ == HomingStep::kStarted && homing_fresh_) {
+    const HomingStatus h = homing_status();
+    if (h == HomingStatus::kCompleted) end_homing(HomingResult::kCompleted);
+    else if (h == HomingStatus::kErrorMoving || h == HomingStatus::kErrorStopped) end_homing(HomingResult::kError);
+  }
 }
 
 bool DriveProxy::set_mode(Mode m) noexcept {
   if (!is_cyclic(m) && m != Mode::kHoming) return false;
-  homing_requested_ = false;
+  if (m != Mode::kHoming) cancel_homing();
   if (mode_slot_.pdo < 0) {
     if (!master_.sdo(cfg_.node).download_value<std::int8_t>(obj::kModesOfOperation, 0, static_cast<std::int8_t>(m), kModeWriteTag))
       return false;
@@ -578,14 +504,14 @@ bool DriveProxy::set_mode(Mode m) noexcept {
     switch (wanted_) {
       case State::kOperationEnabled:
         cw_ = cia402::controlword(Command::kEnableOperation);
-        if (homing_requested_ && mode_ == Mode::kHoming) {
-          const HomingStatus h = homing_status();
-          if (h == HomingStatus::kCompleted || h == HomingStatus::kErrorMoving || h == HomingStatus::kErrorStopped) {
-            homing_requested_ = false;  // done: bit 4 back to 0
-          } else {
-            cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
-          }
+        if (homing_step_ == HomingStep::kWaitMode && mode_ == Mode::kHoming && !mode_switch_pending_ &&
+            fb_.mode_display == static_cast<std::int8_t>(Mode::kHoming)) {
+          // Bit 4 went out clear in the last RPDO (it is clear in every
+          // other step): this one is the rising edge.
+          homing_step_ = HomingStep::kStarted;
+          homing_sync_ = homing_fresh_ = false;
         }
+        if (homing_step_ == HomingStep::kStarted) cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
         break;
       case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
       case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
@@ -686,12 +612,26 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   // in an RPDO: otherwise skip the poll (and the ~300-byte SdoResult).
   if (mode_slot_.pdo < 0 && master_.sdo(cfg_.node).results() > 0) {
     canopen::SdoResult r;
-    while (master_.sdo(cfg_.node).poll_tag(kModeWriteTag, r)) {
-      if (r.ok() && mdisp_slot_.pdo < 0) fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);
+    canopen::SdoClient& sdo = master_.sdo(cfg_.node);
+    while (sdo.poll_tag(kModeWriteTag, r)) {
+      if (!r.upload) {
+        // 0x6060 accepted: what the drive runs is what 0x6061 shows (read it).
+        if (r.ok() && mdisp_slot_.pdo < 0 && !sdo.upload(obj::kModesOfOperationDisplay, 0, kModeWriteTag))
+          fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);  // SDO queue full: assumed
+      } else if (r.ok()) {
+        fb_.mode_display = static_cast<std::int8_t>(r.u32() & 0xFFu);
+        // Not there yet (the switch is asynchronous): read again, until
+        // check_mode_switch()'s timeout ends the wait.
+        if (mode_switch_pending_ && fb_.mode_display != static_cast<std::int8_t>(mode_))
+          (void)sdo.upload(obj::kModesOfOperationDisplay, 0, kModeWriteTag);
+      } else if (canopen::object_absent(r.abort)) {
+        fb_.mode_display = static_cast<std::int8_t>(sdo_mode_pending_);  // no 0x6061: the written mode is assumed
+      }
     }
   }
   if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
   check_mode_switch(now_ns);
+  step_homing(now_ns);
   step_state_machine(now_ns);
   send_rpdos(out);
 }
@@ -713,12 +653,16 @@ void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {
   }
 }
 
-void DriveProxy::on_sync_sent() noexcept { expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_ && !nmt_left_; }
+void DriveProxy::on_sync_sent() noexcept {
+  expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_ && !nmt_left_;
+  if (homing_step_ == HomingStep::kStarted && (cw_ & cw::kHomingStart) != 0) homing_sync_ = true;
+}
 
 // ============================================================================
 // DriveNetwork
 // ============================================================================
-DriveNetwork::DriveNetwork(const NetworkConfig& cfg) : master_(cfg.master), events_(kEventCapacity) {
+DriveNetwork::DriveNetwork(const NetworkConfig& cfg)
+    : tx_queue_frames_(cfg.tx_queue_frames), master_(cfg.master), events_(kEventCapacity) {
   index_.fill(-1);
   tpdo_owner_.fill(-1);
 }
@@ -770,13 +714,24 @@ void DriveNetwork::update(std::int64_t now_ns) noexcept {
 }
 
 void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
-  master_.produce_heartbeat(now_ns, out);
   update(now_ns);
-  for (auto& d : drives_) d->step(now_ns, out);
-  // After the proxies so that what they queued this cycle goes out now.
-  master_.step_sdo(now_ns, out);
-  master_.send_sync(out);
+  // The burst: RPDOs, the SYNC, then what may wait or be repeated (SDO,
+  // heartbeat). With a transmit queue shorter than the burst
+  // (tx_queue_frames) one place stays free for the SYNC: a full queue drops
+  // an RPDO or an SDO request, never the SYNC that every drive needs.
+  budget_.out = &out;
+  budget_.left = tx_queue_frames_ == 0 ? 0xFFFFFFFFu : tx_queue_frames_ - 1;
+  // With a budget the drives take turns at the front, so a queue too short
+  // for every RPDO skips each drive's in turn rather than always the last one's.
+  const std::size_t n = drives_.size();
+  const std::size_t first = tx_queue_frames_ != 0 && n > 0 ? static_cast<std::size_t>(turn_++ % n) : 0;
+  for (std::size_t i = 0; i < n; ++i) drives_[(first + i) % n]->step(now_ns, budget_);
+  if (tx_queue_frames_ != 0) ++budget_.left;  // the place kept for the SYNC
+  master_.send_sync(budget_);
   for (auto& d : drives_) d->on_sync_sent();
+  // After the proxies and the SYNC, so that what they queued this cycle goes out now.
+  master_.step_sdo(now_ns, budget_);
+  master_.produce_heartbeat(now_ns, budget_);
 }
 
 std::vector<can::Filter> DriveNetwork::receive_filters() const {
@@ -810,6 +765,9 @@ bool DriveNetwork::any_failed() const noexcept {
 }
 void DriveNetwork::enable_all() noexcept {
   for (auto& d : drives_) d->enable();
+}
+void DriveNetwork::reboot_all() noexcept {
+  for (auto& d : drives_) d->reboot_node();
 }
 void DriveNetwork::disable_all() noexcept {
   for (auto& d : drives_) d->disable();

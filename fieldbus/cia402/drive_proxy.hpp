@@ -55,6 +55,8 @@ struct WriteHints {
   std::string producer_heartbeat;    ///< 0x1017, e.g. "axes[0].drive.heartbeat_ms"
   std::string consumer_heartbeat;    ///< 0x1016:1, e.g. "axes[0].drive.master_heartbeat_timeout_ms" (0 leaves it out)
   std::vector<std::string> extra;    ///< one per DriveConfig::extra_writes entry, e.g. "axes[0].drive.sdo_writes[1]"
+  std::string identity;              ///< DriveConfig::identity, e.g. "axes[0].drive.identity"
+  std::string mode_switch_timeout;   ///< e.g. "axes[0].drive.timeouts.mode_switch_ms"
 };
 
 /// What a boot configuration write is for.
@@ -67,6 +69,58 @@ enum class WriteOrigin : std::uint8_t {
   kProducerHeartbeat,   ///< 0x1017
   kConsumerHeartbeat,   ///< 0x1016:1
   kExtra,               ///< DriveConfig::extra_writes
+  kCheck,               ///< a read at boot that checks the drive (BootCheck)
+};
+
+/// What a read at boot checks (Failure::check for FailureKind::kBootCheck).
+enum class BootCheck : std::uint8_t {
+  kNone,
+  kDeviceType,      ///< 0x1000: device profile 402 (bits 0..15), or DriveIdentity::device_type
+  kVendorId,        ///< 0x1018:1 against DriveIdentity::vendor_id
+  kProductCode,     ///< 0x1018:2 against DriveIdentity::product_code
+  kRevision,        ///< 0x1018:3 against DriveIdentity::revision
+  kSupportedModes,  ///< 0x6502 has a bit for every DriveConfig::needed_modes entry (absent: not checked)
+  kModeDisplay,     ///< 0x6061 shows the mode written to 0x6060 (absent: assumed)
+};
+
+/// What the configuration expects of the drive's identity (`drive.identity`);
+/// unset members are not read (0x1018:2/3 are optional in CiA 301).
+struct DriveIdentity {
+  bool has_device_type = false;
+  std::uint32_t device_type = 0;  ///< 0x1000 (whole value); unset: the profile number must be 402
+  bool has_vendor_id = false;
+  std::uint32_t vendor_id = 0;    ///< 0x1018:1
+  bool has_product_code = false;
+  std::uint32_t product_code = 0; ///< 0x1018:2
+  bool has_revision = false;
+  std::uint32_t revision = 0;     ///< 0x1018:3
+};
+
+/// A mode the drive must support (0x6502) and the configuration key that needs it.
+struct ModeNeed {
+  Mode mode = Mode::kCsp;
+  std::string key;  ///< e.g. "axes[0].drive.pdo: csp_csv_cst" (empty: the boot mode)
+};
+
+/// Homing parameters (CiA 402 mode 6) in drive units, written over SDO
+/// before each homing start (DriveProxy::start_homing).
+struct HomingParams {
+  std::int8_t method = 35;         ///< 0x6098
+  std::uint32_t speed_search = 0;  ///< 0x6099:1, counts/s (speed during search for switch)
+  std::uint32_t speed_zero = 0;    ///< 0x6099:2, counts/s (speed during search for zero)
+  std::uint32_t accel = 0;         ///< 0x609A, counts/s^2
+  bool write_offset = false;       ///< write 0x607C (home offset) too
+  std::int32_t offset = 0;         ///< 0x607C, counts
+};
+
+/// Where a homing started with DriveProxy::start_homing() is.
+enum class HomingResult : std::uint8_t {
+  kIdle,       ///< none requested (or cancelled)
+  kBusy,       ///< parameters being written, mode 6 awaited, or the drive homing
+  kCompleted,  ///< the drive reported homing completed (bits 12 + 10) after this start
+  kError,      ///< the drive reported a homing error (bit 13) after this start
+  kTimeout,    ///< not completed within DriveConfig::homing_timeout_ns (bit 4 dropped: homing aborted)
+  kRefused,    ///< the drive refused a homing parameter write (homing_abort())
 };
 
 struct DriveConfig {
@@ -83,6 +137,11 @@ struct DriveConfig {
   std::int64_t start_timeout_ns = 1'000'000'000;    ///< NMT start -> first TPDO
   std::int64_t transition_timeout_ns = 500'000'000; ///< per state machine transition
   std::int64_t mode_switch_timeout_ns = 500'000'000; ///< 0x6061 must show a set_mode() request within this; 0 = unchecked
+  std::int64_t homing_timeout_ns = 60'000'000'000;   ///< start_homing() -> homing completed or error; 0 = unchecked
+  DriveIdentity identity;         ///< checked against 0x1000 / 0x1018 at boot
+  /// Modes the drive must support besides `mode` (0x6502 read at boot; a
+  /// drive without 0x6502 is not checked).
+  std::vector<ModeNeed> needed_modes;
   bool reset_node_first = false;  ///< send NMT reset node instead of waiting for a boot-up first
   WriteHints hints;               ///< named in the message when a configuration write is refused
   /// The drive's object dictionary from its EDS (null or not described: no
@@ -95,16 +154,20 @@ struct DriveConfig {
   bool consumer_heartbeat_optional = false;
 };
 
-/// One SDO write of the boot configuration, in the order the proxy makes them.
+/// One SDO transfer of the boot configuration, in the order the proxy makes
+/// them: a write (download), or with `check` set a read (upload, origin
+/// WriteOrigin::kCheck) that checks the drive.
 struct BootWrite {
   SdoWrite w;
   WriteOrigin origin = WriteOrigin::kMode;
   std::uint16_t extra = 0;  ///< kExtra: index in DriveConfig::extra_writes
   bool optional = false;    ///< a drive without the object is fine (abort 0x06020000 / 0x06090011 accepted)
+  BootCheck check = BootCheck::kNone;  ///< not kNone: a read (upload) that checks the drive
+  [[nodiscard]] constexpr bool is_read() const noexcept { return check != BootCheck::kNone; }
 };
 
 /// The configuration key behind a boot write (from `hints`), or nullptr when
-/// none is named (0x6060, unused PDOs). Realtime-safe.
+/// none is named (0x6060, unused PDOs, the checking reads). Realtime-safe.
 [[nodiscard]] const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept;
 
 /// Where the proxy is in bringing its node up.
@@ -133,13 +196,14 @@ enum class FailureKind : std::uint8_t {
   kUnexpectedBootUp,   ///< the drive rebooted while operational
   kModeSwitchTimeout,  ///< 0x6061 did not show the mode requested in 0x6060 in time (mode_requested / mode_shown)
   kNmtState,           ///< while operational, the node's heartbeat shows pre-operational or stopped (`nmt_state`)
+  kBootCheck,          ///< a read at boot showed a drive the configuration cannot run (`check`, `read_value`, `expected`)
 };
 
 /// True for the failures of the boot itself (phase kFailed): the node never
 /// booted, refused its configuration, or sent no TPDO after NMT start.
 [[nodiscard]] constexpr bool is_boot_failure(FailureKind k) noexcept {
   return k == FailureKind::kBootTimeout || k == FailureKind::kSdoAbort || k == FailureKind::kSdoQueueFull ||
-         k == FailureKind::kStartTimeout;
+         k == FailureKind::kStartTimeout || k == FailureKind::kBootCheck;
 }
 
 /// A failure with everything needed to explain it.
@@ -166,6 +230,9 @@ struct Failure {
   /// nullptr. Points into the DriveProxy's configuration: valid while it lives.
   const char* hint = nullptr;
   canopen::NmtState nmt_state = canopen::NmtState::kUnknown;  ///< kNmtState: the state shown
+  BootCheck check = BootCheck::kNone;  ///< kBootCheck: what did not match
+  std::uint32_t read_value = 0;        ///< kBootCheck: what the drive has
+  std::uint32_t expected = 0;          ///< kBootCheck: what the configuration expects (kSupportedModes: the missing mode)
 
   /// One sentence, e.g. "node 2: transition 4 (Switched on -> Operation
   /// enabled) timed out after 500.0 ms: drive is in Switched on, statusword
@@ -208,6 +275,8 @@ class DriveProxy {
   /// collect their results with poll_tag() once the drive is operational
   /// (during the boot configuration the proxy owns the client).
   static constexpr std::uint32_t kModeWriteTag = 0xFFFF0001u;
+  /// Tag of the homing parameter writes (start_homing()).
+  static constexpr std::uint32_t kHomingWriteTag = 0xFFFF0002u;
 
   // ---- commands ---------------------------------------------------------
   /// Go to Operation enabled (2, 3, 4; a fault must be reset first). Clears a
@@ -230,11 +299,25 @@ class DriveProxy {
   /// mode's target starts at the actual value. False for other modes or a
   /// full SDO queue.
   bool set_mode(Mode m) noexcept;
-  /// Homing (mode 6, after set_mode(Mode::kHoming) or DriveConfig::mode):
-  /// sets controlword bit 4 while Operation enabled until the drive reports
-  /// homing completed or a homing error. False if the mode is not homing.
-  bool start_homing() noexcept;
-  /// Homing status from statusword bits 13, 12, 10.
+  /// Homing (CiA 402 §3.3): writes 0x6098, 0x6099:1/2, 0x609A (and 0x607C
+  /// when asked) over SDO, switches to mode 6 (set_mode) unless there, waits
+  /// for 0x6061 = 6 and Operation enabled, then raises controlword bit 4 (after
+  /// at least one RPDO with it clear: a rising edge) until the drive reports
+  /// completion or an error. Only statuswords of TPDOs received after the
+  /// SYNC that carried bit 4 count: a "homing attained" left from an earlier
+  /// homing does not end this one. DriveConfig::homing_timeout_ns bounds the
+  /// whole homing (bit 4 drops: the drive aborts). False when not
+  /// operational or the SDO queue has no room (try again next cycle).
+  bool start_homing(const HomingParams& p) noexcept;
+  /// Drop bit 4 and forget the homing (its result goes back to kIdle).
+  void cancel_homing() noexcept;
+  /// The homing started last (kIdle when none).
+  [[nodiscard]] HomingResult homing_result() const noexcept { return homing_result_; }
+  /// kRefused: the refused write (index << 8 | sub) and its abort code.
+  [[nodiscard]] std::uint32_t homing_abort_object() const noexcept { return homing_abort_object_; }
+  [[nodiscard]] std::uint32_t homing_abort() const noexcept { return homing_abort_; }
+  /// Homing status from statusword bits 13, 12, 10 as the drive shows them
+  /// now (may be left from an earlier homing: see homing_result()).
   [[nodiscard]] HomingStatus homing_status() const noexcept { return decode_homing_status(fb_.statusword); }
   /// Targets in drive units; used only while Operation enabled.
   void set_target_position(std::int32_t counts) noexcept { target_position_ = counts; }
@@ -243,6 +326,10 @@ class DriveProxy {
   /// Restart the boot sequence from the start (wait for the node, NMT
   /// pre-operational if needed, configure, start) and clear the failure.
   void restart() noexcept;
+  /// restart(), and send NMT reset node first (the node may have lost its
+  /// configuration or faulted while it could not hear the master, e.g. after
+  /// a bus-off): it boots and is configured again.
+  void reboot_node() noexcept;
 
   // ---- state --------------------------------------------------------------
   [[nodiscard]] std::uint8_t node() const noexcept { return cfg_.node; }
@@ -266,12 +353,14 @@ class DriveProxy {
   /// heartbeat shows it left NMT operational while the proxy runs it.
   [[nodiscard]] bool heartbeat_lost() const noexcept { return master_.status(cfg_.node).lost; }
   [[nodiscard]] bool left_operational() const noexcept { return nmt_left_; }
-  /// Optional configuration writes the drive refused because it lacks the
-  /// object (unused PDOs, an optional 0x1016), since the last (re)start of
-  /// the configuration.
+  /// Optional configuration writes and reads the drive refused because it
+  /// lacks the object (unused PDOs, an optional 0x1016, no 0x6502 / 0x6061),
+  /// since the last (re)start of the configuration.
   [[nodiscard]] std::size_t tolerated_aborts() const noexcept { return tolerated_; }
-  /// The boot configuration's SDO writes, in order (built at set-up; optional
-  /// writes to objects the DriveConfig::dictionary lacks are not in it).
+  /// The boot configuration's SDO transfers, in order: the checking reads
+  /// (BootWrite::is_read(): 0x1000, 0x1018 as configured, 0x6502 first,
+  /// 0x6061 last) and the writes (built at set-up; optional ones to objects
+  /// the DriveConfig::dictionary lacks are not in it).
   [[nodiscard]] std::span<const BootWrite> boot_writes() const noexcept { return writes_; }
   /// Boot-ups that (re-)ran the configuration: while running, while
   /// configuring, or after a failed boot.
@@ -297,6 +386,10 @@ class DriveProxy {
   DriveConfig cfg_;
   canopen::Master& master_;
   DrivePdoSet pdos_;
+  std::size_t leading_reads_ = 0;      // the checks that run before any write
+  std::int64_t mode_shown_since_ns_ = -1;  // boot: first 0x6061 read that did not show the mode yet
+  /// A boot read's value: true when the boot goes on (`again`: read it again).
+  bool check_read(const BootWrite& bw, std::uint32_t v, std::int64_t now_ns, bool& again) noexcept;
   std::vector<BootWrite> writes_;  // the whole boot configuration, built at set-up
   std::size_t next_write_ = 0;
   std::size_t done_writes_ = 0;
@@ -306,11 +399,23 @@ class DriveProxy {
 
   Phase phase_ = Phase::kWaitBoot;
   bool started_ = false;
+  bool force_reset_ = false;  // reboot_node(): NMT reset node in kWaitBoot
   std::int64_t phase_since_ns_ = 0;
   State state_ = State::kUnknown;
   State wanted_ = State::kSwitchOnDisabled;
   bool reset_requested_ = false;
-  bool homing_requested_ = false;
+  // Homing (start_homing): the step it is at.
+  enum class HomingStep : std::uint8_t { kIdle, kWriting, kWaitMode, kStarted };
+  HomingStep homing_step_ = HomingStep::kIdle;
+  HomingResult homing_result_ = HomingResult::kIdle;
+  std::uint8_t homing_writes_ = 0;    // parameter writes not yet answered
+  bool homing_sync_ = false;          // a SYNC went out after an RPDO with bit 4 set
+  bool homing_fresh_ = false;         // a TPDO came after that SYNC: its homing bits are this homing's
+  std::int64_t homing_since_ns_ = 0;
+  std::uint32_t homing_abort_ = 0;
+  std::uint32_t homing_abort_object_ = 0;
+  void step_homing(std::int64_t now_ns) noexcept;
+  void end_homing(HomingResult r) noexcept;
   // The transition in progress.
   bool in_flight_ = false;
   PlanStep flight_{Command::kShutdown, kNoTransition, State::kUnknown};
@@ -350,6 +455,11 @@ class DriveProxy {
 
 struct NetworkConfig {
   canopen::MasterConfig master{};
+  /// Frames the interface can queue (its txqueuelen; 0 = no limit). One
+  /// cycle then writes at most this many, and at most this many minus one
+  /// before the SYNC, so a burst longer than the queue never loses the SYNC
+  /// (the RPDOs past the limit are left out and counted: tx_budget_skipped()).
+  std::uint32_t tx_queue_frames = 0;
 };
 
 /// The CANopen master plus one DriveProxy per node: the object the RT
@@ -389,6 +499,8 @@ class DriveNetwork {
   [[nodiscard]] bool any_failed() const noexcept;
   void enable_all() noexcept;
   void disable_all() noexcept;
+  /// Every drive: DriveProxy::reboot_node() (after the bus was bus-off).
+  void reboot_all() noexcept;
   /// The SocketCAN receive filters the master needs (set-up time): EMCY,
   /// TPDO1..4, SDO responses and heartbeats of every drive (one exact-ID
   /// filter each, so the kernel drops everything else, e.g. other masters'
@@ -396,8 +508,27 @@ class DriveNetwork {
   [[nodiscard]] std::vector<can::Filter> receive_filters() const;
   /// Master events (boot-up, heartbeat lost, EMCY, ...) for the application.
   bool poll_event(canopen::NodeEvent& out) noexcept;
+  /// Frames left out of a cycle to keep within NetworkConfig::tx_queue_frames.
+  [[nodiscard]] std::uint64_t tx_budget_skipped() const noexcept { return budget_.skipped; }
 
  private:
+  /// Passes frames on while the cycle's budget lasts (NetworkConfig::tx_queue_frames).
+  struct BudgetSink final : canopen::FrameSink {
+    canopen::FrameSink* out = nullptr;
+    std::uint32_t left = 0;  // frames this sink still passes on (0xFFFFFFFF: no limit)
+    std::uint64_t skipped = 0;
+    bool send(const can::Frame& f) noexcept override {
+      if (left == 0) {
+        ++skipped;
+        return false;
+      }
+      if (left != 0xFFFFFFFFu) --left;
+      return out->send(f);
+    }
+  };
+  std::uint32_t tx_queue_frames_ = 0;
+  BudgetSink budget_;
+  std::uint64_t turn_ = 0;
   canopen::Master master_;
   std::vector<std::unique_ptr<DriveProxy>> drives_;
   std::array<std::int16_t, 128> index_{};

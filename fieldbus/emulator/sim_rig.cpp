@@ -3,10 +3,12 @@
 #include <array>
 #include <string>
 
+#include "fieldbus/canopen/cob_id.hpp"
+
 namespace canmotion::emulator {
 
 SimRig::SimRig(const SimRigConfig& cfg)
-    : cfg_(cfg), bus_("sim0"), net_(cia402::NetworkConfig{cfg.master}), master_ep_(&bus_.add_endpoint("master")) {
+    : cfg_(cfg), bus_("sim0"), net_(cia402::NetworkConfig{cfg.master, cfg.tx_queue_frames}), master_ep_(&bus_.add_endpoint("master")) {
   for (std::uint8_t node : cfg_.nodes) {
     cia402::DriveConfig d = cfg_.drive;
     d.node = node;
@@ -47,7 +49,24 @@ void SimRig::step() {
     for (std::size_t i = 0; i < n; ++i) net_.on_frame(buf[i]);
     if (n < buf.size()) break;
   }
-  canopen::TransportSink sink(*master_ep_);
+  // The master's interface queue (tx_queue_depth frames per cycle).
+  struct Queue final : canopen::FrameSink {
+    can::Transport& t;
+    std::uint32_t depth;
+    std::uint32_t used = 0;
+    std::uint64_t& refused;
+    std::uint64_t& syncs;
+    Queue(can::Transport& tr, std::uint32_t d, std::uint64_t& r, std::uint64_t& s) : t(tr), depth(d), refused(r), syncs(s) {}
+    bool send(const can::Frame& f) noexcept override {
+      if (depth != 0 && used >= depth) {
+        ++refused;
+        if (f.id == canopen::cob::kSync) ++syncs;
+        return false;
+      }
+      ++used;
+      return t.send(f) == can::SendResult::kOk;
+    }
+  } sink(*master_ep_, cfg_.tx_queue_depth, tx_refused_, syncs_refused_);
   net_.cycle(now_ns_, sink);
   for (std::size_t i = 0; i < emus_.size(); ++i) {
     if (!connected_[i]) {

@@ -35,6 +35,11 @@ struct SimRigConfig {
   }();
   cia402::DriveConfig drive{};    ///< template; `node` and `cycle_ns` are set per drive
   canopen::MasterConfig master{};
+  /// The master's interface queues this many frames per cycle (txqueuelen,
+  /// emptied between cycles); more are refused like ENOBUFS. 0 = no limit.
+  std::uint32_t tx_queue_depth = 0;
+  /// NetworkConfig::tx_queue_frames of the master (0 = no limit).
+  std::uint32_t tx_queue_frames = 0;
 };
 
 class SimRig {
@@ -56,9 +61,16 @@ class SimRig {
   [[nodiscard]] std::int64_t now_ns() const noexcept { return now_ns_; }
   [[nodiscard]] std::uint64_t cycles() const noexcept { return cycles_; }
   [[nodiscard]] can::Transport& master_endpoint() noexcept { return *master_ep_; }
+  /// Frames the master's queue refused (SimRigConfig::tx_queue_depth), and SYNCs among them.
+  [[nodiscard]] std::uint64_t tx_refused() const noexcept { return tx_refused_; }
+  [[nodiscard]] std::uint64_t syncs_refused() const noexcept { return syncs_refused_; }
   /// Detach an emulator from the bus (simulates a dead node: it neither
   /// receives nor sends any more).
   void disconnect(std::uint8_t node) noexcept;
+ private:
+  std::uint64_t tx_refused_ = 0;
+  std::uint64_t syncs_refused_ = 0;
+ public:
 
  private:
   SimRigConfig cfg_;

@@ -38,6 +38,7 @@ Err start(Ctx& x, const MahParams& p) noexcept {
   // CIP drive homing, CiA 402 mode 6 with 0x6098/0x6099/0x609A from configuration
   a.hs.homing = true;
   a.hs.homing_started = false;
+  a.hs.homing_clear = false;
   a.hs.homed = false;
   a.hs.mah = x.self;
   x.tag.set(flag::IP, true);
@@ -72,7 +73,11 @@ void cancel(Core& c, AxisRt& a) noexcept {
 
 void feedback(Core& c, AxisRt& a) noexcept {
   ControlTag* t = c.tag(a.hs.mah);
-  if (a.fb.homing_attained && a.hs.homing_started) {
+  // A "homing attained" left from an earlier homing is not this one's
+  // completion: it counts only after the feedback showed it clear once
+  // since this start went out.
+  if (a.hs.homing_started && !a.fb.homing_attained) a.hs.homing_clear = true;
+  if (a.fb.homing_attained && a.hs.homing_started && a.hs.homing_clear) {
     a.frame_offset = a.cfg.homing.home_position - a.fb_pos;
     a.hs.homed = true;
     a.hs.homing = false;
@@ -82,13 +87,14 @@ void feedback(Core& c, AxisRt& a) noexcept {
   } else if (a.fb.homing_error || link_failed(a.fb.link)) {
     a.hs.homing = false;
     a.base = a.fb_pos;
-    if (t) { t->set(flag::IP, false); t->reject(Err::ServoMessageFailure, 16); }
+    const bool lf = link_failed(a.fb.link);
+    if (t) { t->set(flag::IP, false); t->reject(Err::ServoMessageFailure, lf ? std::int8_t{16} : a.fb.homing_exerr); }
   }
 }
 
 void output(AxisRt& a, AxisOutput& out) noexcept {
   const HomingConfig& h = a.cfg.homing;
-  out.homing = HomingRequest{h.cia_method, h.speed_search, h.speed_zero, h.accel};
+  out.homing = HomingRequest{h.cia_method, h.speed_search, h.speed_zero, h.accel, h.write_offset, h.offset};
   a.hs.homing_started = true;
 }
 

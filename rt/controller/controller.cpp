@@ -173,22 +173,44 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
 
 void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   BusRt& bus = buses_[b];
+  auto bus_event = [&](Event::Kind k) noexcept {
+    Event e;
+    e.kind = k;
+    e.bus = static_cast<std::uint8_t>(b);
+    e.cycle = cycle_index_;
+    return e;
+  };
   // Bus events first: a bus-off reported now applies to this cycle's feedback.
   std::array<can::BusEvent, 16>& ev = bus_ev_;
   for (std::size_t n; (n = bus.transport->poll_events(ev)) > 0;) {
     for (std::size_t i = 0; i < n; ++i) {
       if (ev[i].kind == can::BusEvent::Kind::kStateChanged || ev[i].kind == can::BusEvent::Kind::kRestarted) {
-        Event e;
-        e.kind = Event::Kind::kBusState;
-        e.bus = static_cast<std::uint8_t>(b);
+        Event e = bus_event(Event::Kind::kBusState);
         e.bus_state = ev[i].state;
-        e.cycle = cycle_index_;
         emit(e);
+      } else if (ev[i].kind == can::BusEvent::Kind::kErrorFrame) {
+        // Reported when the classes change, else at most once a second (a
+        // bus without ACK sends one error frame per frame sent).
+        const auto cls = static_cast<std::uint32_t>(ev[i].detail);
+        if (cls != bus.err_classes || now_ns - bus.err_reported_ns >= 1'000'000'000) {
+          bus.err_classes = cls;
+          bus.err_reported_ns = now_ns;
+          Event e = bus_event(Event::Kind::kBusError);
+          e.value = cls;
+          emit(e);
+        }
       }
     }
     if (n < ev.size()) break;
   }
+  const bool was_off = bus.bus_off;
   bus.bus_off = bus.transport->state() == can::BusState::kBusOff;
+  if (was_off && !bus.bus_off) {
+    // Back from bus-off: the drives may have faulted or rebooted meanwhile
+    // (their watch of the master expired): boot and configure them again.
+    bus.network->reboot_all();
+    emit(bus_event(Event::Kind::kBusRecovered));
+  }
   for (std::size_t n; (n = bus.transport->receive(rx_)) > 0;) {
     const bool tracing = trace_on_.load(std::memory_order_relaxed);
     for (std::size_t i = 0; i < n; ++i) {
@@ -197,7 +219,6 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
     }
     if (n < rx_.size()) break;
   }
-  (void)now_ns;
 }
 
 // Called once per axis per cycle from cycle() only: inlined there (no call per axis).
@@ -241,8 +262,13 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
     f.link = motion::DriveLink::Configuring;
   }
   f.bus_off = buses_[static_cast<std::size_t>(ax.bus)].bus_off;
-  f.homing_attained = (d.statusword & (1u << 12)) != 0 && d.mode_display == 6;
-  f.homing_error = (d.statusword & (1u << 13)) != 0 && d.mode_display == 6;
+  // The proxy's view of the homing it started: never a bit left from an
+  // earlier homing (DriveProxy::start_homing).
+  using HR = cia402::HomingResult;
+  const HR hr = p.homing_result();
+  f.homing_attained = hr == HR::kCompleted;
+  f.homing_error = hr == HR::kError || hr == HR::kTimeout || hr == HR::kRefused;
+  f.homing_exerr = hr == HR::kRefused ? std::int8_t{3} : std::int8_t{16};  // invalid value / device in wrong state
   if (p.failed() && !ax.failure_reported) {
     Event e;
     e.kind = Event::Kind::kDriveFailed;
@@ -267,6 +293,27 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   const auto mode = static_cast<cia402::Mode>(static_cast<std::int8_t>(out.mode));
   if (mode != p.mode() && (mode == cia402::Mode::kCsp || mode == cia402::Mode::kCsv || mode == cia402::Mode::kCst))
     (void)p.set_mode(mode);
+  // Homing (MAH on a CIP drive): mode 6 and the parameters on the planner's
+  // rising edge (retried next cycle when the SDO queue is full), dropped on its falling edge.
+  const bool homing = out.homing_start && out.mode == motion::DriveMode::Homing;
+  if (homing && !ax.homing_out) {
+    auto u32 = [&](double v) noexcept -> std::uint32_t {
+      const double c = round_half_away(std::fabs(v) * ax.conv);
+      return !(c == c) ? 0u : (c > 4294967295.0 ? 0xFFFFFFFFu : static_cast<std::uint32_t>(c));
+    };
+    cia402::HomingParams hp;
+    hp.method = out.homing.method;
+    hp.speed_search = u32(out.homing.speed_search);
+    hp.speed_zero = u32(out.homing.speed_zero);
+    hp.accel = u32(out.homing.accel);
+    hp.write_offset = out.homing.write_offset;
+    const double off = round_half_away(out.homing.offset * ax.conv);
+    hp.offset = static_cast<std::int32_t>(std::clamp(off == off ? off : 0.0, -2147483648.0, 2147483647.0));
+    ax.homing_out = p.start_homing(hp);
+  } else if (!homing && ax.homing_out) {
+    p.cancel_homing();
+    ax.homing_out = false;
+  }
   // Targets in drive units, saturated to the object's range.
   auto sat32 = [](double v) noexcept -> std::int32_t {
     if (!(v == v)) return 0;

@@ -180,6 +180,10 @@ struct Event {
     kDriveFailed,  ///< a drive proxy recorded a failure (see Status axes[].failure)
     kBusState,     ///< a bus changed error state
     kRingOverflow, ///< the trace or telemetry ring was full; `value` records were lost
+    kBusError,     ///< CAN error frames of other classes (no ACK, protocol, transceiver, ...):
+                   ///< `value` = the class bits (SocketCAN CAN_ERR_*); at most once a second per
+                   ///< bus unless the classes change
+    kBusRecovered, ///< the bus left bus-off: every node of the bus is re-booted (NMT reset node, configuration)
   };
   Kind kind = Kind::kNode;
   std::uint8_t bus = 0;
@@ -345,6 +349,8 @@ class Controller {
     std::unique_ptr<canopen::FrameSink> sink;
     bool bus_off = false;
     std::uint64_t rejected = 0;
+    std::uint32_t err_classes = 0;     ///< error classes reported last (kBusError)
+    std::int64_t err_reported_ns = 0;  ///< when
   };
   struct AxisRt {
     int bus = -1;
@@ -353,6 +359,7 @@ class Controller {
     bool have_prev = false;
     std::int32_t prev_counts = 0;
     bool failure_reported = false;
+    bool homing_out = false;  ///< the planner's homing_start as last handed to the proxy (its edges start/cancel)
   };
   class RecordingSink;
   /// A command in the ring with its sequence number (submit()).

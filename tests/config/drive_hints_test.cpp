@@ -70,3 +70,70 @@ TEST(DriveWriteHints, EveryBootWriteNamesItsKey) {
 
 }  // namespace
 }  // namespace canmotion::config
+
+namespace canmotion::config {
+namespace {
+// drive.identity, drive.quick_stop_option, drive.timeouts.homing_ms,
+// homing.offset and the modes an axis needs (issue 15 items 1, 4, 7, 8).
+TEST(DriveWriteHints, IdentityQuickStopHomingAndNeededModes) {
+  Config c;
+  ASSERT_NO_THROW(c = load_string(R"(controller: {period_ms: 2}
+buses:
+  - {name: can0, interface: sim}
+axes:
+  - name: X
+    type: AXIS_CIP_DRIVE
+    bus: can0
+    node: 2
+    conversion_constant: 1000
+    homing: {mode: Active, sequence: Switch, method: 19, position: 5, offset: 1.5}
+    drive:
+      pdo: csp_csv_cst
+      identity: {vendor_id: 0x9A, product_code: 0x30924}
+      quick_stop_option: 6
+      timeouts: {homing_ms: 20000}
+    direct_control: {mode: torque}
+)",
+                                  "id.yaml"));
+  const Runtime rt = build_runtime(c, true);
+  const cia402::DriveConfig& x = rt.controller->axis_spec(0).drive;
+  EXPECT_TRUE(x.identity.has_vendor_id);
+  EXPECT_EQ(x.identity.vendor_id, 0x9Au);
+  EXPECT_TRUE(x.identity.has_product_code);
+  EXPECT_EQ(x.identity.product_code, 0x30924u);
+  EXPECT_FALSE(x.identity.has_revision);
+  EXPECT_FALSE(x.identity.has_device_type);
+  EXPECT_EQ(x.hints.identity, "axes[0].drive.identity");
+  EXPECT_EQ(x.homing_timeout_ns, 20'000'000'000);
+  ASSERT_EQ(x.needed_modes.size(), 2u);
+  EXPECT_EQ(x.needed_modes[0].mode, cia402::Mode::kCst);
+  EXPECT_EQ(x.needed_modes[0].key, "axes[0].direct_control.mode: torque (MDS)");
+  EXPECT_EQ(x.needed_modes[1].mode, cia402::Mode::kHoming);
+  bool qs = false;
+  for (std::size_t i = 0; i < x.extra_writes.size(); ++i)
+    if (x.extra_writes[i].index == cia402::obj::kQuickStopOptionCode) {
+      qs = true;
+      EXPECT_EQ(x.extra_writes[i].value, 6u);
+      EXPECT_EQ(x.extra_writes[i].size, 2u);
+      EXPECT_EQ(x.hints.extra[i], "axes[0].drive.quick_stop_option (or drives.quick_stop_option) (leave it out to keep the drive's own)");
+    }
+  EXPECT_TRUE(qs);
+  EXPECT_TRUE(c.axes[0].axis.homing.write_offset);
+  EXPECT_DOUBLE_EQ(c.axes[0].axis.homing.offset, 1.5);
+}
+
+TEST(DriveWriteHints, BadIdentityKeyNamesIt) {
+  try {
+    (void)load_string(R"(buses: [{name: can0, interface: sim}]
+axes:
+  - {name: X, type: AXIS_CIP_DRIVE, bus: can0, node: 2, drive: {identity: {vendor: 1}}}
+)",
+                      "bad.yaml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("axes[0].drive.identity"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("vendor"), std::string::npos) << e.what();
+  }
+}
+}  // namespace
+}  // namespace canmotion::config

@@ -123,11 +123,14 @@ TEST(EdsConfig, BootWritesLeaveOutOptionalObjectsTheEdsLacks) {
   Config n;
   ASSERT_NO_THROW(n = load_string(yaml("      heartbeat_ms: 50\n"), kFile));
   const std::vector<cia402::BootWrite> all = boot_writes(n.axes[0], n.buses[0], n.controller.period_s, 0);
-  const auto optional = std::count_if(all.begin(), all.end(), [](const cia402::BootWrite& b) { return b.optional; });
+  const auto optional = std::count_if(all.begin(), all.end(), [](const cia402::BootWrite& b) { return b.optional && !b.is_read(); });
   // RPDO 2..4 and TPDO 2..4 (csp uses one each way) and 0x1016:1; the
   // minimal drive has RPDO2 and TPDO2, so 3, 4 and 0x1016 are left out.
   EXPECT_EQ(optional, 7);
   EXPECT_EQ(all.size(), w.size() + 5);
+  // The boot's optional reads (0x6502, 0x6061) stay: the minimal drive has both.
+  const auto optional_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.optional && b.is_read(); });
+  EXPECT_EQ(optional_reads, 2);
 }
 
 }  // namespace

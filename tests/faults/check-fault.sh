@@ -126,10 +126,10 @@ case $scn in
     final_ok "$log"
     grep -qE '^t=[0-9.]+ mso0\.ER=1 mso0\.ERR=11 ' "$log" || { cat "$log" >&2; fail "MSO on the failed drive did not end with ERR 11"; }
     say "MSO on the failed drive: $(grep -E '^t=[0-9.]+ mso0\.ER=' "$log")"
-    why=$(grep -m1 'configuration write to' "$log") || fail "canmotiond did not explain the failed boot"
+    why=$(grep -m1 -E 'configuration (write to|read of)' "$log") || fail "canmotiond did not explain the failed boot"
     say "message: $why"
     if [[ $scn == sdo_timeout ]]; then
-      parts=("node 2: configuration write to 0x6060:0" "aborted with 0x05040000" "the drive did not answer")
+      parts=("node 2: configuration read of 0x1000:0" "aborted with 0x05040000" "the drive did not answer")
       lo=500 hi=1500
     else
       parts=("node 2: configuration write to 0x1016:1" "aborted with 0x06020000 (object does not exist in the object dictionary)"

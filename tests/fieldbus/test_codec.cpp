@@ -3,6 +3,8 @@
 // the SimBus.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cstdlib>
 #include <random>
 
@@ -80,10 +82,11 @@ TEST(FieldbusGolden, MasterRpdosAndBootConfiguration) {
   // Boot-up seen: the proxy starts configuring.
   net.on_frame(can::TimedFrame{frame("702#00"), 0});
   VecSink out;
-  net.cycle(1'000'000, out);  // boot-up seen: configuration starts with 0x6060 = 8
+  net.cycle(1'000'000, out);  // boot-up seen: the boot starts with the read of 0x1000 (device type)
   std::vector<std::string> got;
   for (auto& f : out.frames) got.push_back(hex(f));
-  EXPECT_EQ(got, (std::vector<std::string>{"77F#05", "602#2F60600008000000", "080#"}));
+  // SYNC first (no RPDOs yet), then what may wait: the SDO request, the heartbeat.
+  EXPECT_EQ(got, (std::vector<std::string>{"080#", "602#4000100000000000", "77F#05"}));
   EXPECT_EQ(d.phase(), cia402::Phase::kConfiguring);
   // RPDO packing: controlword + target position; target velocity + torque + mode.
   const auto& pdos = d.pdos();
@@ -135,19 +138,31 @@ TEST(FieldbusGolden, ProxyRpdoAndTpdoBytes) {
   auto& d = net.add_drive(dc);
   net.on_frame(can::TimedFrame{frame("703#00"), 0});
   VecSink out;
-  // Answer every SDO write until NMT start goes out.
+  // Answer every SDO write, and the boot's reads (0x1000 CiA 402 servo
+  // drive, 0x6502 every mode, 0x6061 CSP), until NMT start goes out.
   for (int i = 1; i < 200 && d.phase() != cia402::Phase::kStarting; ++i) {
     out.clear();
     net.cycle(i * 1'000'000, out);
     for (auto& f : out.frames)
       if (f.id == 0x603) {
-        can::Frame r = frame("583#6000000000000000");
+        const bool upload = f.data[0] == 0x40;
+        can::Frame r = frame(upload ? "583#4300000000000000" : "583#6000000000000000");
         r.data[1] = f.data[1], r.data[2] = f.data[2], r.data[3] = f.data[3];
+        const std::uint16_t index = static_cast<std::uint16_t>(f.data[1] | (f.data[2] << 8));
+        const std::uint32_t v = index == 0x1000 ? 0x00020192u : index == 0x6502 ? 0x000003FFu : 8u;
+        if (upload)
+          for (int k = 0; k < 4; ++k) r.data[4 + k] = static_cast<std::uint8_t>(v >> (8 * k));
         net.on_frame(can::TimedFrame{r, i * 1'000'000});
       }
   }
   ASSERT_EQ(d.phase(), cia402::Phase::kStarting) << cia402::phase_name(d.phase());
-  EXPECT_EQ(hex(out.frames[out.frames.size() - 2]), "000#0103");  // NMT start, then SYNC
+  {  // NMT start, then SYNC
+    std::vector<std::string> sent;
+    for (auto& f : out.frames) sent.push_back(hex(f));
+    const auto start = std::find(sent.begin(), sent.end(), "000#0103");
+    ASSERT_NE(start, sent.end());
+    EXPECT_NE(std::find(start, sent.end(), "080#"), sent.end());
+  }
   // TPDO1: statusword 0x0231 (Ready to switch on), position -2.
   net.on_frame(can::TimedFrame{frame("183#3102FEFFFFFF"), 300'000'000});
   out.clear();
@@ -166,7 +181,9 @@ TEST(FieldbusGolden, ProxyRpdoAndTpdoBytes) {
   out.clear();
   net.cycle(302'000'000, out);
   EXPECT_EQ(rpdo(), "203#0700FEFFFFFF");  // switch on (3)
-  EXPECT_EQ(hex(out.frames.back()), "080#");  // RPDOs before the SYNC
+  ASSERT_GE(out.frames.size(), 2u);
+  EXPECT_EQ(hex(out.frames[0]), "203#0700FEFFFFFF");  // RPDOs before the SYNC
+  EXPECT_EQ(hex(out.frames[1]), "080#");
 }
 
 // ---- emulator frames -------------------------------------------------------
@@ -318,6 +335,45 @@ TEST(FieldbusStateTable, MasterPlanReachesEveryTargetThroughNumberedTransitions)
       EXPECT_EQ(s, target) << "from " << cia402::state_name(s0);
     }
   EXPECT_FALSE(cia402::next_step(State::kFaultReactionActive, State::kOperationEnabled).has_value());
+}
+
+// Quick stop from every state where CiA 402 defines the command (7, 10, 11);
+// on main only from Operation enabled.
+TEST(FieldbusStateTable, QuickStopPlannedFromReadySwitchedOnAndOperationEnabled) {
+  struct Case {
+    State from;
+    std::uint8_t transition;
+    State to;
+  };
+  for (const Case c : {Case{State::kReadyToSwitchOn, 7, State::kSwitchOnDisabled}, Case{State::kSwitchedOn, 10, State::kSwitchOnDisabled},
+                       Case{State::kOperationEnabled, 11, State::kQuickStopActive}}) {
+    const auto p = cia402::next_step(c.from, State::kQuickStopActive);
+    ASSERT_TRUE(p.has_value()) << cia402::state_name(c.from);
+    EXPECT_EQ(p->command, Command::kQuickStop);
+    EXPECT_EQ(p->transition, c.transition);
+    EXPECT_EQ(p->expect, c.to);
+    const auto r = cia402::apply_controlword(c.from, 0x000F, cia402::controlword(p->command));
+    EXPECT_EQ(r.transition, c.transition);
+    EXPECT_EQ(r.next, c.to);
+  }
+  EXPECT_FALSE(cia402::next_step(State::kSwitchOnDisabled, State::kQuickStopActive).has_value());
+}
+
+// A drive under local control (statusword bit 9 clear) says so in the
+// transition timeout instead of a bare timeout.
+TEST(FieldbusStateTable, TransitionTimeoutNamesLocalControl) {
+  cia402::Failure f;
+  f.kind = cia402::FailureKind::kTransitionTimeout;
+  f.node = 2;
+  f.transition = 2;
+  f.wanted = State::kOperationEnabled;
+  f.reached = State::kSwitchOnDisabled;
+  f.statusword = 0x0050;  // switch on disabled, voltage enabled, remote 0
+  f.waited_ns = 500'000'000;
+  EXPECT_EQ(f.to_string(),
+            "node 2: transition 2 (Switch on disabled -> Ready to switch on) towards Operation enabled timed out after "
+            "500.0 ms: drive is in Switch on disabled, statusword 0x0050; the drive is under local control (statusword "
+            "bit 9 remote = 0: it does not process the controlword): switch it to bus/remote control on the drive");
 }
 
 TEST(FieldbusStateTable, ProxyFailureExplainsItself) {

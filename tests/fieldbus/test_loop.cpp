@@ -338,37 +338,156 @@ TEST(FieldbusLoop, EmulatorFailAfterNSyncs) {
   EXPECT_EQ(d.last_emcy_code(), 0x4310);
 }
 
-TEST(FieldbusLoop, HomingMethod35SetsHomeOffset) {
+// Homing through the proxy (issue 15 item 1): start_homing() writes 0x6098,
+// 0x6099:1/2, 0x609A (0x607C when asked), switches to mode 6 over SDO, waits
+// for 0x6061 = 6 and raises controlword bit 4 on a rising edge. One test per
+// CiA 402 method family the emulator models: "current position" (35, 37:
+// done at the first SYNC with bit 4) and the searching ones (limit switch +
+// index 1/2, home switch 17-30, index pulse 33/34: the emulator has one home
+// reference at position 0 and drives there at 0x6099:1).
+namespace {
+struct HomingCase {
+  std::int8_t method;
+  std::int32_t start;
+  bool offset;
+};
+class FieldbusHoming : public ::testing::TestWithParam<HomingCase> {};
+}  // namespace
+
+TEST_P(FieldbusHoming, EachMethodFamilyCompletesWithItsParametersWritten) {
+  const HomingCase hc = GetParam();
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
-  cfg.emulator.initial_position = 777;
-  cfg.drive.extra_writes = {cia402::SdoWrite{0x607C, 0, 4, 5000}, cia402::SdoWrite{0x6098, 0, 1, 35}};
+  cfg.emulator.initial_position = hc.start;
   SimRig rig(cfg);
   boot_and_enable(rig);
   auto& d = rig.drive(2);
-  EXPECT_FALSE(d.start_homing());  // CSP: not homing
-  ASSERT_TRUE(d.set_mode(cia402::Mode::kHoming));
-  ASSERT_TRUE(rig.run_until([&] { return rig.emulator(2).mode_display() == 6; }, 50));
-  ASSERT_TRUE(d.start_homing());
-  ASSERT_TRUE(rig.run_until([&] { return d.homing_status() == cia402::HomingStatus::kCompleted; }, 50));
-  EXPECT_EQ(d.feedback().position, 5000);
+  ASSERT_EQ(d.mode(), cia402::Mode::kCsp);
+  cia402::HomingParams hp;
+  hp.method = hc.method;
+  hp.speed_search = 200'000;
+  hp.speed_zero = 20'000;
+  hp.accel = 2'000'000;
+  hp.write_offset = hc.offset;
+  hp.offset = 5000;
+  ASSERT_TRUE(d.start_homing(hp));
+  EXPECT_EQ(d.homing_result(), cia402::HomingResult::kBusy);
+  std::uint64_t bit4_cycles = 0;
+  bool bit4_before_mode = false;
+  ASSERT_TRUE(rig.run_until([&] {
+    if ((d.controlword() & cia402::cw::kHomingStart) != 0) {
+      ++bit4_cycles;
+      bit4_before_mode = bit4_before_mode || rig.emulator(2).mode_display() != 6;
+    }
+    return d.homing_result() != cia402::HomingResult::kBusy;
+  }, 500));
+  ASSERT_EQ(d.homing_result(), cia402::HomingResult::kCompleted);
+  EXPECT_FALSE(bit4_before_mode) << "bit 4 raised before the drive showed mode 6";
+  EXPECT_GE(bit4_cycles, 1u);
+  auto& emu = rig.emulator(2);
+  EXPECT_EQ(emu.read_int(0x6098), hc.method);
+  EXPECT_EQ(emu.read_int(0x6099, 1), 200'000);
+  EXPECT_EQ(emu.read_int(0x6099, 2), 20'000);
+  EXPECT_EQ(emu.read_int(0x609A), 2'000'000);
+  EXPECT_EQ(emu.read_int(0x607C), hc.offset ? 5000 : 0);
+  const bool immediate = hc.method == 35 || hc.method == 37;
+  EXPECT_EQ(d.feedback().position, hc.offset ? 5000 : 0);  // the home position is the home offset
+  if (!immediate) {
+    EXPECT_GT(bit4_cycles, 5u) << "a searching method took one SYNC";
+  }
   for (int i = 0; i < 3; ++i) rig.step();
   EXPECT_EQ(d.controlword() & cia402::cw::kHomingStart, 0);  // bit 4 released after completion
   EXPECT_TRUE(d.enabled());
 }
 
-TEST(FieldbusLoop, HomingSearchMovesToTheSwitch) {
+INSTANTIATE_TEST_SUITE_P(Methods, FieldbusHoming,
+                         ::testing::Values(HomingCase{35, 777, true}, HomingCase{37, -300, false},
+                                           HomingCase{1, 3000, false}, HomingCase{19, -4000, true},
+                                           HomingCase{34, 2500, false}),
+                         [](const ::testing::TestParamInfo<HomingCase>& p) { return "Method" + std::to_string(p.param.method); });
+
+// A second homing while the drive still shows "homing attained" from the
+// first: the old bit does not end it (on main the proxy dropped bit 4 at
+// once and reported completion without the drive moving).
+TEST(FieldbusLoop, SecondHomingIsNotEndedByTheFirstOnesAttainedBit) {
   SimRigConfig cfg = rig_config();
   cfg.nodes = {2};
   cfg.emulator.initial_position = 2000;
-  cfg.drive.mode = cia402::Mode::kHoming;
-  cfg.drive.extra_writes = {cia402::SdoWrite{0x6098, 0, 1, 17}, cia402::SdoWrite{0x6099, 1, 4, 100'000}};
   SimRig rig(cfg);
   boot_and_enable(rig);
   auto& d = rig.drive(2);
-  ASSERT_TRUE(d.start_homing());
-  for (int i = 0; i < 5; ++i) rig.step();
-  EXPECT_EQ(d.homing_status(), cia402::HomingStatus::kInProgress);
-  ASSERT_TRUE(rig.run_until([&] { return d.homing_status() == cia402::HomingStatus::kCompleted; }, 200));
-  EXPECT_EQ(d.feedback().position, 0);  // home offset 0
+  cia402::HomingParams hp;
+  hp.method = 19;
+  hp.speed_search = 100'000;
+  hp.speed_zero = 20'000;  // the strict emulator refuses a search at speed 0 (bit 13)
+  ASSERT_TRUE(d.start_homing(hp));
+  ASSERT_TRUE(rig.run_until([&] { return d.homing_result() != cia402::HomingResult::kBusy; }, 500));
+  ASSERT_EQ(d.homing_result(), cia402::HomingResult::kCompleted);
+  EXPECT_EQ(d.feedback().position, 0);
+  // Move away in CSP, then home again: back in mode 6 the drive still shows
+  // bit 12 from the first homing until it sees the next rising edge of bit 4.
+  d.cancel_homing();
+  ASSERT_TRUE(d.set_mode(cia402::Mode::kCsp));
+  ASSERT_TRUE(rig.run_until([&] { return rig.emulator(2).mode_display() == 8; }, 50));
+  for (int i = 0; i < 300; ++i) {
+    d.set_target_position(d.target_position() + 10);
+    rig.step();
+  }
+  ASSERT_GT(d.feedback().position, 2500);
+  ASSERT_TRUE(d.start_homing(hp));
+  bool stale_seen = false;
+  ASSERT_TRUE(rig.run_until([&] {
+    stale_seen = stale_seen || (rig.emulator(2).mode_display() == 6 && d.homing_status() == cia402::HomingStatus::kCompleted &&
+                                d.homing_result() == cia402::HomingResult::kBusy);
+    return d.homing_result() != cia402::HomingResult::kBusy;
+  }, 500));
+  EXPECT_TRUE(stale_seen) << "the test did not see the old bit (no stale state to ignore)";
+  ASSERT_EQ(d.homing_result(), cia402::HomingResult::kCompleted);
+  EXPECT_EQ(d.feedback().position, 0) << "the second homing ended before the drive homed";
 }
+
+// The drive lacks a homing object: the refused write is the result (bit 4
+// never raised), with its object and abort code.
+TEST(FieldbusLoop, HomingParameterRefusedIsReportedAndBit4NeverRaised) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.absent_objects = {0x609A};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(d.start_homing(cia402::HomingParams{}));
+  bool bit4 = false;
+  ASSERT_TRUE(rig.run_until([&] {
+    bit4 = bit4 || (d.controlword() & cia402::cw::kHomingStart) != 0;
+    return d.homing_result() != cia402::HomingResult::kBusy;
+  }, 500));
+  EXPECT_EQ(d.homing_result(), cia402::HomingResult::kRefused);
+  EXPECT_EQ(d.homing_abort(), 0x06020000u);
+  EXPECT_EQ(d.homing_abort_object(), 0x609A00u);
+  EXPECT_FALSE(bit4);
+}
+
+// Homing that does not finish within DriveConfig::homing_timeout_ns: the
+// result is kTimeout and bit 4 drops (the drive aborts its homing).
+TEST(FieldbusLoop, HomingTimeoutDropsBit4) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.initial_position = 1'000'000;
+  cfg.drive.homing_timeout_ns = 100'000'000;  // 100 ms
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  cia402::HomingParams hp;
+  hp.method = 19;
+  hp.speed_search = 1000;  // 1000 s to the switch
+  hp.speed_zero = 1000;    // (a speed of 0 is a homing error on the strict emulator)
+  const std::int64_t t0 = rig.now_ns();
+  ASSERT_TRUE(d.start_homing(hp));
+  ASSERT_TRUE(rig.run_until([&] { return d.homing_result() != cia402::HomingResult::kBusy; }, 500));
+  EXPECT_EQ(d.homing_result(), cia402::HomingResult::kTimeout);
+  EXPECT_GE(rig.now_ns() - t0, 100'000'000);
+  EXPECT_LE(rig.now_ns() - t0, 103'000'000);
+  rig.step();
+  EXPECT_EQ(d.controlword() & cia402::cw::kHomingStart, 0);
+}
+

@@ -225,6 +225,26 @@ TEST(FieldbusSdo, ClientReportsEveryServerAbortWithItsText) {
   }
 }
 
+// A server that names another index/sub (or none) in its abort: the transfer
+// ends with the real abort code at once (on main it was ignored and became a
+// 0x05040000 timeout 100 ms later); what the abort named is kept.
+TEST(FieldbusSdo, AbortNamingAnotherObjectEndsTheTransferWithItsCode) {
+  canopen::SdoClient c(2, 100 * kMs);
+  VecSink out;
+  ASSERT_TRUE(c.download_value<std::int8_t>(0x6060, 0, 8, 7));
+  c.step(0, out);
+  c.on_frame(frame("582#8000000022000008"), 1 * kMs);  // 0x08000022, index 0x0000 sub 0
+  canopen::SdoResult r;
+  ASSERT_TRUE(c.poll(r));
+  EXPECT_EQ(r.tag, 7u);
+  EXPECT_EQ(r.abort, SdoAbort::kDeviceState);
+  EXPECT_TRUE(r.aborted_by_server);
+  EXPECT_EQ(r.index, 0x6060);
+  EXPECT_EQ(r.abort_index, 0x0000);
+  EXPECT_EQ(r.finished_ns, 1 * kMs);
+  EXPECT_TRUE(c.idle());
+}
+
 TEST(FieldbusSdo, TimeoutOnVirtualClockThenNextTransferRuns) {
   canopen::SdoClient c(2, 100 * kMs);
   VecSink out;

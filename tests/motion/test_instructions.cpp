@@ -514,6 +514,7 @@ TEST(Mah, CipDriveHomingMode6) {
   EXPECT_TRUE(r.axis("D").motion(motion_status::HomingStatus));
   EXPECT_EQ(r.exec(mam("D", "m", 0, 1, 1)), Err::HomeInProcess);
   EXPECT_EQ(r.exec("MAH(D, mah2);"), Err::HomeInProcess);
+  r.step();  // the drive shows this homing in progress
   r.fb[0].position = -2;  // drive moved while homing
   r.fb[0].homing_attained = true;
   r.step();
@@ -522,6 +523,55 @@ TEST(Mah, CipDriveHomingMode6) {
   EXPECT_TRUE(r.axis("D").motion(motion_status::AxisHomedStatus));
   EXPECT_DOUBLE_EQ(r.axis("D").actual_position, 7.0);
   EXPECT_DOUBLE_EQ(r.out[0].position, -2.0);  // drive frame unchanged: no jump
+}
+
+// "Homing attained" still set from an earlier homing when MAH starts is not
+// this homing's completion: it counts only after the feedback showed it
+// clear once since the start (on main MAH was PC in the next cycle).
+TEST(Mah, StaleHomingAttainedDoesNotCompleteANewHoming) {
+  Rig r;
+  AxisConfig c = virt();
+  c.type = AxisType::CipDrive;
+  c.homing.sequence = HomingConfig::Sequence::Switch;
+  c.homing.home_position = 7;
+  r.add_axis("D", c);
+  r.fb[0].drive = DriveState::Enabled;
+  r.fb[0].homing_attained = true;  // left from a previous homing
+  r.exec("MSO(D, mso);");
+  r.step();
+  EXPECT_EQ(r.exec("MAH(D, mah);"), Err::None);
+  for (int i = 0; i < 5; ++i) r.step();
+  EXPECT_BITS(r.tag("mah"), true, true, false, true, false);  // still IP
+  EXPECT_FALSE(r.axis("D").motion(motion_status::AxisHomedStatus));
+  r.fb[0].homing_attained = false;  // the drive started this homing
+  r.step();
+  EXPECT_BITS(r.tag("mah"), true, true, false, true, false);
+  r.fb[0].homing_attained = true;
+  r.step();
+  EXPECT_BITS(r.tag("mah"), true, true, false, false, true);
+  EXPECT_TRUE(r.axis("D").motion(motion_status::AxisHomedStatus));
+}
+
+// A homing error (or the runtime's homing timeout) ends MAH with ERR 12 and
+// the EXERR the feedback gives (3: a homing parameter refused).
+TEST(Mah, HomingErrorEndsWithErr12AndTheFeedbacksExerr) {
+  Rig r;
+  AxisConfig c = virt();
+  c.type = AxisType::CipDrive;
+  c.homing.sequence = HomingConfig::Sequence::Switch;
+  r.add_axis("D", c);
+  r.fb[0].drive = DriveState::Enabled;
+  r.exec("MSO(D, mso);");
+  r.step();
+  EXPECT_EQ(r.exec("MAH(D, mah);"), Err::None);
+  r.step();
+  r.fb[0].homing_error = true;
+  r.fb[0].homing_exerr = 3;
+  r.step();
+  EXPECT_TRUE(r.tag("mah").er());
+  EXPECT_EQ(r.tag("mah").err, 12);
+  EXPECT_EQ(r.tag("mah").exerr, 3);
+  EXPECT_FALSE(r.axis("D").motion(motion_status::HomingStatus));
 }
 
 TEST(Mah, Errors) {

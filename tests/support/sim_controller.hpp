@@ -23,7 +23,8 @@ struct SimController {
   std::unique_ptr<rt::Controller> ctl;
   std::int64_t now = 0;
 
-  SimController() {
+  /// `tweak` may change axis X and its drive's emulator before the controller is built.
+  explicit SimController(const std::function<void(rt::AxisSpec&, emulator::EmulatorConfig&)>& tweak = {}) {
     rt::ControllerSpec spec;
     spec.period_ns = kPeriod;
     rt::BusSpec bus;
@@ -47,14 +48,15 @@ struct SimController {
     x.config.position_error_tolerance = 5;
     x.bus = 0;
     x.drive.node = kNode;
+    emulator::EmulatorConfig ec;
+    ec.node = kNode;
+    ec.behaviour = emulator::EmulatorBehaviour::loop_default();
+    if (tweak) tweak(x, ec);
     spec.axes.push_back(x);
     rt::CamSpec cam;
     cam.name = "cam1";
     cam.points = {{0.0, 0.0, 1}, {0.5, 10.0, 1}, {1.0, 0.0, 0}};
     spec.cams.push_back(cam);
-    emulator::EmulatorConfig ec;
-    ec.node = kNode;
-    ec.behaviour = emulator::EmulatorBehaviour::loop_default();
     world.add_drive(0, ec);
     ctl = std::make_unique<rt::Controller>(spec);
     world.power_on(0);

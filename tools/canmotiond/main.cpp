@@ -74,7 +74,10 @@ int write_dcfs(const config::Config& cfg, const std::string& dir) {
     spec.baudrate_kbit = static_cast<std::uint16_t>(bus->bitrate / 1000);
     spec.node_name = a.name;
     spec.eds = a.drive.eds_data.get();
+    std::size_t written = 0;
     for (const cia402::BootWrite& w : writes) {
+      if (w.is_read()) continue;  // the boot's checks (0x1000, 0x6502, 0x6061, ...) are not configuration
+      ++written;
       const std::string* key = cia402::write_hint_key(dc.hints, w);
       spec.writes.push_back({w.w.index, w.w.sub, w.w.size, w.w.value, key != nullptr ? *key : std::string()});
     }
@@ -86,7 +89,7 @@ int write_dcfs(const config::Config& cfg, const std::string& dir) {
       fmt::print(stderr, "canmotiond: --write-dcf: cannot write {}\n", path);
       return 1;
     }
-    fmt::print("canmotiond: {}: node {}, {} boot writes{}\n", path, a.node, writes.size(),
+    fmt::print("canmotiond: {}: node {}, {} boot writes{}\n", path, a.node, written,
                a.drive.eds.empty() ? "" : " (checked against " + a.drive.eds + ")");
   }
   return 0;
@@ -146,6 +149,14 @@ class Outputs {
         fmt::print(stderr, "canmotiond: bus {} node {}: heartbeat lost\n", cfg_.buses[e.bus].name, e.node.node);
       } else if (e.kind == rt::Event::Kind::kBusState) {
         fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
+        if (e.bus_state == can::BusState::kBusOff && !cfg_.buses[e.bus].is_sim())
+          fmt::print(stderr, "canmotiond: bus {}: bus-off: {}\n", cfg_.buses[e.bus].name,
+                     can::SocketCanBus::bus_off_advice(cfg_.buses[e.bus].interface));
+      } else if (e.kind == rt::Event::Kind::kBusError) {
+        fmt::print(stderr, "canmotiond: bus {}: error frames: {}\n", cfg_.buses[e.bus].name,
+                   can::SocketCanBus::error_classes_text(static_cast<std::uint32_t>(e.value)));
+      } else if (e.kind == rt::Event::Kind::kBusRecovered) {
+        fmt::print(stderr, "canmotiond: bus {}: back from bus-off: re-booting its drives\n", cfg_.buses[e.bus].name);
       }
     }
   }
@@ -314,7 +325,9 @@ config::Config load_config(const Options& o) {
 /// 2. Buses and controller (--check-args: simulated buses, nothing opened).
 config::Runtime open_runtime(const Options& o, const config::Config& cfg) {
   try {
-    return config::build_runtime(cfg, o.sim || o.check_args);
+    config::Runtime rt = config::build_runtime(cfg, o.sim || o.check_args);
+    for (const auto& n : rt.notes) fmt::print(stderr, "canmotiond: {}\n", n);  // e.g. a raised txqueuelen
+    return rt;
   } catch (const std::exception& e) {
     fmt::print(stderr, "canmotiond: {}\n", e.what());
     throw Exit{1};
