@@ -23,11 +23,39 @@ cat "$art/master.log"
 echo "CANSEND-MARK" > "$art/cansend.mark"
 cansend vcan0 602#4000100000000000
 # An independent CANopen tool (plain can-utils cansend, no canmotion code)
-# drives node 3 in CSP: reset node, NMT start, the default RPDO1 (controlword
-# + target position) through Shutdown / Switch on / Enable operation, each
-# applied at a SYNC, then a target of 100100 counts (the drive is at 100000).
+# drives node 3 in CSP: reset node, then in Pre-operational the CiA 301 PDO
+# remap a real drive needs (its power-on PDOs are the CiA 402 predefined
+# ones: RPDO1 = controlword, TPDO1 = statusword, event-driven): RPDO1 =
+# controlword + target position, TPDO1 = statusword + position actual, both
+# synchronous (type 1), mode 8 (CSP); NMT start; RPDO1 through Shutdown /
+# Switch on / Enable operation, each applied at a SYNC, then a target of
+# 100100 counts (the drive is at 100000). Each SDO write waits for its reply
+# (583#60...), as a tool would.
+boots() { grep -c ' 703#00$' "$CANMOTION_TRACE" || true; }
+booted=$(boots)
 cansend vcan0 000#8103
-sleep 0.3
+for ((i = 0; i < 200; i++)); do
+  [[ $(boots) -gt $booted ]] && break
+  sleep 0.05
+done
+sleep 0.3  # the drive's DC bus charges for 100 ms after a reset (Not ready to switch on)
+replies() { grep -c ' 583#60' "$CANMOTION_TRACE" || true; }
+sdo3() {
+  local before; before=$(replies)
+  cansend vcan0 "603#$1"
+  for ((j = 0; j < 200; j++)); do
+    [[ $(replies) -gt $before ]] && return 0
+    grep -q " 583#80${1:2:6}" "$CANMOTION_TRACE" && { echo "vcan-run: node 3 aborted SDO write 603#$1" >&2; return 0; }
+    sleep 0.05
+  done
+  echo "vcan-run: no reply from node 3 to 603#$1" >&2
+}
+for w in 2300140103020080 2F00160000000000 2300160110004060 2300160220007A60 2F00160002000000 \
+         2F00140201000000 2300140103020000 \
+         2300180183010080 2F001A0000000000 23001A0110004160 23001A0220006460 2F001A0002000000 \
+         2F00180201000000 2300180183010000 2F60600008000000; do
+  sdo3 "$w"
+done
 cansend vcan0 000#0103
 for cw in 0600 0700 0F00; do
   cansend vcan0 203#${cw}A0860100
