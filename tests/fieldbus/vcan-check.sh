@@ -10,6 +10,10 @@ fail() { echo "vcan-check: $*" >&2; exit 1; }
 has() { grep -q " $1\$" "$trace"; }
 frames="$CANMOTION_ARTIFACTS/frames.txt"
 awk '{print $1, $3}' "$trace" | tr -d '()' > "$frames"   # "sec.usec ID#DATA"
+# Where the master program's part ends: the raw cansend upload of 0x1000 is
+# the last such request (the master reads 0x1000 at boot too: identity check).
+cut=$(grep -n ' 602#4000100000000000$' "$trace" | tail -1 | cut -d: -f1)
+[[ -n $cut ]] || fail "the cansend request is not in the trace"
 for n in 2 3; do
   has "70$n#00" || fail "no boot-up of node $n"
   # SDO configuration (expedited writes acknowledged): mode 8, 0x60C2, TPDO1 mapping, heartbeat.
@@ -24,7 +28,7 @@ for n in 2 3; do
 done
 # SYNC at the period (mean interval; the VM's timing is loose, so be generous).
 # (the master program's part only: up to the raw cansend requests)
-awk -v p="$cycle_us" '$2 == "602#4000100000000000" { exit } $2 == "080#" { if (last != "") { s += ($1 - last); n++ } last = $1 }
+awk -v p="$cycle_us" -v cut="$cut" 'NR >= cut { exit } $2 == "080#" { if (last != "") { s += ($1 - last); n++ } last = $1 }
   END { if (n < 100) { print "only " n " SYNC intervals"; exit 1 }
         m = s / n * 1e6; printf "vcan-check: %d SYNCs, mean interval %.0f us (period %d us)\n", n + 1, m, p
         if (m < 0.8 * p || m > 5 * p) { print "mean SYNC interval out of range"; exit 1 } }' "$frames" ||
@@ -37,8 +41,8 @@ awk -v p="$cycle_us" '$2 == "602#4000100000000000" { exit } $2 == "080#" { if (l
 # for 1233); a real defect, such as no TPDO or two per SYNC, is off by hundreds.
 for n in 2 3; do
   # (only the master program's part: up to the raw cansend requests)
-  awk -v r="20$n" -v tp="18$n" '
-    $2 == "602#4000100000000000" { exit }
+  awk -v r="20$n" -v tp="18$n" -v cut="$cut" '
+    NR >= cut { exit }
     { split($2, a, "#"); id = a[1] }
     id == tp { if (first == "") first = NR; last = NR }
     { ids[NR] = id }
@@ -51,7 +55,7 @@ for n in 2 3; do
 done
 # The raw cansend upload of 0x1000 and the emulator's expedited reply.
 grep -n ' 602#4000100000000000$' "$trace" >/dev/null || fail "the cansend request is not in the trace"
-awk '$3 == "602#4000100000000000" { req = NR } req && NR > req && $3 == "582#4300100092010200" { ok = 1 }
+awk -v cut="$cut" 'NR == cut { req = NR } req && NR > req && $3 == "582#4300100092010200" { ok = 1 }
   END { exit ok ? 0 : 1 }' "$trace" || fail "no reply 582#4300100092010200 to the 0x1000 upload"
 # The cansend-only master: node 3 rebooted, was enabled and reached 100100.
 awk '$3 == "000#8103" { r = NR } r && NR > r && $3 == "703#00" { b = 1 } b && $3 == "183#371204870100" { ok = 1 }
