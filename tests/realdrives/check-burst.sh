@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# A cycle burst longer than the interface's queue, CHECK part: the candump -L
+# trace ($CANMOTION_TRACE) against canmotiond's own trace and log
+# (artefacts of run-burst.sh raise). Writes the figures to measure.txt.
+#   check-burst.sh PERIOD_MS NODES...
+# What "no SYNC lost" means here:
+#  1. every SYNC canmotiond wrote (its own trace: one record per frame it
+#     handed to the socket) is on the bus (candump), and there is one per
+#     cycle (the summary's cycle count);
+#  2. on canmotiond's clock, consecutive SYNCs are at most 1.5 periods apart
+#     (a cycle that skipped its SYNC, or an overrun, shows as a gap of 2);
+#  3. while all nodes are operational, every node gets exactly one RPDO
+#     between two SYNCs. Order, not time: vcan hands each frame to every
+#     receiving socket synchronously in the order the frames were written,
+#     so candump's order is the bus order even when its stamps lag under
+#     emulation; no tolerance is needed for the master's frames. The drives'
+#     TPDOs come from another process scheduled by the emulated CPU: each
+#     node's TPDO count in the window must be within 2 % of the SYNC count
+#     (each missing one is also counted by canmotiond as TpdoMissed).
+set -euo pipefail
+period_ms="$1"
+shift
+nodes=("$@")
+trace="$CANMOTION_TRACE"
+art="${CANMOTION_ARTIFACTS:-$(dirname "$trace")}"
+dtrace="$art/canmotiond-trace.log"
+log="$art/canmotiond.log"
+fail() { echo "check-burst: FAIL: $*" >&2; exit 1; }
+measure() { echo "$*" >> "$art/measure.txt"; echo "check-burst: measured: $*"; }
+: > "$art/measure.txt"
+[[ -s $trace ]] || fail "empty trace $trace"
+[[ -s $dtrace ]] || fail "no canmotiond trace $dtrace"
+
+# 1. SYNC counts.
+sync_bus=$(awk '$3 ~ /^080#/ { n++ } END { print n + 0 }' "$trace")
+sync_master=$(awk '$3 ~ /^080#/ { n++ } END { print n + 0 }' "$dtrace")
+cycles=$(sed -nE 's/^summary: ([0-9]+) cycles.*/\1/p' "$log")
+[[ -n $cycles ]] || fail "no cycle count in canmotiond's summary"
+measure "cycles $cycles, SYNCs written by canmotiond $sync_master, SYNCs on the bus (candump) $sync_bus"
+[[ $sync_master -gt 0 ]] || fail "canmotiond wrote no SYNC"
+[[ $sync_bus == "$sync_master" ]] || fail "$sync_master SYNCs written, $sync_bus on the bus: $((sync_master - sync_bus)) lost"
+[[ $sync_master == "$cycles" ]] || fail "$cycles cycles but $sync_master SYNCs written"
+
+# 2. Gaps between SYNCs on canmotiond's clock.
+read -r max_gap n_gaps <<<"$(awk -v T="$period_ms" '$3 ~ /^080#/ {
+    t = substr($1, 2, length($1) - 2) + 0
+    if (seen) { g = (t - last) * 1000; if (g > max) max = g; if (g > 1.5 * T) n++ }
+    last = t; seen = 1 }
+  END { printf "%.3f %d\n", max, n }' "$dtrace")"
+overruns=$(sed -nE 's/^summary: wake-up latency .* overruns ([0-9]+).*/\1/p' "$log")
+measure "largest gap between SYNCs (canmotiond's clock) $max_gap ms (period $period_ms ms), gaps > 1.5 periods: $n_gaps, overruns ${overruns:-?}"
+[[ $n_gaps == 0 ]] || fail "$n_gaps gaps longer than 1.5 periods between SYNCs in canmotiond's trace (largest $max_gap ms)"
+
+# 3. One RPDO per node between SYNCs, in the window where all nodes are
+# operational: from the first SYNC after the last NMT start to the NMT
+# pre-operational of the controlled stop.
+last_start=0
+for n in "${nodes[@]}"; do
+  l=$(awk -v id="$(printf '000#01%02X' "$n")" '$3 == id { print NR; exit }' "$trace")
+  [[ -n $l ]] || fail "node $n was never started (no NMT start in the trace)"
+  ((l > last_start)) && last_start=$l
+done
+ids=$(printf '%X ' "${nodes[@]}")
+result=$(awk -v from="$last_start" -v ids="$ids" '
+  function hex(s,  i, v) { v = 0; for (i = 1; i <= length(s); i++) v = v * 16 + index("0123456789ABCDEF", toupper(substr(s, i, 1))) - 1; return v }
+  BEGIN { k = split(ids, id, " "); for (i = 1; i <= k; i++) { r = sprintf("%03X", 512 + hex(id[i])); t = sprintf("%03X", 384 + hex(id[i])); rp[r] = 1; tp[t] = 1 } }
+  NR <= from { next }
+  { split($3, f, "#") }
+  f[1] == "000" && substr(f[2], 1, 2) == "80" { stop = 1 }
+  stop { next }
+  f[1] == "080" {
+    if (open) {
+      intervals++
+      for (r in rp) if (cnt[r] != 1) { bad++; if (!first_bad) first_bad = sprintf("line %d: RPDO %s %d times since the previous SYNC", NR, r, cnt[r] + 0) }
+    }
+    delete cnt; open = 1; syncs++; next }
+  open && (f[1] in rp) { cnt[f[1]]++ }
+  open && (f[1] in tp) { tcount[f[1]]++ }
+  END {
+    min = -1; for (t in tp) { if (min < 0 || tcount[t] < min) { min = tcount[t] + 0; minid = t } }
+    printf "%d %d %d %s %d %s\n", syncs, intervals, bad + 0, minid, min, (first_bad ? first_bad : "-") }' "$trace")
+read -r w_syncs w_intervals w_bad t_min_id t_min first_bad <<<"$result"
+measure "window (all ${#nodes[@]} nodes operational): $w_syncs SYNCs, $w_intervals intervals checked, intervals where a node's RPDO was missing or doubled: $w_bad"
+measure "TPDOs in the window: fewest $t_min (node 0x$t_min_id) against $w_syncs SYNCs"
+[[ $w_intervals -ge $((2000 / period_ms)) ]] || fail "only $w_intervals SYNC intervals with all nodes operational (expected >= 2 s of cycles)"
+[[ $w_bad == 0 ]] || fail "$w_bad intervals where a node did not get exactly one RPDO; first: $first_bad"
+awk -v t="$t_min" -v s="$w_syncs" 'BEGIN { exit !(t >= 0.98 * s) }' || fail "node 0x$t_min_id sent $t_min TPDOs for $w_syncs SYNCs (below 98 %)"
+# The jog reached every axis: each ended away from 0 without a fault.
+for n in "${nodes[@]}"; do
+  line=$(grep -E "^t=[0-9.]+ A$n\.AxisFault=0 " "$log") || fail "axis A$n faulted or did not report"
+  pos=$(sed -nE 's/.*ActualPosition=([-0-9.e+]+).*/\1/p' <<<"$line")
+  awk -v p="$pos" 'BEGIN { exit !(p > 1) }' || fail "axis A$n did not move ($line)"
+done
+echo "check-burst: OK"
