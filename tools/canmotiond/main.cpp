@@ -24,6 +24,7 @@
 #include "config/eds_check.hpp"
 #include "config/runtime.hpp"
 #include "fieldbus/eds/dcf.hpp"
+#include "fieldbus/can/can_netlink.hpp"
 #include "fieldbus/can/candump_format.hpp"
 #include "fieldbus/canopen/emcy.hpp"
 #include "rt/clock.hpp"
@@ -149,9 +150,11 @@ class Outputs {
         fmt::print(stderr, "canmotiond: bus {} node {}: heartbeat lost\n", cfg_.buses[e.bus].name, e.node.node);
       } else if (e.kind == rt::Event::Kind::kBusState) {
         fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
+        // On this (housekeeping) thread, never the cycle: rtnetlink, and a
+        // restart when restart-ms is 0 (fieldbus/can/can_netlink.hpp).
         if (e.bus_state == can::BusState::kBusOff && !cfg_.buses[e.bus].is_sim())
-          fmt::print(stderr, "canmotiond: bus {}: bus-off: {}\n", cfg_.buses[e.bus].name,
-                     can::SocketCanBus::bus_off_advice(cfg_.buses[e.bus].interface));
+          if (const std::string what = can::handle_bus_off(cfg_.buses[e.bus].interface); !what.empty())
+            fmt::print(stderr, "canmotiond: bus {}: bus-off: {}\n", cfg_.buses[e.bus].name, what);
       } else if (e.kind == rt::Event::Kind::kBusError) {
         fmt::print(stderr, "canmotiond: bus {}: error frames: {}\n", cfg_.buses[e.bus].name,
                    can::SocketCanBus::error_classes_text(static_cast<std::uint32_t>(e.value)));
