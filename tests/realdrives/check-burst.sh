@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A cycle burst longer than the interface's queue, CHECK part: the candump -L
-# trace ($CANMOTION_TRACE) against canmotiond's own trace and log
+# trace (bus.log, run-burst.sh's candump) against canmotiond's own trace and log
 # (artefacts of run-burst.sh raise). Writes the figures to measure.txt.
 #   check-burst.sh PERIOD_MS NODES...
 # What "no SYNC lost" means here:
@@ -29,14 +29,18 @@ set -euo pipefail
 period_ms="$1"
 shift
 nodes=("$@")
-trace="$CANMOTION_TRACE"
-art="${CANMOTION_ARTIFACTS:-$(dirname "$trace")}"
+art="${CANMOTION_ARTIFACTS:-$(dirname "$CANMOTION_TRACE")}"
+# run-burst.sh's own candump (tmpfs, -d); see there why not the harness' trace.
+trace="$art/bus.log"
 dtrace="$art/canmotiond-trace.log"
 log="$art/canmotiond.log"
 fail() { echo "check-burst: FAIL: $*" >&2; exit 1; }
 measure() { echo "$*" >> "$art/measure.txt"; echo "check-burst: measured: $*"; }
 : > "$art/measure.txt"
 [[ -s $trace ]] || fail "empty trace $trace"
+if drops=$(grep -m1 '^DROPCOUNT' "$trace"); then
+  fail "candump's own socket dropped frames, the trace cannot show the bus: $drops"
+fi
 [[ -s $dtrace ]] || fail "no canmotiond trace $dtrace"
 
 # 1. SYNC counts.

@@ -44,10 +44,10 @@ if [[ -z $m98 ]]; then  # the homing objects may be written before the mode swit
 fi
 [[ -n $m98 ]] || fail "no SDO write of 0x6098 = $method to node $node"
 read -r edge t_edge <<<"$(awk -v from="$m6" -v id="$rpdo" "$lib"' NR > from { split($3, f, "#") }
-  NR > from && f[1] == id { b = band(word(f[2], 1), 16) != 0; if (b && seen && !last) { print NR, t($1); exit } last = b; seen = 1 }' "$trace")"
+  NR > from && f[1] == id { b = band(word(f[2], 1), 16) != 0; if (b && seen && !last) { printf "%d %.6f\n", NR, t($1); exit } last = b; seen = 1 }' "$trace")"
 [[ -n ${edge:-} ]] || fail "no rising edge of controlword bit 4 in RPDO $rpdo after the mode switch"
 read -r att t_att n_tpdo <<<"$(awk -v from="$edge" -v id="$tpdo" "$lib"' NR > from { split($3, f, "#") }
-  NR > from && f[1] == id { n++; if (band(word(f[2], 1), 4096) != 0) { print NR, t($1), n; exit } }' "$trace")"
+  NR > from && f[1] == id { n++; if (band(word(f[2], 1), 4096) != 0) { printf "%d %.6f %d\n", NR, t($1), n; exit } }' "$trace")"
 [[ -n ${att:-} ]] || fail "no TPDO $tpdo with statusword bit 12 (homing attained) after the bit 4 edge at line $edge"
 [[ $n_tpdo -gt 2 ]] || fail "homing attained in TPDO $n_tpdo after the edge: the strict drive should take time"
 measure "0x6060=6 at line $m6, 0x6098=$method at line $m98, bit 4 edge at line $edge, bit 12 at line $att ($n_tpdo TPDOs, $(awk -v a="$t_edge" -v b="$t_att" 'BEGIN { printf "%.0f", (b - a) * 1000 }') ms on candump stamps)"
