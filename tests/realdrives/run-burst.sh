@@ -112,8 +112,8 @@ rc=0
 timeout -s INT -k 30 400 "$daemon" --config "$art/burst.yaml" --script "$art/burst.script" \
   --trace "$art/canmotiond-trace.log" > "$art/canmotiond.log" 2>&1 &
 dpid=$!
-for ((i = 0; i < 300; i++)); do  # the raise happens before the first frame
-  [[ -s $CANMOTION_TRACE ]] && break
+for ((i = 0; i < 300; i++)); do  # the raise happens before the first SYNC
+  grep -q ' vcan0 080#' "$busdir/bus.log" && break
   kill -0 "$dpid" 2>/dev/null || break
   sleep 0.1
 done
