@@ -228,6 +228,8 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       if (const auto link = can::query_can_link(b.interface, &link_why)) {
         if (std::string w = can::restart_ms_warning(*link); !w.empty())
           rt.notes.push_back(fmt::format("bus '{}': {}", b.name, w));
+        if (std::string w = can::bitrate_note(*link, b.bitrate); !w.empty())
+          rt.notes.push_back(fmt::format("bus '{}' (line {}): {}", b.name, b.where.line, w));
       } else {
         rt.notes.push_back(fmt::format("bus '{}': could not read the CAN settings: {}", b.name, link_why));
       }

@@ -216,6 +216,15 @@ std::string restart_ms_warning(const CanLink& link) {
          i + " down && ip link set " + i + " type can restart-ms 100 && ip link set " + i + " up`";
 }
 
+std::string bitrate_note(const CanLink& link, std::uint32_t configured) {
+  if (!link.is_can || !link.bitrate || *link.bitrate == configured) return {};
+  return "interface " + link.name + " runs at " + std::to_string(*link.bitrate) + " bit/s but buses[].bitrate is " +
+         std::to_string(configured) + " (the bus budget was checked with " + std::to_string(configured) +
+         "): set buses[].bitrate to " + std::to_string(*link.bitrate) + ", or the interface with `ip link set " +
+         link.name + " down && ip link set " + link.name + " type can bitrate " + std::to_string(configured) +
+         " && ip link set " + link.name + " up`";
+}
+
 std::optional<CanLink> query_can_link(std::string_view ifname, std::string* why) {
   const std::string name(ifname);
   const unsigned idx = if_nametoindex(name.c_str());

@@ -74,6 +74,11 @@ enum class BusOffRestart : std::uint8_t {
 /// `ip link set can0 type can restart-ms 100` (with the link down first).
 [[nodiscard]] std::string restart_ms_warning(const CanLink& link);
 
+/// Start-up note when a CAN controller's bitrate differs from `configured`
+/// (buses[].bitrate, which the bus budget uses): "" when it matches, the
+/// link is not CAN or the kernel gave no bitrate.
+[[nodiscard]] std::string bitrate_note(const CanLink& link, std::uint32_t configured);
+
 /// Read `ifname`'s link settings over rtnetlink. nullopt and `why` (naming
 /// the interface and the failing step) on failure. Not realtime-safe.
 [[nodiscard]] std::optional<CanLink> query_can_link(std::string_view ifname, std::string* why = nullptr);

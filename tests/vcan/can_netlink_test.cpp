@@ -92,6 +92,20 @@ TEST(CanNetlink, CanLinkWithRestartMsZeroIsRestartedByCanmotion) {
             std::string::npos) << w;
 }
 
+TEST(CanNetlink, BitrateDifferingFromTheConfigurationIsNoted) {
+  const auto link = parse_link_reply(can_link_reply("00000000", "00000000"));
+  ASSERT_TRUE(link);
+  EXPECT_EQ(bitrate_note(*link, 500000), "");
+  const std::string n = bitrate_note(*link, 1000000);
+  EXPECT_NE(n.find("interface can0 runs at 500000 bit/s but buses[].bitrate is 1000000"), std::string::npos) << n;
+  EXPECT_NE(n.find("`ip link set can0 down && ip link set can0 type can bitrate 1000000 && ip link set can0 up`"),
+            std::string::npos) << n;
+  CanLink vcan;
+  vcan.name = "vcan0";
+  vcan.kind = "vcan";
+  EXPECT_EQ(bitrate_note(vcan, 1000000), "");
+}
+
 TEST(CanNetlink, CanLinkWithRestartMs100IsLeftToTheKernel) {
   const auto link = parse_link_reply(can_link_reply("64000000", "00000000"));
   ASSERT_TRUE(link);

@@ -100,7 +100,7 @@ int write_dcfs(const config::Config& cfg, const std::string& dir) {
 /// controller's rings on a non-RT thread (or inline in --sim).
 class Outputs {
  public:
-  Outputs(const Options& o, config::Runtime& rt, const config::Config& cfg) : rt_(rt), cfg_(cfg) {
+  Outputs(const Options& o, config::Runtime& rt, const config::Config& cfg) : rt_(rt), cfg_(cfg), sim_(o.sim) {
     rt::OutputWriterConfig wc;
     wc.trace_path = o.trace;
     wc.csv_path = o.csv;
@@ -152,7 +152,7 @@ class Outputs {
         fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
         // On this (housekeeping) thread, never the cycle: rtnetlink, and a
         // restart when restart-ms is 0 (fieldbus/can/can_netlink.hpp).
-        if (e.bus_state == can::BusState::kBusOff && !cfg_.buses[e.bus].is_sim())
+        if (e.bus_state == can::BusState::kBusOff && !sim_ && !cfg_.buses[e.bus].is_sim())
           if (const std::string what = can::handle_bus_off(cfg_.buses[e.bus].interface); !what.empty())
             fmt::print(stderr, "canmotiond: bus {}: bus-off: {}\n", cfg_.buses[e.bus].name, what);
       } else if (e.kind == rt::Event::Kind::kBusError) {
@@ -167,6 +167,7 @@ class Outputs {
  private:
   config::Runtime& rt_;
   const config::Config& cfg_;
+  bool sim_ = false;  // --sim: every bus is a SimBus, whatever its interface says
   std::optional<rt::OutputWriter> writer_;
   std::int64_t mono_to_real_ = 0;
 };
