@@ -43,6 +43,21 @@ MAH(X, h);
 WAIT UNTIL h.PC TIMEOUT 120;
 PRINT h.PC, h.ER, X.AxisHomedStatus, X.AxisFault, X.ActualPosition, X.CommandPosition;
 S
+rc=0 epid=""
+timeout -s INT -k 30 400 "$daemon" --config "$art/homing.yaml" --script "$art/homing.script" \
+  --trace "$art/canmotiond-trace.log" > "$art/canmotiond.log" 2>&1 &
+dpid=$!
+trap 'kill -TERM $dpid $epid 2>/dev/null || true; wait $dpid $epid 2>/dev/null || true' EXIT
+# The drive is switched on once canmotiond runs (its first SYNC is on the
+# bus), so canmotiond sees its boot-up. (Started the other way round, when
+# the boot-up came before canmotiond's socket, canmotiond reset the node
+# after boot_ms and MSO then never completed: controlword 0 for 60 s, no ER;
+# reported with issue 15, branch net15.)
+for ((i = 0; i < 600; i++)); do
+  grep -q ' vcan0 080#' "$CANMOTION_TRACE" && break
+  kill -0 "$dpid" 2>/dev/null || break
+  sleep 0.05
+done
 # --ip-index-ro false: canmotiond writes 0x60C2:2 (interpolation time index)
 # and a strict drive refuses it (0x06010002), which fails the boot; that is
 # one of the two master gaps the loop profile leaves out (see the report of
@@ -50,10 +65,7 @@ S
 # optional objects (0x1016) absent, one transition per SYNC, boot 100 ms.
 "$emu" --interface vcan0 --node 2 --profile strict --ip-index-ro false --verbose > "$art/emu.log" 2>&1 &
 epid=$!
-trap 'kill -TERM $epid 2>/dev/null || true; wait $epid 2>/dev/null || true' EXIT
-rc=0
-timeout -s INT -k 30 400 "$daemon" --config "$art/homing.yaml" --script "$art/homing.script" \
-  --trace "$art/canmotiond-trace.log" > "$art/canmotiond.log" 2>&1 || rc=$?
+wait "$dpid" || rc=$?
 cat "$art/canmotiond.log"
 [[ $rc == 0 ]] || { cat "$art/emu.log" >&2; fail "canmotiond exited $rc"; }
 kill -TERM "$epid" 2>/dev/null || true
