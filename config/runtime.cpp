@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldbus/can/can_netlink.hpp"
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/canopen/receive_filters.hpp"
@@ -220,6 +221,17 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
         // The cycle keeps within the queue and a place for the SYNC.
         // (0: no queue, no limit)
         bs.network.tx_queue_frames = std::max(chk.current, chk.action == canopen::TxQueueCheck::Action::kRaise ? chk.needed : 0u);
+      }
+      // restart-ms 0 (the kernel's default) keeps a bus-off controller off:
+      // say so once, with the command (nothing for vcan: no CAN attributes).
+      std::string link_why;
+      if (const auto link = can::query_can_link(b.interface, &link_why)) {
+        if (std::string w = can::restart_ms_warning(*link); !w.empty())
+          rt.notes.push_back(fmt::format("bus '{}': {}", b.name, w));
+        if (std::string w = can::bitrate_note(*link, b.bitrate); !w.empty())
+          rt.notes.push_back(fmt::format("bus '{}' (line {}): {}", b.name, b.where.line, w));
+      } else {
+        rt.notes.push_back(fmt::format("bus '{}': could not read the CAN settings: {}", b.name, link_why));
       }
       bs.transport = sock.get();
       rt.sockets.push_back(std::move(sock));

@@ -24,6 +24,7 @@
 #include "config/eds_check.hpp"
 #include "config/runtime.hpp"
 #include "fieldbus/eds/dcf.hpp"
+#include "fieldbus/can/can_netlink.hpp"
 #include "fieldbus/can/candump_format.hpp"
 #include "fieldbus/canopen/emcy.hpp"
 #include "rt/clock.hpp"
@@ -99,7 +100,7 @@ int write_dcfs(const config::Config& cfg, const std::string& dir) {
 /// controller's rings on a non-RT thread (or inline in --sim).
 class Outputs {
  public:
-  Outputs(const Options& o, config::Runtime& rt, const config::Config& cfg) : rt_(rt), cfg_(cfg) {
+  Outputs(const Options& o, config::Runtime& rt, const config::Config& cfg) : rt_(rt), cfg_(cfg), sim_(o.sim) {
     rt::OutputWriterConfig wc;
     wc.trace_path = o.trace;
     wc.csv_path = o.csv;
@@ -149,9 +150,11 @@ class Outputs {
         fmt::print(stderr, "canmotiond: bus {} node {}: heartbeat lost\n", cfg_.buses[e.bus].name, e.node.node);
       } else if (e.kind == rt::Event::Kind::kBusState) {
         fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
-        if (e.bus_state == can::BusState::kBusOff && !cfg_.buses[e.bus].is_sim())
-          fmt::print(stderr, "canmotiond: bus {}: bus-off: {}\n", cfg_.buses[e.bus].name,
-                     can::SocketCanBus::bus_off_advice(cfg_.buses[e.bus].interface));
+        // On this (housekeeping) thread, never the cycle: rtnetlink, and a
+        // restart when restart-ms is 0 (fieldbus/can/can_netlink.hpp).
+        if (e.bus_state == can::BusState::kBusOff && !sim_ && !cfg_.buses[e.bus].is_sim())
+          if (const std::string what = can::handle_bus_off(cfg_.buses[e.bus].interface); !what.empty())
+            fmt::print(stderr, "canmotiond: bus {}: bus-off: {}\n", cfg_.buses[e.bus].name, what);
       } else if (e.kind == rt::Event::Kind::kBusError) {
         fmt::print(stderr, "canmotiond: bus {}: error frames: {}\n", cfg_.buses[e.bus].name,
                    can::SocketCanBus::error_classes_text(static_cast<std::uint32_t>(e.value)));
@@ -164,6 +167,7 @@ class Outputs {
  private:
   config::Runtime& rt_;
   const config::Config& cfg_;
+  bool sim_ = false;  // --sim: every bus is a SimBus, whatever its interface says
   std::optional<rt::OutputWriter> writer_;
   std::int64_t mono_to_real_ = 0;
 };
