@@ -617,5 +617,38 @@ TEST(DriveFaults, LateSyncIsCountedAsAMissedTpdoAndMotionGoesOn) {
   EXPECT_EQ(r.read("X.JogStatus"), 1.0);
 }
 
+
+// The drive was powered before the master: its boot-up was missed, and a
+// drive without a configured heartbeat sends nothing more. After boot_timeout
+// the master resets the node and configures it from its new boot-up; an MSO
+// issued while all this goes on completes (DN) once the drive is operational,
+// or ends with ER, but never stays pending (issue 15; seen over vcan: the
+// controlword stayed 0 for 60 s, no ER).
+TEST(DriveFaults, MsoIssuedBeforeAMissedBootUpCompletes) {
+  FaultRig r(
+      [](AxisSpec& x, emulator::EmulatorConfig& e) {
+        x.drive.boot_timeout_ns = 200'000'000;
+        e.behaviour = emulator::EmulatorBehaviour::strict();
+        e.behaviour.ip_index_read_only = false;
+        e.behaviour.optional_objects_absent = false;
+      },
+      false);
+  can::SimFault drop;
+  drop.cob_id = 0x700u + kNode;
+  drop.count = 1;
+  r.world.bus(0).add_fault(drop);
+  r.world.power_cycle(0, r.now);  // its boot-up is lost
+  r.exec("MSO(X, mso1)");
+  ASSERT_TRUE(r.run_until([&] { return r.read("mso1.DN") != 0.0 || r.read("mso1.ER") != 0.0; }, 5000))
+      << "MSO still pending: phase " << static_cast<int>(r.axis().phase) << ", " << r.axis().failure.to_string();
+  std::printf("missed boot-up: MSO DN=%g ER=%g at %.0f ms; boot-up frames dropped %llu, drive heartbeats seen %llu\n",
+              r.read("mso1.DN"), r.read("mso1.ER"), ms(r.status().time_ns),
+              static_cast<unsigned long long>(r.world.bus(0).counters().dropped), static_cast<unsigned long long>(r.hb_rx));
+  EXPECT_EQ(r.world.bus(0).counters().dropped, 1u);
+  EXPECT_GE(r.status().time_ns, 200'000'000) << "configured before the boot timeout: the boot-up was not missed";
+  EXPECT_EQ(r.read("mso1.DN"), 1.0) << "ERR " << r.read("mso1.ERR");
+  EXPECT_EQ(r.read("X.DriveEnableStatus"), 1.0);
+}
+
 }  // namespace
 }  // namespace canmotion::rt
