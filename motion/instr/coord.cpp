@@ -245,16 +245,8 @@ Err start(Ctx& x, const McsParams& p) noexcept {
       if (a.servo.on) x.c.stop_slots(a, others, a.cfg.max_decel > 0 ? a.cfg.max_decel : 1e12, kInf, kNoControl, 0);
     }
   }
-  auto it = std::find_if(s.owners.begin(), s.owners.end(), [](const auto& o) { return o.id == 0; });
-  if (it == s.owners.end()) return Err::CoordinateSystemQueueFull;
-  coord::Events ev;
-  if (s.fold_due && !s.path.moving()) coordsys::settle(x.c, s);
-  const std::uint32_t id = s.next_id;
-  s.next_id = s.next_id == 0xFFFFFFFFu ? 1 : s.next_id + 1;
-  *it = CoordSystemRt::Owner{id, x.self};
   x.tag.set(flag::IP, true);
-  s.path.stop(id, d, jd, ev);
-  coordsys::apply_events(x.c, s, ev);
+  coordsys::start_stop(x.c, s, x.self, d, jd);
   return Err::None;
 }
 

@@ -499,16 +499,15 @@ void ProfileGen::finish(Core& c, AxisRt& a, Slot s, ControlTag* t) noexcept {
     }
   }
   const std::uint8_t post = post_stop;
-  // ramps of an MGS: the MGS gets PC when every axis of its group stopped
-  bool group_owned = false;
-  for (const auto& go : c.groups)
-    if (go.active && go.owner == owner) group_owned = true;
-  if (t && !group_owned) {
+  // ramps of an MGS: the MGS gets PC when every axis of its group stopped;
+  // an MAS All whose coordinate system still stops along its path: PC then
+  const bool later = c.group_owns(owner) || (role == GenRole::Stop && coordsys::stop_owned_by(c, owner));
+  if (t && !later) {
     t->set(flag::PC, true);
     t->set(flag::ACCEL, false);
     t->set(flag::DECEL, false);
   }
-  c.fold(a, s, !group_owned);  // *this is gone from here on
+  c.fold(a, s, !later);  // *this is gone from here on
   if (post == 1) c.servo_off(a);
   if (post == 2) c.do_shutdown(a);
 }

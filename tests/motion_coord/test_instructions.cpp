@@ -262,16 +262,18 @@ TEST(CoordInstr, McsdShutsTheMembersDownAndEndsEverything) {
   EXPECT_EQ(r.exec(mclm("m2", "p1", 50)), Err::ShutdownState);
 }
 
-TEST(CoordInstr, MemberServoOffDropsThePath) {
-  CoordRig r;
+TEST(CoordInstr, MemberServoOffStopsTheOtherMemberAlongThePath) {
+  CoordRig r;  // max decel 1000
   r.set("p1", 50, 50);
   ASSERT_EQ(r.exec(mclm("m1", "p1", 50)), Err::None);
   r.step(100);
   ASSERT_EQ(r.exec("MSF(X, f);"), Err::None);
   EXPECT_FALSE(r.tag("m1").ip());
-  const double y = r.y();
-  r.step(10);
-  EXPECT_EQ(r.y(), y);  // the other member holds
+  const double y = r.y(), x = r.x();
+  r.step(100);
+  // the other member stops along the path: 50^2 / (2 * 1000) of travel, Y's share 1/sqrt(2) of it
+  EXPECT_NEAR(r.y() - y, 1.25 / std::sqrt(2.0), 0.05);
+  EXPECT_EQ(r.x(), x);  // the member that left holds
   EXPECT_EQ(r.exec(mclm("m2", "p1", 50)), Err::ServoOffState);
 }
 
