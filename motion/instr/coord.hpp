@@ -13,6 +13,7 @@
 
 #include "motion/coord/path_generator.hpp"
 #include "motion/instr/common.hpp"
+#include "motion/units.hpp"
 
 namespace canmotion::motion {
 
@@ -96,19 +97,6 @@ struct CoordGen : GenBase {
   void on_fold(Core& c, AxisRt& a) noexcept;
 };
 
-/// Speed .. JerkUnits of MCLM, MCCM (same layout) and the limits of MCCD.
-struct CoordDynamics {
-  double speed = 0.0;
-  SpeedUnits speed_units = SpeedUnits::UnitsPerSec;
-  double accel = 0.0;
-  AccelUnits accel_units = AccelUnits::UnitsPerSec2;
-  double decel = 0.0;
-  AccelUnits decel_units = AccelUnits::UnitsPerSec2;
-  ProfileType profile = ProfileType::Trapezoidal;
-  double accel_jerk = 0.0, decel_jerk = 0.0;
-  JerkUnits jerk_units = JerkUnits::UnitsPerSec3;
-};
-
 /// MCLM and MCCM (one params type each; `circle` tells them apart).
 struct CoordMoveParams {
   CoordSystemId cs = 0;
@@ -119,7 +107,7 @@ struct CoordMoveParams {
   std::uint8_t circle_type = 0, direction = 0;
   std::uint16_t aux = 0xFFFF;  ///< REAL[] id of Via/Center/Radius
   double aux_start = 0.0;
-  CoordDynamics dyn{};
+  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
   std::uint8_t termination = 1;
   std::uint8_t merge = 0;
   MergeSpeed merge_speed = MergeSpeed::Programmed;
@@ -161,7 +149,7 @@ struct MccdParams {
   CoordSystemId cs = 0;
   bool change_speed = false, change_accel = false, change_decel = false;
   bool change_accel_jerk = false, change_decel_jerk = false;
-  CoordDynamics dyn{};
+  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
   bool active_and_pending = false;
   static MccdParams decode(const Operands& q) noexcept;
 };

@@ -452,11 +452,12 @@ Err start(Ctx& x, const McdParams& p) noexcept {
   AxisRt& a = x.axis(p.axis);
   if (Err e = x.c.common_checks(a, true); e != Err::None) return e;
   const bool chj = p.change_accel_jerk || p.change_decel_jerk;
-  const bool md = (p.change_speed && is_master_driven(p.speed_units)) || (p.change_accel && is_master_driven(p.accel_units)) ||
-                  (p.change_decel && is_master_driven(p.decel_units)) || (chj && is_master_driven(p.jerk_units));
-  const bool td = (p.change_speed && !is_master_driven(p.speed_units)) || (p.change_accel && !is_master_driven(p.accel_units)) ||
-                  (p.change_decel && !is_master_driven(p.decel_units)) || (chj && !is_master_driven(p.jerk_units));
-  if (md && td) return Err::MdscUnitsConflict;
+  bool md = false;
+  if (Err e = units::changed_units_mode(p.change_speed, p.speed_units, p.change_accel, p.accel_units, p.change_decel,
+                                        p.decel_units, chj, p.jerk_units, md);
+      e != Err::None)
+    return e;
+  const bool td = !md && (p.change_speed || p.change_accel || p.change_decel || chj);  // time-driven units changed
   auto* g = std::get_if<ProfileGen>(&a.gen[index(p.jog ? Slot::Jog : Slot::Move)]);
   if (!g || g->role != (p.jog ? GenRole::Jog : GenRole::Move)) {
     // nothing to change; master-driven units still need an MDAC link of that motion type

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "motion/instr/coord.hpp"
-#include "tests/motion/rig.hpp"
+#include "tests/motion_coord/array_rig.hpp"
 #include "tests/support/allocation_counter.hpp"
 
 namespace canmotion::motion::test {
@@ -20,8 +20,7 @@ bool cs_bit(const CoordSystemTag& t, unsigned b) { return (t.motion_status >> b)
 
 /// Two virtual axes X, Y (servo on), a master M, the coordinate system cs
 /// {X, Y}, REAL arrays p1, p2, p3 (2 elements) and ctr.
-struct CoordRig : Rig {
-  std::vector<std::vector<double>> arrays;
+struct CoordRig : ArrayRig {
   CoordRig(double max_speed = 200, double ratio_y = 1.0) {
     AxisConfig a;
     a.max_speed = 500;
@@ -42,15 +41,8 @@ struct CoordRig : Rig {
     c.command_tolerance = 0.5;
     EXPECT_TRUE(p->configure_coordinate_system(0, c));
     sym.coordinate_systems["cs"] = 0;
-    arrays.reserve(8);
     for (const char* n : {"p1", "p2", "p3", "ctr"}) add_array(n, 2);
     step();
-  }
-  void add_array(const std::string& name, std::size_t n) {
-    arrays.emplace_back(n, 0.0);
-    const auto id = static_cast<std::uint16_t>(arrays.size() - 1);
-    EXPECT_TRUE(p->attach_real_array(id, std::span<double>(arrays.back())));
-    sym.real_arrays[name] = id;
   }
   void set(const std::string& name, double x, double y) {
     auto& a = arrays[sym.real_arrays.at(name)];

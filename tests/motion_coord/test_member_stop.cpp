@@ -16,7 +16,7 @@
 
 #include "motion/instr/coord.hpp"
 #include "tests/motion/prop_util.hpp"
-#include "tests/motion/rig.hpp"
+#include "tests/motion_coord/array_rig.hpp"
 
 namespace canmotion::motion::test {
 namespace {
@@ -28,8 +28,7 @@ bool coord_bit(const AxisTag& t) { return (t.motion_status >> motion_status::Coo
 /// Virtual axes X, Y, Z (servo on) in group g, masters M and M2; the
 /// coordinate system cs {X, Y, Z} (or {X, Y}) with the given ratios and max
 /// decel; REAL arrays p1, p2 (3 elements) and ctr.
-struct MemberRig : Rig {
-  std::vector<std::vector<double>> arrays;
+struct MemberRig : ArrayRig {
   int dim;
   explicit MemberRig(int dim_ = 3, double max_decel = 1000, std::array<double, 3> ratio = {1, 1, 1},
                      AxisConfig a = {}) : dim(dim_) {
@@ -50,15 +49,8 @@ struct MemberRig : Rig {
     c.max_accel_jerk = c.max_decel_jerk = 1e6;
     EXPECT_TRUE(p->configure_coordinate_system(0, c));
     sym.coordinate_systems["cs"] = 0;
-    arrays.reserve(8);
     for (const char* n : {"p1", "p2", "ctr"}) add_array(n, 3);
     step();
-  }
-  void add_array(const std::string& name, std::size_t n) {
-    arrays.emplace_back(n, 0.0);
-    const auto id = static_cast<std::uint16_t>(arrays.size() - 1);
-    EXPECT_TRUE(p->attach_real_array(id, std::span<double>(arrays.back())));
-    sym.real_arrays[name] = id;
   }
   void set(const std::string& name, double x, double y, double z = 0) { arrays[sym.real_arrays.at(name)] = {x, y, z}; }
   const CoordSystemTag& cs() { return p->coordinate_system(0); }
