@@ -497,6 +497,9 @@ TEST(CoordInstr, NoAllocationInTheCycleOrTheInstructions) {
       r.req(mdmove("m3", "p1", 1.0)),
       r.req("MCS(cs, s1, all, no, 0, unitspersec2, no, 0, unitspersec3);"),
       r.req(mclm("m4", "p3", 100)),
+      r.req("MAS(X, sx, all, no, 0, unitspersec2, no, 0, unitspersec3);"),  // the path stops along itself
+      r.req(mclm("m5", "p1", 100)),
+      r.req("MSF(Y, fy);"),  // a member leaves: the other stops along the path
       r.req("MCSD(cs, sd);"),
   };
   canmotion::test::reset_allocation_count();
@@ -508,6 +511,8 @@ TEST(CoordInstr, NoAllocationInTheCycleOrTheInstructions) {
   canmotion::test::count_allocations_on_this_thread(false);
   EXPECT_EQ(canmotion::test::counted_allocations(), 0u);
   EXPECT_TRUE(r.tag("sd").dn());
+  EXPECT_TRUE(r.tag("sx").pc());
+  EXPECT_TRUE(r.tag("fy").dn());
   EXPECT_TRUE(r.p->check_incremental_state());
 }
 
