@@ -21,9 +21,10 @@ fail() { echo "vcan-coordinated: FAIL: $*" >&2; exit 1; }
 
 cfg="$art/coordinated-vcan.yaml"
 "$here/make-vcan-config.sh" "$examples/coordinated.yaml" "$period" > "$cfg"
-# The VM (TCG, loaded host) answers SDOs late: seen aborting the boot
-# configuration at the default 200 ms. Behaviour, not timing, is checked here.
-printf 'drives:\n  timeouts: {sdo_ms: 2000, transition_ms: 5000}\n' >> "$cfg"
+# The VM (TCG, loaded host) answers SDOs late and stalls: seen aborting the boot
+# configuration at the default 200 ms SDO timeout and losing heartbeats after
+# 150 ms. Behaviour, not timing, is checked here: heartbeat 1 s, SDO 2 s.
+printf 'drives:\n  heartbeat_ms: 1000\n  timeouts: {sdo_ms: 2000, transition_ms: 5000}\n' >> "$cfg"
 csv="$art/xy.csv"
 emu_pid=""
 cleanup() { [[ -z "$emu_pid" ]] || { kill -TERM "$emu_pid" 2>/dev/null || true; wait "$emu_pid" 2>/dev/null || true; }; }
