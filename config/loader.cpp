@@ -659,9 +659,9 @@ class Loader {
   CoordinateSystemSettings coordinate_system(const YAML::Node& n, const std::string& path) {
     CoordinateSystemSettings c;
     c.where = loc(n);
-    if (!check_map(n, path, {"name", "axes", "conversion_ratios", "units", "max_speed", "max_accel", "max_decel",
-                             "max_accel_jerk", "max_decel_jerk", "actual_position_tolerance",
-                             "command_position_tolerance"}))
+    if (!check_map(n, path, {"name", "axes", "conversion_ratios", "coordination_modes", "units", "max_speed",
+                             "max_accel", "max_decel", "max_accel_jerk", "max_decel_jerk",
+                             "actual_position_tolerance", "command_position_tolerance"}))
       return c;
     if (required(n, path, "name", "every coordinate system needs a name")) string(n, path, "name", c.name);
     if (required(n, path, "axes", "the member axes in order, 1 to 3 axis names")) {
@@ -687,6 +687,22 @@ class Loader {
           const std::string k = fmt::format("{}.conversion_ratios[{}]", path, i);
           if (finite_number(r[i], k, "", x) && !(x > 0)) error(r[i], k, fmt::format("must be > 0, got {}", x));
           c.conversion_ratios.push_back(x);
+        }
+      }
+    }
+    // Logix's per-member Coordination Mode: only Primary (every member is in
+    // the vector length); Ancillary members are refused (README, "Coordinated motion")
+    if (const YAML::Node m = n["coordination_modes"]) {
+      if (!m.IsSequence() || m.size() != c.axes.size()) {
+        error(m, path + ".coordination_modes", fmt::format("must be a list of {} modes (primary), one per member axis", c.axes.size()));
+      } else {
+        for (std::size_t i = 0; i < m.size(); ++i) {
+          const std::string k = fmt::format("{}.coordination_modes[{}]", path, i);
+          const std::string v = m[i].IsScalar() ? m[i].Scalar() : std::string{};
+          if (v == "ancillary")
+            error(m[i], k, "ancillary members are not supported: every member is primary (part of the vector length)");
+          else if (v != "primary")
+            error(m[i], k, fmt::format("must be primary, got '{}'", v));
         }
       }
     }

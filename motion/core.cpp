@@ -88,6 +88,7 @@ void Core::do_shutdown(AxisRt& a) noexcept {
   a.servo.shutdown = true;
   mdac::break_links(*this, a);                 // MASD/MGSD on a slave ...
   mdac::break_links_of_master(*this, id_of(a));  // ... and on a master
+  coordsys::on_shutdown(*this, id_of(a));        // MDCC links: as a member and as a master
 }
 
 bool Core::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, ControlId owner,
@@ -99,12 +100,20 @@ bool Core::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Contro
   st.post_stop = post_stop;
   st.scurve = !std::isinf(jd);
   st.t0_cycle = cycle;
+  // A member's share of a coordinated path is stopped along the path (the
+  // whole coordinate system at its max decel, reference "MAS All on a
+  // member ... the path is kept"): its slot stays. Not when the servo goes
+  // off after the ramp (FastDisable/FastShutdown): then the servo-off stops
+  // the path for the other members (CoordGen::on_fold).
+  bool path = false;
+  if ((mask & slot_bit(Slot::Coord)) && post_stop == 0) path = coordsys::stop_member_path(*this, a, own);
   if ((mask & kAllSlots) == kAllSlots) {
     // one ramp of the whole motion in Slot::StopAll; the master offset move
     // (master units) is not part of the axis' motion
     Kin tot{};
     bool any = false;
     for (std::size_t s = 0; s < kSlots; ++s) {
+      if (path && s == index(Slot::Coord)) continue;
       if (const GenBase* g = gen_base(a.gen[s]); g && s != index(Slot::MasterOffset)) {
         tot.v += g->k.v;
         tot.a += g->k.a;
@@ -112,12 +121,13 @@ bool Core::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Contro
       }
       fold(a, static_cast<Slot>(s), true);
     }
-    if (!any || (tot.v == 0 && tot.a == 0)) return false;
-    if (!plan_stop(st.prof, Kin{0, tot.v, tot.a}, d, jd)) return false;
+    if (!any || (tot.v == 0 && tot.a == 0)) return path;
+    if (!plan_stop(st.prof, Kin{0, tot.v, tot.a}, d, jd)) return path;
     st.k = Kin{0, tot.v, tot.a};
     set_slot(a, Slot::StopAll, st);
     return true;
   }
+  if (path) mask &= ~slot_bit(Slot::Coord);
   bool any = false;
   for (std::size_t s = 0; s < kSlots; ++s) {
     if (!(mask & (1u << s))) continue;
@@ -132,7 +142,7 @@ bool Core::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Contro
     set_slot(a, static_cast<Slot>(s), one);
     any = true;
   }
-  return any;
+  return any || path;
 }
 
 bool Core::stop_all(AxisRt& a, ControlId owner, std::uint8_t post_stop) noexcept {

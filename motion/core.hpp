@@ -163,6 +163,13 @@ struct Core {
     ControlTag& c = controls[o.id];
     return c.generation == o.gen ? &c : nullptr;  // the tag was re-executed: not ours any more
   }
+  /// An active MGS owns `o`: its ramps end without PC (the MGS gets PC when
+  /// its whole group stopped, stop::finish_group_stops).
+  bool group_owns(OwnerRef o) const noexcept {
+    for (const GroupOp& g : groups)
+      if (g.active && g.owner == o) return true;
+    return false;
+  }
   /// End the generator in slot `s`: its on_fold(), its offset into the base
   /// (a master offset move's into the position cam), its owner's IP, ACCEL,
   /// DECEL, TrackingMaster, AC cleared (if `clear_owner_ip`); the slot empty.

@@ -46,6 +46,7 @@ std::string_view err_name(Err e) noexcept {
     case Err::CircularInfiniteSolutions: return "Circular Infinite Solution Error";
     case Err::CircularNoSolutions: return "Circular No Solutions Error";
     case Err::CircularSmallR: return "Circular Small R Error";
+    case Err::CoordinatedMotionInProcess: return "Coordinated Motion In Process Error";
     case Err::AxisIsInhibited: return "Axis Is Inhibited";
     case Err::ZeroMaxDecel: return "Zero Max Decel";
     case Err::InstructionNotSupported: return "Instruction Not Supported";

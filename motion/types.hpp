@@ -154,6 +154,7 @@ enum class Err : std::int16_t {
   CircularInfiniteSolutions = 47,  ///< MCCM: the circle or its plane is not determined
   CircularNoSolutions = 48,        ///< MCCM: no circle (zero radius)
   CircularSmallR = 49,             ///< MCCM: |Radius| smaller than half the chord
+  CoordinatedMotionInProcess = 52,  ///< MRP/MAH/MDS on a member of a coordinate system while its path moves (reference ?)
   AxisIsInhibited = 53,
   ZeroMaxDecel = 54,
   InstructionNotSupported = 75,

@@ -8,7 +8,39 @@
 #include "motion/profile.hpp"
 #include "motion/types.hpp"
 
+namespace canmotion::motion {
+
+/// Speed .. JerkUnits as a program writes them: the rate operands of MAM and
+/// MAJ (`Dynamics`), MCLM and MCCM (`CoordMoveParams`) and MCCD.
+struct RateOperands {
+  double speed = 0.0;
+  SpeedUnits speed_units = SpeedUnits::UnitsPerSec;
+  double accel = 0.0;
+  AccelUnits accel_units = AccelUnits::UnitsPerSec2;
+  double decel = 0.0;
+  AccelUnits decel_units = AccelUnits::UnitsPerSec2;
+  ProfileType profile = ProfileType::Trapezoidal;
+  double accel_jerk = 0.0;
+  double decel_jerk = 0.0;
+  JerkUnits jerk_units = JerkUnits::UnitsPerSec3;
+};
+
+}  // namespace canmotion::motion
+
 namespace canmotion::motion::units {
+
+/// MCD and MCCD: the mode of the values they change (Change... = yes; `jerk`:
+/// either jerk). All of one mode (seed 001: Accel, Decel and Jerk in the
+/// Speed's units), else ERR 94 MDSC_UNITS_CONFLICT; `md`: master-driven
+/// units (false when nothing changes).
+constexpr Err changed_units_mode(bool speed, SpeedUnits su, bool accel, AccelUnits au, bool decel, AccelUnits du,
+                                 bool jerk, JerkUnits ju, bool& md) noexcept {
+  md = (speed && is_master_driven(su)) || (accel && is_master_driven(au)) || (decel && is_master_driven(du)) ||
+       (jerk && is_master_driven(ju));
+  const bool td = (speed && !is_master_driven(su)) || (accel && !is_master_driven(au)) ||
+                  (decel && !is_master_driven(du)) || (jerk && !is_master_driven(ju));
+  return md && td ? Err::MdscUnitsConflict : Err::None;
+}
 
 /// `v` % of `max`. The one formula of %ofMaximum (v / 100 * max: the order
 /// of the operations is part of the results).

@@ -184,6 +184,10 @@ class PathGenerator {
   bool stopping() const noexcept { return stopping_; }
   std::uint32_t active_id() const noexcept { return has_head_ && !head_.pc ? head_.rq.id : 0; }
   std::uint32_t pending_id() const noexcept { return has_pending_ ? pending_.rq.id : 0; }
+  /// The id of the stop that runs (0: none).
+  std::uint32_t stop_id() const noexcept { return stopping_ ? stop_id_ : 0; }
+  /// The head (active move) runs on the master's travel.
+  bool master_driven() const noexcept { return has_head_ && ht_.clock == Clock::Master; }
   const Vec3& position() const noexcept { return pos_; }
   double speed() const noexcept { return speed_; }
   const SystemConfig& config() const noexcept { return cfg_; }

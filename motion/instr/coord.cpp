@@ -29,8 +29,8 @@ std::span<const double> array_from(const Core& c, std::uint16_t ref, double star
 
 // Speed .. JerkUnits, the same positions in MCLM/MCCM and MCCD's value operands.
 template <Instr I>
-CoordDynamics decode_dynamics(const Operands& q) noexcept {
-  CoordDynamics y;
+RateOperands decode_dynamics(const Operands& q) noexcept {
+  RateOperands y;
   y.speed = q.real(op<I>("Speed"));
   y.speed_units = q.enumeration<SpeedUnits>(op<I>("SpeedUnits"));
   y.accel = q.real(op<I>("AccelRate"));
@@ -66,11 +66,6 @@ P decode_move(const Operands& q) noexcept {
   return p;
 }
 
-/// The coordinate system of an execution, or null (ERR 11 then).
-CoordSystemRt* system(Core& c, CoordSystemId id) noexcept {
-  return id < kMaxCoordSystems && c.systems[id].present ? &c.systems[id] : nullptr;
-}
-
 /// The checks of a move on every member: ERR 11, 53, 7, 20, 5, 87; 39 when
 /// a member runs a move of another coordinate system (an axis may belong to
 /// several systems, moved by one at a time).
@@ -86,7 +81,7 @@ Err member_checks(const Core& c, const CoordSystemRt& s) noexcept {
 
 /// Vector limits of a move or MCCD in coordination units (per second, or
 /// per master unit when master-driven). ERR 94 mixed modes, 13 out of range.
-Err convert_dynamics(Ctx& x, const CoordDynamics& y, const CoordSystemConfig& cfg, bool scurve, int first,
+Err convert_dynamics(Ctx& x, const RateOperands& y, const CoordSystemConfig& cfg, bool scurve, int first,
                      Limits& lim, bool& md) noexcept {
   md = is_master_driven(y.speed_units);
   if (is_master_driven(y.accel_units) != md || is_master_driven(y.decel_units) != md ||
@@ -154,10 +149,8 @@ Err build_request(Ctx& x, const CoordMoveParams& p, const CoordSystemRt& s, coor
   return Err::None;
 }
 
-Err start_move(Ctx& x, const CoordMoveParams& p) noexcept {
-  CoordSystemRt* sp = system(x.c, p.cs);
-  if (!sp) return Err::AxisNotConfigured;
-  CoordSystemRt& s = *sp;
+/// MCLM, MCCM.
+Err run(Ctx& x, CoordSystemRt& s, const CoordMoveParams& p) noexcept {
   if (Err e = member_checks(x.c, s); e != Err::None) return e;
   coord::MoveRequest rq;
   if (Err e = build_request(x, p, s, rq); e != Err::None) return e;
@@ -201,8 +194,6 @@ MccmParams MccmParams::decode(const Operands& q) noexcept {
   return p;
 }
 
-Err start(Ctx& x, const MclmParams& p) noexcept { return start_move(x, p); }
-Err start(Ctx& x, const MccmParams& p) noexcept { return start_move(x, p); }
 
 McsParams McsParams::decode(const Operands& q) noexcept {
   constexpr Instr I = kInstr;
@@ -218,11 +209,8 @@ McsParams McsParams::decode(const Operands& q) noexcept {
   return p;
 }
 
-Err start(Ctx& x, const McsParams& p) noexcept {
+static Err run(Ctx& x, CoordSystemRt& s, const McsParams& p) noexcept {
   constexpr Instr I = Instr::MCS;
-  CoordSystemRt* sp = system(x.c, p.cs);
-  if (!sp) return Err::AxisNotConfigured;
-  CoordSystemRt& s = *sp;
   // the system's max decel; trapezoidal unless ChangeDecelJerk gives a jerk (README choices)
   double d = s.cfg.max_decel, jd = kInf;
   if (p.change_decel &&
@@ -245,16 +233,8 @@ Err start(Ctx& x, const McsParams& p) noexcept {
       if (a.servo.on) x.c.stop_slots(a, others, a.cfg.max_decel > 0 ? a.cfg.max_decel : 1e12, kInf, kNoControl, 0);
     }
   }
-  auto it = std::find_if(s.owners.begin(), s.owners.end(), [](const auto& o) { return o.id == 0; });
-  if (it == s.owners.end()) return Err::CoordinateSystemQueueFull;
-  coord::Events ev;
-  if (s.fold_due && !s.path.moving()) coordsys::settle(x.c, s);
-  const std::uint32_t id = s.next_id;
-  s.next_id = s.next_id == 0xFFFFFFFFu ? 1 : s.next_id + 1;
-  *it = CoordSystemRt::Owner{id, x.self};
   x.tag.set(flag::IP, true);
-  s.path.stop(id, d, jd, ev);
-  coordsys::apply_events(x.c, s, ev);
+  coordsys::start_stop(x.c, s, x.self, d, jd);
   return Err::None;
 }
 
@@ -264,10 +244,7 @@ McsdParams McsdParams::decode(const Operands& q) noexcept {
   return p;
 }
 
-Err start(Ctx& x, const McsdParams& p) noexcept {
-  CoordSystemRt* sp = system(x.c, p.cs);
-  if (!sp) return Err::AxisNotConfigured;
-  CoordSystemRt& s = *sp;
+static Err run(Ctx& x, CoordSystemRt& s, const McsdParams&) noexcept {
   coordsys::drop(x.c, s);          // queue cleared, the moves' IP cleared
   coordsys::break_links(x.c, s);   // MDCC links broken
   for (int i = 0; i < s.cfg.dim; ++i) {
@@ -292,21 +269,15 @@ MccdParams MccdParams::decode(const Operands& q) noexcept {
   return p;
 }
 
-Err start(Ctx& x, const MccdParams& p) noexcept {
+static Err run(Ctx& x, CoordSystemRt& s, const MccdParams& p) noexcept {
   constexpr Instr I = Instr::MCCD;
-  CoordSystemRt* sp = system(x.c, p.cs);
-  if (!sp) return Err::AxisNotConfigured;
-  CoordSystemRt& s = *sp;
   // the units of the changed values: all of one mode (94); the other mode than the move's: 105 (seed 001)
-  const bool md = (p.change_speed && is_master_driven(p.dyn.speed_units)) ||
-                  (p.change_accel && is_master_driven(p.dyn.accel_units)) ||
-                  (p.change_decel && is_master_driven(p.dyn.decel_units)) ||
-                  ((p.change_accel_jerk || p.change_decel_jerk) && is_master_driven(p.dyn.jerk_units));
-  const bool td = (p.change_speed && !is_master_driven(p.dyn.speed_units)) ||
-                  (p.change_accel && !is_master_driven(p.dyn.accel_units)) ||
-                  (p.change_decel && !is_master_driven(p.dyn.decel_units)) ||
-                  ((p.change_accel_jerk || p.change_decel_jerk) && !is_master_driven(p.dyn.jerk_units));
-  if (md && td) return Err::MdscUnitsConflict;
+  bool md = false;
+  if (Err e = units::changed_units_mode(p.change_speed, p.dyn.speed_units, p.change_accel, p.dyn.accel_units,
+                                        p.change_decel, p.dyn.decel_units, p.change_accel_jerk || p.change_decel_jerk,
+                                        p.dyn.jerk_units, md);
+      e != Err::None)
+    return e;
   coord::DynamicsChange ch;
   ch.change_speed = p.change_speed;
   ch.change_accel = p.change_accel;
@@ -351,10 +322,7 @@ MdccParams MdccParams::decode(const Operands& q) noexcept {
   return p;
 }
 
-Err start(Ctx& x, const MdccParams& p) noexcept {
-  CoordSystemRt* sp = system(x.c, p.cs);
-  if (!sp) return Err::AxisNotConfigured;
-  CoordSystemRt& s = *sp;
+static Err run(Ctx& x, CoordSystemRt& s, const MdccParams& p) noexcept {
   for (int i = 0; i < s.cfg.dim; ++i)
     if (s.cfg.axes[static_cast<std::size_t>(i)] == p.master) return Err::MasterAxisConflict;  // master in the slave system
   const AxisRt& m = x.c.axes[p.master];
@@ -380,5 +348,22 @@ Err start(Ctx& x, const MdccParams& p) noexcept {
   coordsys::refresh_link_master(x.c, s);
   return Err::None;
 }
+
+namespace {
+/// The coordinate system an execution names, handed to the instruction's
+/// `run`; ERR 11 when it is not configured.
+template <class P>
+Err on_system(Ctx& x, const P& p) noexcept {
+  if (p.cs >= kMaxCoordSystems || !x.c.systems[p.cs].present) return Err::AxisNotConfigured;
+  return run(x, x.c.systems[p.cs], p);
+}
+}  // namespace
+
+Err start(Ctx& x, const MclmParams& p) noexcept { return on_system(x, p); }
+Err start(Ctx& x, const MccmParams& p) noexcept { return on_system(x, p); }
+Err start(Ctx& x, const McsParams& p) noexcept { return on_system(x, p); }
+Err start(Ctx& x, const McsdParams& p) noexcept { return on_system(x, p); }
+Err start(Ctx& x, const MccdParams& p) noexcept { return on_system(x, p); }
+Err start(Ctx& x, const MdccParams& p) noexcept { return on_system(x, p); }
 
 }  // namespace canmotion::motion

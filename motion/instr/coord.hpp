@@ -13,6 +13,7 @@
 
 #include "motion/coord/path_generator.hpp"
 #include "motion/instr/common.hpp"
+#include "motion/units.hpp"
 
 namespace canmotion::motion {
 
@@ -65,6 +66,7 @@ struct CoordSystemRt {
     std::uint16_t cd = 0xFFFF;  ///< CalculatedData REAL[] id (0xFFFF none)
     std::uint16_t ed = 0xFFFF;  ///< EventDistance REAL[] id
     double cd_start = 0.0, ed_start = 0.0;
+    bool stop = false;  ///< a path stop (MCS, MAS All, MGS, a member that left), not a move
   };
   CoordSystemConfig cfg{};
   bool present = false;
@@ -95,19 +97,6 @@ struct CoordGen : GenBase {
   void on_fold(Core& c, AxisRt& a) noexcept;
 };
 
-/// Speed .. JerkUnits of MCLM, MCCM (same layout) and the limits of MCCD.
-struct CoordDynamics {
-  double speed = 0.0;
-  SpeedUnits speed_units = SpeedUnits::UnitsPerSec;
-  double accel = 0.0;
-  AccelUnits accel_units = AccelUnits::UnitsPerSec2;
-  double decel = 0.0;
-  AccelUnits decel_units = AccelUnits::UnitsPerSec2;
-  ProfileType profile = ProfileType::Trapezoidal;
-  double accel_jerk = 0.0, decel_jerk = 0.0;
-  JerkUnits jerk_units = JerkUnits::UnitsPerSec3;
-};
-
 /// MCLM and MCCM (one params type each; `circle` tells them apart).
 struct CoordMoveParams {
   CoordSystemId cs = 0;
@@ -118,7 +107,7 @@ struct CoordMoveParams {
   std::uint8_t circle_type = 0, direction = 0;
   std::uint16_t aux = 0xFFFF;  ///< REAL[] id of Via/Center/Radius
   double aux_start = 0.0;
-  CoordDynamics dyn{};
+  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
   std::uint8_t termination = 1;
   std::uint8_t merge = 0;
   MergeSpeed merge_speed = MergeSpeed::Programmed;
@@ -160,7 +149,7 @@ struct MccdParams {
   CoordSystemId cs = 0;
   bool change_speed = false, change_accel = false, change_decel = false;
   bool change_accel_jerk = false, change_decel_jerk = false;
-  CoordDynamics dyn{};
+  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
   bool active_and_pending = false;
   static MccdParams decode(const Operands& q) noexcept;
 };
@@ -190,12 +179,36 @@ bool configure(Core& c, CoordSystemId id, const CoordSystemConfig& cfg) noexcept
 /// One cycle of a coordinate system: its path stepped, the events written
 /// to the control tags, its tag. Called by the first member that steps.
 void step_system(Core& c, CoordSystemRt& s) noexcept;
-/// Drop the path at once (MCSD, a member's servo off / shutdown / fault):
-/// every move ends (IP cleared), the members hold where they are.
+/// Drop the path at once (MCSD, the last member following it left): every
+/// move ends (IP cleared), the members hold where they are.
 /// `folding`: a member whose slot is being folded by the caller.
 void drop(Core& c, CoordSystemRt& s, const AxisRt* folding = nullptr) noexcept;
 /// Break the MDCC links of the system (MCS All, MCSD; a member or master shut down).
 void break_links(Core& c, CoordSystemRt& s) noexcept;
+/// Start a stop along the path at decel `d` / jerk `jd` (MCS) for `owner`:
+/// the active and pending moves end (IP, AC cleared, no PC), StoppingStatus
+/// until standstill, then StopDone. A stop that runs is superseded.
+void start_stop(Core& c, CoordSystemRt& s, OwnerRef owner, double d, double jd) noexcept;
+/// Stop the path along itself at the system's max decel (trapezoidal, as
+/// MCS without ChangeDecel) for `owner` (none: an exception or a member that
+/// left), unless a stop for that owner runs already. True when the path moves.
+bool path_stop(Core& c, CoordSystemRt& s, OwnerRef owner) noexcept;
+/// A member stops all its motion (MAS All, MGS, a Stop Planner exception):
+/// the path of its coordinate system stops along itself, the member keeps
+/// following it (reference: "the path is kept"). True when a path moves.
+bool stop_member_path(Core& c, AxisRt& a, OwnerRef owner) noexcept;
+/// A path stop for `owner` runs (MAS All / MGS get PC when it ends).
+bool stop_owned_by(const Core& c, OwnerRef owner) noexcept;
+/// MRP, MAH, MDS on a member while its coordinate system's path moves:
+/// ERR 52 (Coordinated Motion In Process, reference ?).
+Err check_no_coordinated_motion(const Core& c, const AxisRt& a) noexcept;
+/// MAS All, MGS on a member: the MDCC links of its coordinate systems break.
+void break_member_links(Core& c, AxisId axis) noexcept;
+/// An axis shut down (MASD, MGSD, MCSD, a Shutdown fault): the MDCC links of
+/// the systems it is a member or the master of break (seed 001, p.531); a
+/// master-driven path of a system whose master was shut down stops along
+/// itself (time-driven, max decel) instead of waiting for a master that is gone.
+void on_shutdown(Core& c, AxisId axis) noexcept;
 /// The tag of every coordinate system (status words, positions): after the
 /// axes stepped. Realtime-safe.
 void update_tags(Core& c) noexcept;

@@ -5,6 +5,7 @@
 // allocation-free.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "motion/core.hpp"
 #include "motion/instr/coord.hpp"
@@ -29,6 +30,21 @@ CoordGen* slot_of(AxisRt& a, CoordSystemId id) noexcept {
 
 CoordSystemId id_of(const Core& c, const CoordSystemRt& s) noexcept {
   return static_cast<CoordSystemId>(&s - c.systems.data());
+}
+
+bool is_member(const CoordSystemRt& s, AxisId axis) noexcept {
+  for (int i = 0; i < s.cfg.dim; ++i)
+    if (s.cfg.axes[static_cast<std::size_t>(i)] == axis) return true;
+  return false;
+}
+
+/// A single-axis stop ramp of `owner` still runs on a member (MAS All: the
+/// member's other motion; its PC waits for both).
+bool ramp_owned_by(Core& c, const CoordSystemRt& s, OwnerRef owner) noexcept {
+  for (int i = 0; i < s.cfg.dim; ++i)
+    for (const auto& g : member(c, s, i).gen)
+      if (auto* p = std::get_if<ProfileGen>(&g); p && p->role == GenRole::Stop && p->owner == owner) return true;
+  return false;
 }
 
 /// EventDistance / CalculatedData of the move that just went active.
@@ -129,6 +145,9 @@ void apply_events(Core& c, CoordSystemRt& s, const coord::Events& ev) noexcept {
     CoordSystemRt::Owner* o = find_owner(s, e.id);
     if (!o) continue;
     ControlTag* t = c.tag(o->owner);
+    // a stop of an MGS (its PC when the whole group stopped: stop::finish_group_stops),
+    // or of an MAS All whose single-axis ramp still runs (that ramp ends it)
+    if (t && o->stop && (c.group_owns(o->owner) || ramp_owned_by(c, s, o->owner))) t = nullptr;
     switch (e.kind) {
       case coord::EventKind::Activated:
         if (t) t->set(flag::AC, true);
@@ -167,6 +186,64 @@ void drop(Core& c, CoordSystemRt& s, const AxisRt* folding) noexcept {
   s.path.clear(ev);
   apply_events(c, s, ev);
   settle(c, s, folding);
+}
+
+void start_stop(Core& c, CoordSystemRt& s, OwnerRef owner, double d, double jd) noexcept {
+  if (s.fold_due && !s.path.moving()) settle(c, s);
+  // a free owner entry always exists: the path holds an active, a pending
+  // move and a stop (superseded by this one), 4 entries
+  auto it = std::find_if(s.owners.begin(), s.owners.end(), [](const auto& o) { return o.id == 0; });
+  const std::uint32_t id = s.next_id;
+  s.next_id = s.next_id == 0xFFFFFFFFu ? 1 : s.next_id + 1;
+  if (it != s.owners.end()) {
+    *it = CoordSystemRt::Owner{id, owner};
+    it->stop = true;
+  }
+  coord::Events ev;
+  s.path.stop(id, d, jd, ev);
+  apply_events(c, s, ev);
+}
+
+bool path_stop(Core& c, CoordSystemRt& s, OwnerRef owner) noexcept {
+  if (!s.path.moving()) return false;
+  if (const CoordSystemRt::Owner* o = find_owner(s, s.path.stop_id()); o && o->owner == owner) return true;
+  start_stop(c, s, owner, s.cfg.max_decel, std::numeric_limits<double>::infinity());
+  return true;
+}
+
+bool stop_member_path(Core& c, AxisRt& a, OwnerRef owner) noexcept {
+  const auto* g = std::get_if<CoordGen>(&a.gen[index(Slot::Coord)]);
+  return g && path_stop(c, c.systems[g->cs], owner);
+}
+
+bool stop_owned_by(const Core& c, OwnerRef owner) noexcept {
+  for (const CoordSystemRt& s : c.systems) {
+    if (!s.present || !s.path.stopping()) continue;
+    for (const auto& o : s.owners)
+      if (o.id != 0 && o.id == s.path.stop_id() && o.owner == owner) return true;
+  }
+  return false;
+}
+
+Err check_no_coordinated_motion(const Core& c, const AxisRt& a) noexcept {
+  const auto* g = std::get_if<CoordGen>(&a.gen[index(Slot::Coord)]);
+  return g && c.systems[g->cs].path.moving() ? Err::CoordinatedMotionInProcess : Err::None;
+}
+
+void break_member_links(Core& c, AxisId axis) noexcept {
+  for (CoordSystemRt& s : c.systems)
+    if (s.present && is_member(s, axis) && (s.link.valid() || s.pending.valid())) break_links(c, s);
+}
+
+void on_shutdown(Core& c, AxisId axis) noexcept {
+  for (CoordSystemRt& s : c.systems) {
+    if (!s.present) continue;
+    const bool master = s.link.master == axis || s.pending.master == axis;
+    if (master && s.path.master_driven()) path_stop(c, s, OwnerRef{});  // its master is gone
+    if (master || is_member(s, axis)) {
+      if (s.link.valid() || s.pending.valid()) break_links(c, s);
+    }
+  }
 }
 
 void take_pending_link(Core& c, CoordSystemRt& s) noexcept {
@@ -244,10 +321,21 @@ void CoordGen::step(Core& c, AxisRt& a, Slot s) noexcept {
 }
 
 void CoordGen::on_fold(Core& c, AxisRt& a) noexcept {
-  // A member's slot taken away while the path runs (servo off, shutdown, a
-  // fault, MAS All): the path is dropped and the other members hold.
+  // A member's slot taken away while the path runs (servo off: MSF, a drive
+  // that left Operation Enabled, a Stop Drive fault; shutdown: MASD, MGSD, a
+  // Shutdown fault): the moves end and the path stops along itself at the
+  // system's max decel, the other members following it (reference: "path-stop
+  // the other members"). The last member that leaves drops the path.
   CoordSystemRt& sys = c.systems[cs];
-  if (!sys.dropping && sys.path.moving()) coordsys::drop(c, sys, &a);  // `a` is folding already
+  if (sys.dropping || !sys.path.moving()) return;
+  bool others = false;
+  for (int i = 0; i < sys.cfg.dim; ++i) {
+    const AxisRt& m = c.axes[sys.cfg.axes[static_cast<std::size_t>(i)]];
+    const auto* g = std::get_if<CoordGen>(&m.gen[index(Slot::Coord)]);
+    others = others || (&m != &a && g && g->cs == cs);
+  }
+  if (others) coordsys::path_stop(c, sys, OwnerRef{});
+  else coordsys::drop(c, sys, &a);  // `a` is folding already
 }
 
 }  // namespace canmotion::motion

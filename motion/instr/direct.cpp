@@ -20,6 +20,7 @@ MdsParams MdsParams::decode(const Operands& q) noexcept {
 Err start(Ctx& x, const MdsParams& p) noexcept {
   AxisRt& a = x.axis(p.axis);
   if (Err e = x.c.common_checks(a, false); e != Err::None) return e;
+  if (Err e = coordsys::check_no_coordinated_motion(x.c, a); e != Err::None) return e;  // ERR 52
   if (a.cfg.type != AxisType::CipDrive) return Err::WrongAxisType;  // AXIS_CIP_DRIVE only [seed 002]
   // "validated if the CIP drive device supports the ramp attributes" [seed 002]:
   // here, if the axis has direct_control: (ramps written at boot)

@@ -15,6 +15,7 @@ MrpParams MrpParams::decode(const Operands& q) noexcept {
 Err start(Ctx& x, const MahParams& p) noexcept {
   AxisRt& a = x.axis(p.axis);
   if (Err e = x.c.common_checks(a, false); e != Err::None) return e;
+  if (Err e = coordsys::check_no_coordinated_motion(x.c, a); e != Err::None) return e;  // ERR 52
   if (a.direct.status) return Err::NotAllowedWhileInDirectMotion;
   if (a.hs.homing) return Err::HomeInProcess;
   const HomingConfig& h = a.cfg.homing;
@@ -49,6 +50,7 @@ Err start(Ctx& x, const MrpParams& prm) noexcept {
   AxisRt& a = x.axis(prm.axis);
   if (!a.cfg.configured) return Err::AxisNotConfigured;
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
+  if (Err e = coordsys::check_no_coordinated_motion(x.c, a); e != Err::None) return e;  // ERR 52
   if (a.direct.status) return Err::NotAllowedWhileInDirectMotion;
   if (a.hs.homing) return Err::HomeInProcess;
   double delta = prm.position;

@@ -452,11 +452,12 @@ Err start(Ctx& x, const McdParams& p) noexcept {
   AxisRt& a = x.axis(p.axis);
   if (Err e = x.c.common_checks(a, true); e != Err::None) return e;
   const bool chj = p.change_accel_jerk || p.change_decel_jerk;
-  const bool md = (p.change_speed && is_master_driven(p.speed_units)) || (p.change_accel && is_master_driven(p.accel_units)) ||
-                  (p.change_decel && is_master_driven(p.decel_units)) || (chj && is_master_driven(p.jerk_units));
-  const bool td = (p.change_speed && !is_master_driven(p.speed_units)) || (p.change_accel && !is_master_driven(p.accel_units)) ||
-                  (p.change_decel && !is_master_driven(p.decel_units)) || (chj && !is_master_driven(p.jerk_units));
-  if (md && td) return Err::MdscUnitsConflict;
+  bool md = false;
+  if (Err e = units::changed_units_mode(p.change_speed, p.speed_units, p.change_accel, p.accel_units, p.change_decel,
+                                        p.decel_units, chj, p.jerk_units, md);
+      e != Err::None)
+    return e;
+  const bool td = !md && (p.change_speed || p.change_accel || p.change_decel || chj);  // time-driven units changed
   auto* g = std::get_if<ProfileGen>(&a.gen[index(p.jog ? Slot::Jog : Slot::Move)]);
   if (!g || g->role != (p.jog ? GenRole::Jog : GenRole::Move)) {
     // nothing to change; master-driven units still need an MDAC link of that motion type
@@ -499,16 +500,15 @@ void ProfileGen::finish(Core& c, AxisRt& a, Slot s, ControlTag* t) noexcept {
     }
   }
   const std::uint8_t post = post_stop;
-  // ramps of an MGS: the MGS gets PC when every axis of its group stopped
-  bool group_owned = false;
-  for (const auto& go : c.groups)
-    if (go.active && go.owner == owner) group_owned = true;
-  if (t && !group_owned) {
+  // ramps of an MGS: the MGS gets PC when every axis of its group stopped;
+  // an MAS All whose coordinate system still stops along its path: PC then
+  const bool later = c.group_owns(owner) || (role == GenRole::Stop && coordsys::stop_owned_by(c, owner));
+  if (t && !later) {
     t->set(flag::PC, true);
     t->set(flag::ACCEL, false);
     t->set(flag::DECEL, false);
   }
-  c.fold(a, s, !group_owned);  // *this is gone from here on
+  c.fold(a, s, !later);  // *this is gone from here on
   if (post == 1) c.servo_off(a);
   if (post == 2) c.do_shutdown(a);
 }

@@ -8,6 +8,7 @@
 
 #include "motion/instr/common.hpp"
 #include "motion/master_follow.hpp"
+#include "motion/units.hpp"
 
 namespace canmotion::motion {
 
@@ -50,17 +51,7 @@ struct ProfileGen : GenBase {
 };
 
 /// Speed .. LockDirection, laid out identically in MAM and MAJ.
-struct Dynamics {
-  double speed = 0.0;
-  SpeedUnits speed_units = SpeedUnits::UnitsPerSec;
-  double accel = 0.0;
-  AccelUnits accel_units = AccelUnits::UnitsPerSec2;
-  double decel = 0.0;
-  AccelUnits decel_units = AccelUnits::UnitsPerSec2;
-  ProfileType profile = ProfileType::Trapezoidal;
-  double accel_jerk = 0.0;
-  double decel_jerk = 0.0;
-  JerkUnits jerk_units = JerkUnits::UnitsPerSec3;
+struct Dynamics : RateOperands {
   Merge merge = Merge::Disabled;
   MergeSpeed merge_speed = MergeSpeed::Programmed;
   double lock_position = 0.0;

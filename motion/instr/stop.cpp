@@ -109,7 +109,10 @@ Err start(Ctx& x, const MasParams& p) noexcept {
     if (a.cfg.type == AxisType::CipDrive) a.base = a.fb_pos;
   }
   const bool ramping = a.servo.on && mask != 0 && x.c.stop_slots(a, mask, d, jd, x.self.id, 0);
-  if (type == StopType::All) mdac::break_links(x.c, a);  // MAS All on the slave breaks its MDAC links
+  if (type == StopType::All) {
+    mdac::break_links(x.c, a);                    // MAS All on the slave breaks its MDAC links,
+    coordsys::break_member_links(x.c, p.axis);    // and on a member its systems' MDCC links (seed 001)
+  }
   if (type == StopType::All || type == StopType::TimeCam) time_cam::drop_pending(x.c, a);
   if (type == StopType::All || type == StopType::PositionCam) position_cam::drop_pending(x.c, a);
   if ((type == StopType::All || type == StopType::DirectControl) && a.direct.active) {
@@ -169,6 +172,7 @@ void finish_group_stops(Core& c) noexcept {
     for (std::size_t i = 0; i < c.axis_count && !any; ++i)
       for (const auto& s : c.axes[i].gen)
         if (auto* p = std::get_if<ProfileGen>(&s); p && p->owner == g.owner) any = true;
+    any = any || coordsys::stop_owned_by(c, g.owner);  // a coordinate system still stops along its path
     if (!any) {
       if (ControlTag* t = c.tag(g.owner)) {
         t->set(flag::IP, false);
@@ -182,6 +186,7 @@ void finish_group_stops(Core& c) noexcept {
 bool programmed_stop(Core& c, AxisRt& a, ProgrammedStopMode m, ControlId owner) noexcept {
   if (a.hs.homing) home::cancel(c, a);
   mdac::break_links(c, a);
+  coordsys::break_member_links(c, c.id_of(a));  // MGS on a member breaks the MDCC links (seed 001)
   if (m == ProgrammedStopMode::HardDisable) {
     c.servo_off(a);
     return false;

@@ -73,6 +73,24 @@ TEST(ConfigCoordinateSystems, RatiosMustMatchTheMembers) {
   EXPECT_NE(e.find("coordinate_systems[0].conversion_ratios: must be a list of 2 numbers > 0"), std::string::npos) << e;
 }
 
+TEST(ConfigCoordinateSystems, AncillaryMembersAreRefused) {
+  const std::string e = errors_of(kHead + R"(coordinate_systems:
+  - {name: XY, axes: [X, Y], coordination_modes: [primary, ancillary], max_speed: 1, max_accel: 1, max_decel: 1}
+  - {name: YZ, axes: [Y, Z], coordination_modes: [primary, second], max_speed: 1, max_accel: 1, max_decel: 1}
+  - {name: XZ, axes: [X, Z], coordination_modes: [primary], max_speed: 1, max_accel: 1, max_decel: 1}
+)");
+  EXPECT_NE(e.find("cs.yaml:8:60: error: coordinate_systems[0].coordination_modes[1]: ancillary members are not supported: "
+                   "every member is primary (part of the vector length)"),
+            std::string::npos) << e;
+  EXPECT_NE(e.find("coordinate_systems[1].coordination_modes[1]: must be primary, got 'second'"), std::string::npos) << e;
+  EXPECT_NE(e.find("coordinate_systems[2].coordination_modes: must be a list of 2 modes (primary), one per member axis"),
+            std::string::npos) << e;
+  const Config c = load_string(kHead + R"(coordinate_systems:
+  - {name: XY, axes: [X, Y], coordination_modes: [primary, primary], max_speed: 1, max_accel: 1, max_decel: 1}
+)", "cs.yaml");
+  EXPECT_EQ(c.coordinate_systems.size(), 1u);
+}
+
 TEST(ConfigCoordinateSystems, RuntimeRunsAnMclmAndReadsTheTags) {
   const Config c = load_string(kHead + R"(coordinate_systems:
   - {name: XY, axes: [X, Y], max_speed: 200, max_accel: 1000, max_decel: 1000}

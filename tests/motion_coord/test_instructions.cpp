@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "motion/instr/coord.hpp"
-#include "tests/motion/rig.hpp"
+#include "tests/motion_coord/array_rig.hpp"
 #include "tests/support/allocation_counter.hpp"
 
 namespace canmotion::motion::test {
@@ -20,8 +20,7 @@ bool cs_bit(const CoordSystemTag& t, unsigned b) { return (t.motion_status >> b)
 
 /// Two virtual axes X, Y (servo on), a master M, the coordinate system cs
 /// {X, Y}, REAL arrays p1, p2, p3 (2 elements) and ctr.
-struct CoordRig : Rig {
-  std::vector<std::vector<double>> arrays;
+struct CoordRig : ArrayRig {
   CoordRig(double max_speed = 200, double ratio_y = 1.0) {
     AxisConfig a;
     a.max_speed = 500;
@@ -42,15 +41,8 @@ struct CoordRig : Rig {
     c.command_tolerance = 0.5;
     EXPECT_TRUE(p->configure_coordinate_system(0, c));
     sym.coordinate_systems["cs"] = 0;
-    arrays.reserve(8);
     for (const char* n : {"p1", "p2", "p3", "ctr"}) add_array(n, 2);
     step();
-  }
-  void add_array(const std::string& name, std::size_t n) {
-    arrays.emplace_back(n, 0.0);
-    const auto id = static_cast<std::uint16_t>(arrays.size() - 1);
-    EXPECT_TRUE(p->attach_real_array(id, std::span<double>(arrays.back())));
-    sym.real_arrays[name] = id;
   }
   void set(const std::string& name, double x, double y) {
     auto& a = arrays[sym.real_arrays.at(name)];
@@ -262,16 +254,18 @@ TEST(CoordInstr, McsdShutsTheMembersDownAndEndsEverything) {
   EXPECT_EQ(r.exec(mclm("m2", "p1", 50)), Err::ShutdownState);
 }
 
-TEST(CoordInstr, MemberServoOffDropsThePath) {
-  CoordRig r;
+TEST(CoordInstr, MemberServoOffStopsTheOtherMemberAlongThePath) {
+  CoordRig r;  // max decel 1000
   r.set("p1", 50, 50);
   ASSERT_EQ(r.exec(mclm("m1", "p1", 50)), Err::None);
   r.step(100);
   ASSERT_EQ(r.exec("MSF(X, f);"), Err::None);
   EXPECT_FALSE(r.tag("m1").ip());
-  const double y = r.y();
-  r.step(10);
-  EXPECT_EQ(r.y(), y);  // the other member holds
+  const double y = r.y(), x = r.x();
+  r.step(100);
+  // the other member stops along the path: 50^2 / (2 * 1000) of travel, Y's share 1/sqrt(2) of it
+  EXPECT_NEAR(r.y() - y, 1.25 / std::sqrt(2.0), 0.05);
+  EXPECT_EQ(r.x(), x);  // the member that left holds
   EXPECT_EQ(r.exec(mclm("m2", "p1", 50)), Err::ServoOffState);
 }
 
@@ -503,6 +497,9 @@ TEST(CoordInstr, NoAllocationInTheCycleOrTheInstructions) {
       r.req(mdmove("m3", "p1", 1.0)),
       r.req("MCS(cs, s1, all, no, 0, unitspersec2, no, 0, unitspersec3);"),
       r.req(mclm("m4", "p3", 100)),
+      r.req("MAS(X, sx, all, no, 0, unitspersec2, no, 0, unitspersec3);"),  // the path stops along itself
+      r.req(mclm("m5", "p1", 100)),
+      r.req("MSF(Y, fy);"),  // a member leaves: the other stops along the path
       r.req("MCSD(cs, sd);"),
   };
   canmotion::test::reset_allocation_count();
@@ -514,6 +511,8 @@ TEST(CoordInstr, NoAllocationInTheCycleOrTheInstructions) {
   canmotion::test::count_allocations_on_this_thread(false);
   EXPECT_EQ(canmotion::test::counted_allocations(), 0u);
   EXPECT_TRUE(r.tag("sd").dn());
+  EXPECT_TRUE(r.tag("sx").pc());
+  EXPECT_TRUE(r.tag("fy").dn());
   EXPECT_TRUE(r.p->check_incremental_state());
 }
 
