@@ -7,6 +7,7 @@
 
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/emcy.hpp"
+#include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/canopen/receive_filters.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 
@@ -57,6 +58,33 @@ const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) n
     case WriteOrigin::kCheck: return nullptr;
   }
   return nullptr;
+}
+
+std::string describe_notice(const canopen::NodeEvent& e) {
+  const std::string_view name = canopen::object_name(e.index, e.sub);
+  const char* fallback = "not written; the drive keeps its own setting";
+  char buf[160];
+  if (e.index == 0x1016) {
+    fallback = "the drive does not watch the master's heartbeat (a lost master is not detected by the drive)";
+  } else if (e.index == obj::kInterpolationTimePeriod && e.detail != 0) {
+    std::snprintf(buf, sizeof buf, "0x60C2:1 written in the drive's unit 10^%d s", static_cast<int>(e.detail));
+    fallback = buf;
+  } else if (e.index == obj::kInterpolationTimePeriod) {
+    fallback = "0x60C2:1 written with the master's value; the unit is the drive's own";
+  } else if (e.index == obj::kSupportedDriveModes) {
+    fallback = "the modes the configuration needs are not checked";
+  } else if (e.index == obj::kModesOfOperationDisplay) {
+    fallback = "the mode written to 0x6060 is taken as the one the drive runs";
+  } else if (e.index == obj::kSlatConfiguration || e.index == obj::kSlatSetPoint || e.index == obj::kSlatTimeDelay) {
+    fallback = "the drive has no SLAT: MDS runs without it (direct_control.slat is not set)";
+  }
+  char out[512];
+  const char* what = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly) ? "read-only" : "absent";
+  std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) %s (SDO abort 0x%08" PRIX32 " %.*s): %s",
+                e.node, e.index, e.sub, static_cast<int>(name.size()), name.data(), what, e.abort,
+                static_cast<int>(canopen::sdo_abort_text(e.abort).size()), canopen::sdo_abort_text(e.abort).data(),
+                fallback);
+  return out;
 }
 
 // ============================================================================
@@ -185,6 +213,15 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                             node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(rq.size()), rq.data(),
                             static_cast<int>(static_cast<std::int8_t>(read_value)), static_cast<int>(sh.size()), sh.data(),
                             waited_ms, k ? hint : "mode switch timeout");
+          break;
+        }
+        case BootCheck::kInterpolationIndex: {
+          const auto idx = static_cast<int>(static_cast<std::int8_t>(read_value & 0xFFu));
+          n = std::snprintf(out.data(), out.size(),
+                            "node %u: 0x60C2:2 (Interpolation time index) is read-only at %d (periods in units of "
+                            "10^%d s) and the cycle period %.6g ms (%s) is not a whole number 1..255 of that unit: "
+                            "choose a period the drive can take",
+                            node, idx, idx, static_cast<double>(expected) / 1e6, k ? hint : "the cycle period");
           break;
         }
         case BootCheck::kNone: n = std::snprintf(out.data(), out.size(), "node %u: boot check failed", node); break;
@@ -320,6 +357,7 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
         fail(FailureKind::kHeartbeatLost, e.t_ns, 0, master_.status(cfg_.node).heartbeat_timeout_ns);
       }
       break;
+    case K::kObjectAbsent: break;  // made by the proxy itself (poll_notice)
     case K::kHeartbeatRecovered:
       // The condition is gone (the planner has latched the axis fault until
       // MAFR/MASR); a node that rebooted meanwhile is being configured again.
@@ -704,13 +742,19 @@ void DriveNetwork::on_frame(const can::TimedFrame& f) noexcept {
 void DriveNetwork::update(std::int64_t now_ns) noexcept {
   master_.check_heartbeats(now_ns);
   canopen::NodeEvent e;
-  while (master_.poll_event(e)) {
-    if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
+  auto keep = [this](const canopen::NodeEvent& ev) noexcept {
     if (ev_count_ < kEventCapacity) {
-      events_[(ev_head_ + ev_count_) % kEventCapacity] = e;
+      events_[(ev_head_ + ev_count_) % kEventCapacity] = ev;
       ++ev_count_;
     }
+  };
+  while (master_.poll_event(e)) {
+    if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
+    keep(e);
   }
+  // The optional objects the drives lacked during their boot (said once each).
+  for (auto& d : drives_)
+    while (d->poll_notice(e)) keep(e);
 }
 
 void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {

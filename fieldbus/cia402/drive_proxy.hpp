@@ -44,6 +44,10 @@ struct SdoWrite {
   std::uint8_t sub = 0;
   std::uint8_t size = 4;  ///< 1, 2, 3 or 4 bytes
   std::uint32_t value = 0;
+  /// DriveConfig::extra_writes: a drive without the object is fine (abort
+  /// 0x06020000 / 0x06090011 accepted and said once: DriveProxy::poll_notice), e.g. a
+  /// default the configuration did not ask for.
+  bool optional = false;
 };
 
 /// Configuration keys to name when the drive refuses a boot configuration
@@ -81,7 +85,18 @@ enum class BootCheck : std::uint8_t {
   kRevision,        ///< 0x1018:3 against DriveIdentity::revision
   kSupportedModes,  ///< 0x6502 has a bit for every DriveConfig::needed_modes entry (absent: not checked)
   kModeDisplay,     ///< 0x6061 shows the mode written to 0x6060 (absent: assumed)
+  /// 0x60C2:2 read after the drive refused to write it (read-only or
+  /// absent): the period must be expressible in the drive's unit (`read_value`
+  /// the drive's index, `expected` the period in ns).
+  kInterpolationIndex,
 };
+
+/// One sentence for a canopen::NodeEvent::Kind::kObjectAbsent (an optional
+/// boot object the drive lacks or refused as read-only, and the fallback the
+/// proxy took), e.g. "node 2: no 0x1016 (Consumer heartbeat time, SDO abort
+/// 0x06020000): the drive does not watch the master's heartbeat". Uses
+/// snprintf: call it from a non-RT thread.
+[[nodiscard]] std::string describe_notice(const canopen::NodeEvent& e);
 
 /// What the configuration expects of the drive's identity (`drive.identity`);
 /// unset members are not read (0x1018:2/3 are optional in CiA 301).
@@ -150,8 +165,10 @@ struct DriveConfig {
   /// abort 0x06020000 / 0x06090011 is accepted.
   std::shared_ptr<const canopen::DeviceDictionary> dictionary;
   /// 0x1016:1 comes from a default, not from the configuration: a drive
-  /// without 0x1016 is fine (the write is optional, see `dictionary`).
-  bool consumer_heartbeat_optional = false;
+  /// without 0x1016 is fine (the write is optional, see `dictionary`). True
+  /// by default (consumer_heartbeat_ms's default is not a user's request);
+  /// canmotiond sets it false when the file sets master_heartbeat_timeout_ms.
+  bool consumer_heartbeat_optional = true;
 };
 
 /// One SDO transfer of the boot configuration, in the order the proxy makes
@@ -162,6 +179,9 @@ struct BootWrite {
   WriteOrigin origin = WriteOrigin::kMode;
   std::uint16_t extra = 0;  ///< kExtra: index in DriveConfig::extra_writes
   bool optional = false;    ///< a drive without the object is fine (abort 0x06020000 / 0x06090011 accepted)
+  /// Runs only after the drive refused 0x60C2:2 (the read of its index and
+  /// 0x60C2:1 written again in its unit); skipped otherwise.
+  bool ip_fallback = false;
   BootCheck check = BootCheck::kNone;  ///< not kNone: a read (upload) that checks the drive
   [[nodiscard]] constexpr bool is_read() const noexcept { return check != BootCheck::kNone; }
 };
@@ -357,6 +377,11 @@ class DriveProxy {
   /// lacks the object (unused PDOs, an optional 0x1016, no 0x6502 / 0x6061),
   /// since the last (re)start of the configuration.
   [[nodiscard]] std::size_t tolerated_aborts() const noexcept { return tolerated_; }
+  /// The next optional boot object the drive lacked (or refused as
+  /// read-only) and the fallback taken (NodeEvent::Kind::kObjectAbsent,
+  /// describe_notice()), each object once per proxy (not again at a
+  /// re-boot). DriveNetwork::update() passes them on as events. Realtime-safe.
+  bool poll_notice(canopen::NodeEvent& out) noexcept;
   /// The boot configuration's SDO transfers, in order: the checking reads
   /// (BootWrite::is_read(): 0x1000, 0x1018 as configured, 0x6502 first,
   /// 0x6061 last) and the writes (built at set-up; optional ones to objects
@@ -394,6 +419,12 @@ class DriveProxy {
   std::size_t next_write_ = 0;
   std::size_t done_writes_ = 0;
   std::size_t tolerated_ = 0;
+  bool ip_fallback_ = false;  // 0x60C2:2 refused: the BootWrite::ip_fallback entries run
+  std::uint32_t ip_abort_ = 0;  // the abort 0x60C2:2's write got
+  std::vector<std::uint8_t> noticed_;  // per writes_ entry: its notice was made (said once)
+  std::array<canopen::NodeEvent, 16> notices_{};  // bound: at most one per optional boot object, 16 is ample
+  std::size_t notice_head_ = 0, notice_count_ = 0;
+  void notice(std::size_t write, std::uint32_t abort, std::int32_t detail = 0) noexcept;
   std::uint32_t reboots_ = 0;
   bool nmt_left_ = false;  // heartbeat showed pre-operational / stopped while operational
 

@@ -58,7 +58,7 @@ struct FaultRig {
     x.drive.node = kNode;
     emulator::EmulatorConfig ec;
     ec.node = kNode;
-    ec.behaviour = emulator::EmulatorBehaviour::loop_default();
+    ec.behaviour = emulator::EmulatorBehaviour::strict();
     if (tweak) tweak(x, ec);
     spec.axes.push_back(x);
     world.add_drive(0, ec);
