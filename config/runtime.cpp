@@ -174,6 +174,16 @@ emulator::EmulatorConfig emulator_config(const AxisSettings& a) {
   emulator::EmulatorConfig e;
   e.node = a.node;
   e.behaviour = emulator::EmulatorBehaviour::strict();  // --sim drives behave like real ones (README "Emulator profiles")
+  // The simulated drive lacks the optional objects (emulator::kOptionalObjects)
+  // except those the configuration asks for: 0x1016 when the file sets
+  // master_heartbeat_timeout_ms, 0x2010..0x2022 with `direct_control:`. Those
+  // a real drive must have (its boot fails naming the key otherwise).
+  e.behaviour.optional_objects_absent = false;
+  for (const std::uint16_t index : emulator::kOptionalObjects) {
+    const bool asked = index == 0x1016 ? a.drive.master_heartbeat_timeout_set && a.drive.master_heartbeat_timeout_ms > 0
+                                       : a.direct.present;
+    if (!asked) e.absent_objects.push_back(index);
+  }
   const double conv = a.axis.conversion_constant;
   // Give the model headroom over the axis's own limits, so that the emulated
   // drive follows any profile the planner may command.
