@@ -594,9 +594,21 @@ bool DriveProxy::set_mode(Mode m) noexcept {
     if (plan->command == Command::kFaultReset) {
       // The drive acts on the rising edge of bit 7. In Fault the proxy sends
       // it clear, so the reset goes out in this cycle's RPDO; only when the
-      // last controlword had it set does one cycle without it come first.
-      cw_ = flight_cycles_ == 0 && (cw_ & cw::kFaultReset) != 0 ? std::uint16_t{0}
-                                                               : cia402::controlword(Command::kFaultReset);
+      // last controlword had it set does one cycle without it come first. A
+      // drive refuses the reset while the cause remains: every
+      // fault_reset_repeat_ns one RPDO with bit 7 clear, then a new edge,
+      // until it leaves Fault or the transition times out.
+      const bool set = (cw_ & cw::kFaultReset) != 0;
+      if (set && (flight_cycles_ == 0 ||
+                  (cfg_.fault_reset_repeat_ns > 0 && now_ns - reset_edge_ns_ >= cfg_.fault_reset_repeat_ns))) {
+        cw_ = 0;
+      } else {
+        if (!set) {
+          reset_edge_ns_ = now_ns;
+          ++reset_edges_;
+        }
+        cw_ = cia402::controlword(Command::kFaultReset);
+      }
     } else {
       cw_ = cia402::controlword(plan->command);
     }

@@ -151,6 +151,11 @@ struct DriveConfig {
   std::int64_t sdo_timeout_ns = 200'000'000;        ///< per SDO response
   std::int64_t start_timeout_ns = 1'000'000'000;    ///< NMT start -> first TPDO
   std::int64_t transition_timeout_ns = 500'000'000; ///< per state machine transition
+  /// A drive refuses a fault reset while the fault's cause remains: the reset
+  /// edge (controlword bit 7 0 -> 1) is repeated this often (one RPDO with
+  /// bit 7 clear, then set again) until the drive leaves Fault or
+  /// transition_timeout_ns expires. 0 = one edge only.
+  std::int64_t fault_reset_repeat_ns = 50'000'000;
   std::int64_t mode_switch_timeout_ns = 500'000'000; ///< 0x6061 must show a set_mode() request within this; 0 = unchecked
   std::int64_t homing_timeout_ns = 60'000'000'000;   ///< start_homing() -> homing completed or error; 0 = unchecked
   DriveIdentity identity;         ///< checked against 0x1000 / 0x1018 at boot
@@ -390,6 +395,9 @@ class DriveProxy {
   /// Boot-ups that (re-)ran the configuration: while running, while
   /// configuring, or after a failed boot.
   [[nodiscard]] std::uint32_t reboots() const noexcept { return reboots_; }
+  /// Fault-reset rising edges (controlword bit 7 0 -> 1) sent so far
+  /// (DriveConfig::fault_reset_repeat_ns).
+  [[nodiscard]] std::uint32_t fault_reset_edges() const noexcept { return reset_edges_; }
   /// Clear the recorded failure (the state machine keeps its state).
   void clear_failure() noexcept { failure_ = Failure{}; }
   [[nodiscard]] std::uint16_t last_emcy_code() const noexcept { return emcy_code_; }
@@ -453,6 +461,8 @@ class DriveProxy {
   State flight_from_ = State::kUnknown;
   std::int64_t flight_since_ns_ = 0;
   std::uint32_t flight_cycles_ = 0;
+  std::int64_t reset_edge_ns_ = 0;     // when the last fault-reset rising edge went out
+  std::uint32_t reset_edges_ = 0;      // fault-reset rising edges sent (fault_reset_edges())
 
   Mode mode_ = Mode::kCsp;
   Mode sdo_mode_pending_ = Mode::kNoMode;

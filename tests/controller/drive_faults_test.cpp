@@ -501,13 +501,12 @@ TEST(DriveFaults, AbsentDriveFailsTheBootAndItsLaterBootUpConfiguresIt) {
 TEST(DriveFaults, BusOffFaultsTheAxisAndMasrRecoversOnceTheBusIsBack) {
   // No 0x1029 here: with it the drive also goes Pre-operational when it loses
   // the master's heartbeat, and the master, reading the state only from
-  // TPDOs, never sees its Fault. No lasting fault cause: MASR's one reset
-  // edge may come before the master's heartbeat is back, and is not repeated.
+  // TPDOs, never sees its Fault. (The fault's cause lasts as in the strict
+  // profile: the reset edge is repeated until the drive takes it.)
   // Instant boot: the MSO right after MASR's node restart fails (ERR 20)
   // while the drive is still in Not ready to switch on (issue 15, master side).
   FaultRig r([](AxisSpec&, emulator::EmulatorConfig& e) {
     e.behaviour.error_behaviour = false;
-    e.behaviour.fault_cause_syncs = 0;
     e.behaviour.boot_ns = 0;
     e.behaviour.optional_objects_absent = false;  // the drive has 0x1016: it watches the master
   });

@@ -76,11 +76,7 @@ TEST(FieldbusLoop, CspRampFollowedWithinLag) {
 }
 
 TEST(FieldbusLoop, InjectedFaultEmcyResetReenable) {
-  SimRigConfig cfg = rig_config();
-  // Permissive here: the master sends one fault-reset edge and does not send
-  // another while the strict drive refuses it (the fault's cause lasts 20
-  // SYNCs), so the drive stays in Fault (issue 15, master side).
-  cfg.emulator.behaviour.fault_cause_syncs = 0;
+  SimRigConfig cfg = rig_config();  // strict: the fault's cause lasts 20 SYNCs, a reset meanwhile is refused
   SimRig rig(cfg);
   boot_and_enable(rig);
   // Inject over SDO: write 0x2310 to 0x2000 of node 3.
@@ -104,9 +100,40 @@ TEST(FieldbusLoop, InjectedFaultEmcyResetReenable) {
   d.fault_reset();
   ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kSwitchOnDisabled; }, 100));
   EXPECT_FALSE(d.failed());
+  // The first edge came while the cause lasted: the drive took a later one.
+  EXPECT_GE(d.fault_reset_edges(), 2u);
   EXPECT_EQ(rig.emulator(3).read_int(0x603F), 0);
   d.enable();
   ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 100));
+}
+
+TEST(FieldbusLoop, FaultResetEdgeRepeatedUntilTheTransitionTimeout) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.behaviour.fault_cause_syncs = 1'000'000;  // the cause never goes
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(rig.network().master().sdo(2).download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 100));
+  d.fault_reset();
+  // Record bit 7 of every controlword: rising edges every 50 ms, each after one clear RPDO.
+  std::uint32_t rises = 0;
+  bool last = false;
+  for (int i = 0; i < 600 && !d.failed(); ++i) {
+    rig.step();
+    const bool bit7 = (d.controlword() & 0x0080) != 0;
+    rises += bit7 && !last ? 1 : 0;
+    last = bit7;
+  }
+  ASSERT_TRUE(d.failed());
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kTransitionTimeout);
+  EXPECT_EQ(d.failure().transition, 15);
+  EXPECT_EQ(d.state(), State::kFault);
+  // 500 ms transition timeout / 50 ms repeat: 10 or 11 edges (the first at once).
+  EXPECT_GE(rises, 10u);
+  EXPECT_LE(rises, 11u);
+  EXPECT_EQ(d.fault_reset_edges(), rises);
 }
 
 TEST(FieldbusLoop, FollowingErrorFaultsWith8611) {
