@@ -214,6 +214,7 @@ void DriveProxy::forget_drive(std::int64_t now_ns) noexcept {
   mode_ = cfg_.mode;  // configured again with the boot mode
   next_write_ = done_writes_ = tolerated_ = 0;
   ip_fallback_ = false;
+  in_fault_ = emcy_in_fault_ = error_code_asked_ = false;
   mode_shown_since_ns_ = -1;
   master_.sdo(cfg_.node).cancel_all();
   // A rebooted drive sends no heartbeat until 0x1017 is written again: the

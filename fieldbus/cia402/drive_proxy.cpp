@@ -350,6 +350,9 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
       if (e.emcy.code != canopen::emcy_code::kNoError) {
         has_emcy_ = true;
         emcy_code_ = e.emcy.code;
+        emcy_in_fault_ = true;
+      } else if (!in_fault_) {
+        emcy_in_fault_ = false;  // error reset / no error: an earlier warning's EMCY is not this fault's
       }
       break;
     case K::kHeartbeatLost:
@@ -680,10 +683,54 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
     }
   }
   if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
+  step_error_code(now_ns);
   check_mode_switch(now_ns);
   step_homing(now_ns);
   step_state_machine(now_ns);
   send_rpdos(out);
+}
+
+// A drive in Fault that sent no EMCY (EMCY disabled, or lost): read 0x603F
+// two cycles after the Fault shows (an EMCY sent with the fault has come by
+// then) and take its code as the EMCY's.
+void DriveProxy::step_error_code(std::int64_t now_ns) noexcept {
+  const State s = decode_state(fb_.statusword);
+  const bool faulted = s == State::kFault || s == State::kFaultReactionActive;
+  if (!faulted) {
+    // The fault ended: the next one needs its own EMCY. (An EMCY may come
+    // before the statusword shows the fault: kept until then.)
+    if (in_fault_) in_fault_ = emcy_in_fault_ = error_code_asked_ = false;
+    return;
+  }
+  if (!in_fault_) {
+    in_fault_ = true;
+    fault_since_ns_ = now_ns;
+  }
+  canopen::SdoClient& sdo = master_.sdo(cfg_.node);
+  if (!error_code_asked_ && !emcy_in_fault_ && now_ns - fault_since_ns_ >= 2 * cfg_.cycle_ns)
+    error_code_asked_ = sdo.upload(obj::kErrorCode, 0, kErrorCodeTag);  // queue full: next cycle
+  if (!error_code_asked_ || sdo.results() == 0) return;
+  canopen::SdoResult r;
+  if (!sdo.poll_tag(kErrorCodeTag, r) || !r.ok()) return;
+  const auto code = static_cast<std::uint16_t>(r.u32() & 0xFFFFu);
+  if (code == canopen::emcy_code::kNoError || emcy_in_fault_) return;
+  emcy_in_fault_ = has_emcy_ = true;
+  emcy_code_ = code;
+  if (failure_.kind != FailureKind::kNone && !failure_.has_emcy) {
+    failure_.has_emcy = true;
+    failure_.emcy_code = code;
+  }
+  if (notice_count_ < notices_.size()) {
+    canopen::NodeEvent& e = notices_[(notice_head_ + notice_count_) % notices_.size()];
+    ++notice_count_;
+    e = canopen::NodeEvent{};
+    e.kind = canopen::NodeEvent::Kind::kEmcy;
+    e.node = cfg_.node;
+    e.t_ns = now_ns;
+    e.emcy.node = cfg_.node;
+    e.emcy.code = code;
+    e.index = obj::kErrorCode;  // read from 0x603F, not received as an EMCY
+  }
 }
 
 void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {

@@ -302,6 +302,11 @@ class DriveProxy {
   static constexpr std::uint32_t kModeWriteTag = 0xFFFF0001u;
   /// Tag of the homing parameter writes (start_homing()).
   static constexpr std::uint32_t kHomingWriteTag = 0xFFFF0002u;
+  /// Tag of the read of 0x603F (error code) when the drive is in Fault
+  /// without having sent an EMCY: its code is taken as the EMCY's
+  /// (last_emcy_code(), Failure::emcy_code) and passed on as a
+  /// NodeEvent::Kind::kEmcy (poll_notice()).
+  static constexpr std::uint32_t kErrorCodeTag = 0xFFFF0003u;
 
   // ---- commands ---------------------------------------------------------
   /// Go to Operation enabled (2, 3, 4; a fault must be reset first). Clears a
@@ -462,6 +467,12 @@ class DriveProxy {
   std::int64_t flight_since_ns_ = 0;
   std::uint32_t flight_cycles_ = 0;
   std::int64_t reset_edge_ns_ = 0;     // when the last fault-reset rising edge went out
+  // 0x603F read (kErrorCodeTag) for a Fault without EMCY.
+  bool in_fault_ = false;              // the statusword shows Fault / Fault reaction active
+  bool emcy_in_fault_ = false;         // an EMCY (not 0000h) came since the last fault ended
+  bool error_code_asked_ = false;      // 0x603F queued for this fault
+  std::int64_t fault_since_ns_ = 0;
+  void step_error_code(std::int64_t now_ns) noexcept;
   std::uint32_t reset_edges_ = 0;      // fault-reset rising edges sent (fault_reset_edges())
 
   Mode mode_ = Mode::kCsp;

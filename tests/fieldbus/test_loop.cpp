@@ -1,6 +1,8 @@
 // Deterministic master + emulated drives on the SimBus with a virtual clock.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "fieldbus/canopen/cob_id.hpp"
@@ -105,6 +107,59 @@ TEST(FieldbusLoop, InjectedFaultEmcyResetReenable) {
   EXPECT_EQ(rig.emulator(3).read_int(0x603F), 0);
   d.enable();
   ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 100));
+}
+
+// A drive in Fault that sends no EMCY (its EMCY COB-ID 0x1014 invalid): the
+// master reads 0x603F and reports its code as the EMCY's.
+TEST(FieldbusLoop, FaultWithoutEmcyReads603F) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  auto& emu = rig.emulator(2);
+  const std::array<std::uint8_t, 4> off{0x82, 0x00, 0x00, 0x80};  // 0x1014 = 0x80000082: EMCY off
+  ASSERT_EQ(emu.sdo_write(0x1014, 0, off), canopen::SdoAbort::kNone);
+  can::SimBus::Endpoint& spy = rig.bus().add_endpoint("spy");
+  ASSERT_TRUE(rig.network().master().sdo(2).download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 100));
+  EXPECT_FALSE(d.has_emcy());
+  ASSERT_TRUE(rig.run_until([&] { return d.has_emcy(); }, 20)) << "0x603F not read";
+  EXPECT_EQ(d.last_emcy_code(), 0x2310);
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kDriveFault);
+  EXPECT_NE(d.failure().to_string().find("last EMCY 0x2310"), std::string::npos) << d.failure().to_string();
+  rig.step();  // the network passes the proxy's events on at the next cycle
+  bool event = false;
+  canopen::NodeEvent e;
+  while (rig.network().poll_event(e))
+    event = event || (e.kind == canopen::NodeEvent::Kind::kEmcy && e.node == 2 && e.emcy.code == 0x2310);
+  EXPECT_TRUE(event) << "the code is passed on as an EMCY event";
+  // Golden bytes: upload 0x603F, expedited 2-byte reply 0x2310.
+  std::array<can::TimedFrame, 512> buf{};
+  bool req = false, rsp = false;
+  for (std::size_t k; (k = spy.receive(buf)) > 0;)
+    for (std::size_t j = 0; j < k; ++j) {
+      const can::Frame& f = buf[j].frame;
+      const std::array<std::uint8_t, 8> up{0x40, 0x3F, 0x60, 0x00, 0, 0, 0, 0};
+      const std::array<std::uint8_t, 8> ans{0x4B, 0x3F, 0x60, 0x00, 0x10, 0x23, 0, 0};
+      if (f.id == 0x602 && std::equal(up.begin(), up.end(), f.data.begin())) req = true;
+      if (f.id == 0x582 && std::equal(ans.begin(), ans.end(), f.data.begin())) rsp = true;
+      EXPECT_NE(f.id, 0x082u) << "no EMCY was to be sent";
+    }
+  EXPECT_TRUE(req) << "602#403F600000000000";
+  EXPECT_TRUE(rsp) << "582#4B3F600010230000";
+  // With the EMCY on, no read: the EMCY's code is used.
+  SimRig rig2(cfg);
+  boot_and_enable(rig2);
+  can::SimBus::Endpoint& spy2 = rig2.bus().add_endpoint("spy");
+  ASSERT_TRUE(rig2.network().master().sdo(2).download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
+  ASSERT_TRUE(rig2.run_until([&] { return rig2.drive(2).state() == State::kFault; }, 100));
+  for (int i = 0; i < 20; ++i) rig2.step();
+  EXPECT_EQ(rig2.drive(2).last_emcy_code(), 0x2310);
+  for (std::size_t k; (k = spy2.receive(buf)) > 0;)
+    for (std::size_t j = 0; j < k; ++j)
+      EXPECT_FALSE(buf[j].frame.id == 0x602 && buf[j].frame.data[0] == 0x40 && buf[j].frame.data[1] == 0x3F)
+          << "0x603F read although the EMCY came";
 }
 
 TEST(FieldbusLoop, FaultResetEdgeRepeatedUntilTheTransitionTimeout) {
