@@ -144,6 +144,10 @@ struct DirectControlSettings {
   std::uint8_t slat_configuration = 0;           ///< 0 disabled, 1 min speed/torque, 2 max speed/torque -> 0x2020
   double slat_set_point = 0.0;                   ///< units/s -> 0x2021
   std::uint16_t slat_time_delay_ms = 0;          ///< ms -> 0x2022
+  /// `slat:` is in the file. Without it the SLAT writes (SLAT disabled) are
+  /// optional: a drive without 0x2020..0x2022 has no SLAT, which is what
+  /// they ask for, and MDS runs with the drive's other objects.
+  bool slat_set = false;
   Location where;
 };
 

@@ -443,6 +443,7 @@ class Loader {
     }
     if (const YAML::Node s = n["slat"]) {
       const std::string p = path + ".slat";
+      d.slat_set = true;  // asked for: a drive without 0x2020..0x2022 then fails its boot, naming the key
       if (check_map(s, p, {"configuration", "set_point", "time_delay_ms"})) {
         enumeration(s, p, "configuration", d.slat_configuration,
                     {{"SLAT disabled", std::uint8_t{0}}, {"SLAT Min Speed/Torque", std::uint8_t{1}},

@@ -64,9 +64,18 @@ std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
   if (d.ramp_velocity_negative)
     counts(od_write(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub), *d.ramp_velocity_negative);
   if (d.ramp_jerk_control) write(od_write(obj::kRampJerkControl, 0), *d.ramp_jerk_control);
+  // The SLAT objects are vendor-area (cia402.hpp): written always, so that a
+  // drive keeps no SLAT from an earlier configuration, but without `slat:`
+  // in the file (SLAT disabled) a drive that lacks them is fine (it has no
+  // SLAT): optional, said once at boot. The ramp objects above are written
+  // only when their key is set, and then a drive without them fails its boot
+  // naming the key: MDS is validated only if the drive supports the ramp
+  // attributes the configuration asks for [seed 002].
+  const std::size_t slat_first = w.size();
   write(od_write(obj::kSlatConfiguration, 0), d.slat_configuration);
   counts(od_write(obj::kSlatSetPoint, 0), d.slat_set_point);
   write(od_write(obj::kSlatTimeDelay, 0), d.slat_time_delay_ms);
+  for (std::size_t i = slat_first; i < w.size(); ++i) w[i].optional = !d.slat_set;
   return w;
 }
 
@@ -164,7 +173,17 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
 emulator::EmulatorConfig emulator_config(const AxisSettings& a) {
   emulator::EmulatorConfig e;
   e.node = a.node;
-  e.behaviour = emulator::EmulatorBehaviour::loop_default();  // --sim drives: strict but for two master gaps
+  e.behaviour = emulator::EmulatorBehaviour::strict();  // --sim drives behave like real ones (README "Emulator profiles")
+  // The simulated drive lacks the optional objects (emulator::kOptionalObjects)
+  // except those the configuration asks for: 0x1016 when the file sets
+  // master_heartbeat_timeout_ms, 0x2010..0x2022 with `direct_control:`. Those
+  // a real drive must have (its boot fails naming the key otherwise).
+  e.behaviour.optional_objects_absent = false;
+  for (const std::uint16_t index : emulator::kOptionalObjects) {
+    const bool asked = index == 0x1016 ? a.drive.master_heartbeat_timeout_set && a.drive.master_heartbeat_timeout_ms > 0
+                                       : a.direct.present;
+    if (!asked) e.absent_objects.push_back(index);
+  }
   const double conv = a.axis.conversion_constant;
   // Give the model headroom over the axis's own limits, so that the emulated
   // drive follows any profile the planner may command.

@@ -42,12 +42,20 @@ struct NodeEvent {
     kHeartbeatLost,       ///< no heartbeat within the consumer time
     kHeartbeatRecovered,  ///< heartbeat back after kHeartbeatLost
     kEmcy,                ///< EMCY received (`emcy` is set)
+    /// The drive lacks an optional boot object, or refused it as read-only;
+    /// the master took a fallback (`index`, `sub`, `abort`; made by
+    /// cia402::DriveProxy::poll_notice, said once per node and object).
+    kObjectAbsent,
   };
   Kind kind = Kind::kBootUp;
   std::uint8_t node = 0;
   NmtState state = NmtState::kUnknown;
   Emcy emcy{};
   std::int64_t t_ns = 0;
+  std::uint16_t index = 0;  ///< kObjectAbsent: the object
+  std::uint8_t sub = 0;
+  std::uint32_t abort = 0;  ///< kObjectAbsent: the SDO abort code
+  std::int32_t detail = 0;  ///< kObjectAbsent: 0x60C2:2, the drive's own index
 };
 
 /// What the master knows about one node.

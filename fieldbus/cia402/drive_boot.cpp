@@ -18,8 +18,9 @@ void DriveProxy::build_configuration() {
     return cfg_.dictionary && cfg_.dictionary->has(w.index, w.sub) == canopen::Presence::kAbsent;
   };
   auto add = [&](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) {
-    const bool optional =
-        o == WriteOrigin::kUnusedPdo || (o == WriteOrigin::kConsumerHeartbeat && cfg_.consumer_heartbeat_optional);
+    const bool optional = o == WriteOrigin::kUnusedPdo ||
+                          (o == WriteOrigin::kConsumerHeartbeat && cfg_.consumer_heartbeat_optional) ||
+                          (o == WriteOrigin::kExtra && w.optional);
     if (optional && absent(w)) return;
     writes_.push_back(BootWrite{w, o, extra, optional});
   };
@@ -32,7 +33,7 @@ void DriveProxy::build_configuration() {
     const SdoWrite w{index, sub, 4, 0};
     const bool optional = c == BootCheck::kSupportedModes || c == BootCheck::kModeDisplay;
     if (optional && absent(w)) return;
-    writes_.push_back(BootWrite{w, WriteOrigin::kCheck, 0, optional, c});
+    writes_.push_back(BootWrite{w, WriteOrigin::kCheck, 0, optional, false, c});
   };
   check(obj::kDeviceType, 0, BootCheck::kDeviceType);
   if (cfg_.identity.has_vendor_id) check(obj::kIdentity, 1, BootCheck::kVendorId);
@@ -44,8 +45,16 @@ void DriveProxy::build_configuration() {
       SdoWrite{obj::kModesOfOperation, 0, 1, static_cast<std::uint8_t>(static_cast<std::int8_t>(cfg_.mode))});
   const auto ip = *encode_interpolation_period(cfg_.cycle_ns);
   add(WriteOrigin::kInterpolationPeriod, SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value});
-  add(WriteOrigin::kInterpolationPeriod,
-      SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)});
+  // 0x60C2:2 may be read-only (a drive that takes periods in one unit only)
+  // or absent: then its index is read and 0x60C2:1 written again in that
+  // unit (the two ip_fallback entries, skipped when :2 was written); a period
+  // the drive's unit cannot express fails the boot (BootCheck::kInterpolationIndex).
+  writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)},
+                              WriteOrigin::kInterpolationPeriod, 0, false});
+  writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 2, 1, 0}, WriteOrigin::kCheck, 0, true, true,
+                              BootCheck::kInterpolationIndex});
+  writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value}, WriteOrigin::kInterpolationPeriod,
+                              0, false, true});
   // PDOs: the CiA 301 procedure for the used ones, COB-ID invalid for PDO 1..4 not used.
   auto add_map = [&](const canopen::PdoMap& m) {
     const std::uint32_t cob = m.cob_id & 0x7FFu;
@@ -84,6 +93,31 @@ void DriveProxy::build_configuration() {
   // Last: the mode the drive runs, read back (read again until it shows the
   // written mode, at most DriveConfig::mode_switch_timeout_ns).
   check(obj::kModesOfOperationDisplay, 0, BootCheck::kModeDisplay);
+  noticed_.assign(writes_.size(), 0);
+}
+
+void DriveProxy::notice(std::size_t write, std::uint32_t abort, std::int32_t detail) noexcept {
+  if (write >= noticed_.size() || noticed_[write] != 0) return;
+  noticed_[write] = 1;
+  if (notice_count_ == notices_.size()) return;  // cannot happen: fewer optional objects than places
+  canopen::NodeEvent& e = notices_[(notice_head_ + notice_count_) % notices_.size()];
+  ++notice_count_;
+  e = canopen::NodeEvent{};
+  e.kind = canopen::NodeEvent::Kind::kObjectAbsent;
+  e.node = cfg_.node;
+  e.t_ns = now_ns_;
+  e.index = writes_[write].w.index;
+  e.sub = writes_[write].w.sub;
+  e.abort = abort;
+  e.detail = detail;
+}
+
+bool DriveProxy::poll_notice(canopen::NodeEvent& out) noexcept {
+  if (notice_count_ == 0) return false;
+  out = notices_[notice_head_];
+  notice_head_ = (notice_head_ + 1) % notices_.size();
+  --notice_count_;
+  return true;
 }
 
 bool DriveProxy::check_read(const BootWrite& bw, std::uint32_t v, std::int64_t now_ns, bool& again) noexcept {
@@ -136,6 +170,22 @@ bool DriveProxy::check_read(const BootWrite& bw, std::uint32_t v, std::int64_t n
       key = &cfg_.hints.mode_switch_timeout;
       break;
     }
+    case BootCheck::kInterpolationIndex: {
+      // The drive keeps its own unit 10^idx s: 0x60C2:1 (the next entry) is
+      // written in it when the period is a whole number 1..255 of it.
+      const auto idx = static_cast<std::int8_t>(v & 0xFFu);
+      const std::int64_t unit = interpolation_period_ns(InterpolationPeriod{1, idx});
+      const std::size_t at = static_cast<std::size_t>(&bw - writes_.data());
+      if (unit > 0 && cfg_.cycle_ns % unit == 0 && cfg_.cycle_ns / unit >= 1 && cfg_.cycle_ns / unit <= 255) {
+        writes_[at + 1].w.value = static_cast<std::uint32_t>(cfg_.cycle_ns / unit);
+        notice(at - 1, ip_abort_, idx);
+        return true;
+      }
+      ok = false;
+      expected = static_cast<std::uint32_t>(cfg_.cycle_ns);
+      key = &cfg_.hints.interpolation_period;
+      break;
+    }
     case BootCheck::kNone: break;
   }
   if (ok) return true;
@@ -163,6 +213,8 @@ void DriveProxy::forget_drive(std::int64_t now_ns) noexcept {
   nmt_left_ = false;
   mode_ = cfg_.mode;  // configured again with the boot mode
   next_write_ = done_writes_ = tolerated_ = 0;
+  ip_fallback_ = false;
+  in_fault_ = emcy_in_fault_ = error_code_asked_ = false;
   mode_shown_since_ns_ = -1;
   master_.sdo(cfg_.node).cancel_all();
   // A rebooted drive sends no heartbeat until 0x1017 is written again: the
@@ -228,11 +280,27 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
       while (sdo.poll(r)) {
         if (r.tag == kModeWriteTag) continue;
         const BootWrite* bw = r.tag < writes_.size() ? &writes_[r.tag] : nullptr;
-        if (!r.ok() && bw != nullptr && bw->optional && canopen::object_absent(r.abort)) {
+        if (!r.ok() && bw != nullptr && bw->origin == WriteOrigin::kInterpolationPeriod && bw->w.sub == 2 &&
+            !bw->ip_fallback && (canopen::object_absent(r.abort) || r.abort == canopen::SdoAbort::kReadOnly)) {
+          // 0x60C2:2 read-only or absent: the ip_fallback entries read the
+          // drive's index and write 0x60C2:1 again in it (said then, with the index).
+          ip_fallback_ = true;
+          ip_abort_ = static_cast<std::uint32_t>(r.abort);
+          ++tolerated_;
+        } else if (!r.ok() && bw != nullptr && bw->optional && canopen::object_absent(r.abort)) {
           // The drive lacks an optional object: fewer PDOs than 4, no 0x1016;
           // no 0x6502 / 0x6061: the modes are not checked, the written mode is
-          // taken as the one the drive runs (what a drive without them allows).
+          // taken as the one the drive runs (what a drive without them allows);
+          // an optional extra write (e.g. SLAT left at its default): not written.
+          // Said once per object (poll_notice), but not for unused PDOs.
           ++tolerated_;
+          if (bw->origin != WriteOrigin::kUnusedPdo) {
+            if (bw->check == BootCheck::kInterpolationIndex) {
+              notice(r.tag - 1, ip_abort_, 0);  // no 0x60C2:2 at all: 0x60C2:1 keeps the master's value
+            } else {
+              notice(r.tag, static_cast<std::uint32_t>(r.abort));
+            }
+          }
         } else if (r.ok() && bw != nullptr && bw->is_read()) {
           bool again = false;
           if (!check_read(*bw, r.u32(), now_ns, again)) {
@@ -266,6 +334,14 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
         // Nothing is written before the checks have passed.
         if (next_write_ >= leading_reads_ && done_writes_ < leading_reads_) break;
         const BootWrite& bw = writes_[next_write_];
+        if (bw.ip_fallback) {
+          if (done_writes_ < next_write_) break;  // 0x60C2:2's answer decides
+          if (!ip_fallback_) {
+            ++next_write_;  // 0x60C2:2 was written: nothing to fall back on
+            ++done_writes_;
+            continue;
+          }
+        }
         const SdoWrite& w = bw.w;
         const auto tag = static_cast<std::uint32_t>(next_write_);
         if (bw.is_read()) {

@@ -7,6 +7,7 @@
 
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/emcy.hpp"
+#include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/canopen/receive_filters.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 
@@ -57,6 +58,33 @@ const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) n
     case WriteOrigin::kCheck: return nullptr;
   }
   return nullptr;
+}
+
+std::string describe_notice(const canopen::NodeEvent& e) {
+  const std::string_view name = canopen::object_name(e.index, e.sub);
+  const char* fallback = "not written; the drive keeps its own setting";
+  char buf[160];
+  if (e.index == 0x1016) {
+    fallback = "the drive does not watch the master's heartbeat (a lost master is not detected by the drive)";
+  } else if (e.index == obj::kInterpolationTimePeriod && e.detail != 0) {
+    std::snprintf(buf, sizeof buf, "0x60C2:1 written in the drive's unit 10^%d s", static_cast<int>(e.detail));
+    fallback = buf;
+  } else if (e.index == obj::kInterpolationTimePeriod) {
+    fallback = "0x60C2:1 written with the master's value; the unit is the drive's own";
+  } else if (e.index == obj::kSupportedDriveModes) {
+    fallback = "the modes the configuration needs are not checked";
+  } else if (e.index == obj::kModesOfOperationDisplay) {
+    fallback = "the mode written to 0x6060 is taken as the one the drive runs";
+  } else if (e.index == obj::kSlatConfiguration || e.index == obj::kSlatSetPoint || e.index == obj::kSlatTimeDelay) {
+    fallback = "the drive has no SLAT: MDS runs without it (direct_control.slat is not set)";
+  }
+  char out[512];
+  const char* what = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly) ? "read-only" : "absent";
+  std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) %s (SDO abort 0x%08" PRIX32 " %.*s): %s",
+                e.node, e.index, e.sub, static_cast<int>(name.size()), name.data(), what, e.abort,
+                static_cast<int>(canopen::sdo_abort_text(e.abort).size()), canopen::sdo_abort_text(e.abort).data(),
+                fallback);
+  return out;
 }
 
 // ============================================================================
@@ -187,6 +215,15 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                             waited_ms, k ? hint : "mode switch timeout");
           break;
         }
+        case BootCheck::kInterpolationIndex: {
+          const auto idx = static_cast<int>(static_cast<std::int8_t>(read_value & 0xFFu));
+          n = std::snprintf(out.data(), out.size(),
+                            "node %u: 0x60C2:2 (Interpolation time index) is read-only at %d (periods in units of "
+                            "10^%d s) and the cycle period %.6g ms (%s) is not a whole number 1..255 of that unit: "
+                            "choose a period the drive can take",
+                            node, idx, idx, static_cast<double>(expected) / 1e6, k ? hint : "the cycle period");
+          break;
+        }
         case BootCheck::kNone: n = std::snprintf(out.data(), out.size(), "node %u: boot check failed", node); break;
       }
       break;
@@ -313,6 +350,9 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
       if (e.emcy.code != canopen::emcy_code::kNoError) {
         has_emcy_ = true;
         emcy_code_ = e.emcy.code;
+        emcy_in_fault_ = true;
+      } else if (!in_fault_) {
+        emcy_in_fault_ = false;  // error reset / no error: an earlier warning's EMCY is not this fault's
       }
       break;
     case K::kHeartbeatLost:
@@ -320,6 +360,7 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
         fail(FailureKind::kHeartbeatLost, e.t_ns, 0, master_.status(cfg_.node).heartbeat_timeout_ns);
       }
       break;
+    case K::kObjectAbsent: break;  // made by the proxy itself (poll_notice)
     case K::kHeartbeatRecovered:
       // The condition is gone (the planner has latched the axis fault until
       // MAFR/MASR); a node that rebooted meanwhile is being configured again.
@@ -556,9 +597,21 @@ bool DriveProxy::set_mode(Mode m) noexcept {
     if (plan->command == Command::kFaultReset) {
       // The drive acts on the rising edge of bit 7. In Fault the proxy sends
       // it clear, so the reset goes out in this cycle's RPDO; only when the
-      // last controlword had it set does one cycle without it come first.
-      cw_ = flight_cycles_ == 0 && (cw_ & cw::kFaultReset) != 0 ? std::uint16_t{0}
-                                                               : cia402::controlword(Command::kFaultReset);
+      // last controlword had it set does one cycle without it come first. A
+      // drive refuses the reset while the cause remains: every
+      // fault_reset_repeat_ns one RPDO with bit 7 clear, then a new edge,
+      // until it leaves Fault or the transition times out.
+      const bool set = (cw_ & cw::kFaultReset) != 0;
+      if (set && (flight_cycles_ == 0 ||
+                  (cfg_.fault_reset_repeat_ns > 0 && now_ns - reset_edge_ns_ >= cfg_.fault_reset_repeat_ns))) {
+        cw_ = 0;
+      } else {
+        if (!set) {
+          reset_edge_ns_ = now_ns;
+          ++reset_edges_;
+        }
+        cw_ = cia402::controlword(Command::kFaultReset);
+      }
     } else {
       cw_ = cia402::controlword(plan->command);
     }
@@ -630,10 +683,54 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
     }
   }
   if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
+  step_error_code(now_ns);
   check_mode_switch(now_ns);
   step_homing(now_ns);
   step_state_machine(now_ns);
   send_rpdos(out);
+}
+
+// A drive in Fault that sent no EMCY (EMCY disabled, or lost): read 0x603F
+// two cycles after the Fault shows (an EMCY sent with the fault has come by
+// then) and take its code as the EMCY's.
+void DriveProxy::step_error_code(std::int64_t now_ns) noexcept {
+  const State s = decode_state(fb_.statusword);
+  const bool faulted = s == State::kFault || s == State::kFaultReactionActive;
+  if (!faulted) {
+    // The fault ended: the next one needs its own EMCY. (An EMCY may come
+    // before the statusword shows the fault: kept until then.)
+    if (in_fault_) in_fault_ = emcy_in_fault_ = error_code_asked_ = false;
+    return;
+  }
+  if (!in_fault_) {
+    in_fault_ = true;
+    fault_since_ns_ = now_ns;
+  }
+  canopen::SdoClient& sdo = master_.sdo(cfg_.node);
+  if (!error_code_asked_ && !emcy_in_fault_ && now_ns - fault_since_ns_ >= 2 * cfg_.cycle_ns)
+    error_code_asked_ = sdo.upload(obj::kErrorCode, 0, kErrorCodeTag);  // queue full: next cycle
+  if (!error_code_asked_ || sdo.results() == 0) return;
+  canopen::SdoResult r;
+  if (!sdo.poll_tag(kErrorCodeTag, r) || !r.ok()) return;
+  const auto code = static_cast<std::uint16_t>(r.u32() & 0xFFFFu);
+  if (code == canopen::emcy_code::kNoError || emcy_in_fault_) return;
+  emcy_in_fault_ = has_emcy_ = true;
+  emcy_code_ = code;
+  if (failure_.kind != FailureKind::kNone && !failure_.has_emcy) {
+    failure_.has_emcy = true;
+    failure_.emcy_code = code;
+  }
+  if (notice_count_ < notices_.size()) {
+    canopen::NodeEvent& e = notices_[(notice_head_ + notice_count_) % notices_.size()];
+    ++notice_count_;
+    e = canopen::NodeEvent{};
+    e.kind = canopen::NodeEvent::Kind::kEmcy;
+    e.node = cfg_.node;
+    e.t_ns = now_ns;
+    e.emcy.node = cfg_.node;
+    e.emcy.code = code;
+    e.index = obj::kErrorCode;  // read from 0x603F, not received as an EMCY
+  }
 }
 
 void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {
@@ -704,13 +801,19 @@ void DriveNetwork::on_frame(const can::TimedFrame& f) noexcept {
 void DriveNetwork::update(std::int64_t now_ns) noexcept {
   master_.check_heartbeats(now_ns);
   canopen::NodeEvent e;
-  while (master_.poll_event(e)) {
-    if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
+  auto keep = [this](const canopen::NodeEvent& ev) noexcept {
     if (ev_count_ < kEventCapacity) {
-      events_[(ev_head_ + ev_count_) % kEventCapacity] = e;
+      events_[(ev_head_ + ev_count_) % kEventCapacity] = ev;
       ++ev_count_;
     }
+  };
+  while (master_.poll_event(e)) {
+    if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
+    keep(e);
   }
+  // The optional objects the drives lacked during their boot (said once each).
+  for (auto& d : drives_)
+    while (d->poll_notice(e)) keep(e);
 }
 
 void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {

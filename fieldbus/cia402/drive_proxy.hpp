@@ -44,6 +44,10 @@ struct SdoWrite {
   std::uint8_t sub = 0;
   std::uint8_t size = 4;  ///< 1, 2, 3 or 4 bytes
   std::uint32_t value = 0;
+  /// DriveConfig::extra_writes: a drive without the object is fine (abort
+  /// 0x06020000 / 0x06090011 accepted and said once: DriveProxy::poll_notice), e.g. a
+  /// default the configuration did not ask for.
+  bool optional = false;
 };
 
 /// Configuration keys to name when the drive refuses a boot configuration
@@ -81,7 +85,18 @@ enum class BootCheck : std::uint8_t {
   kRevision,        ///< 0x1018:3 against DriveIdentity::revision
   kSupportedModes,  ///< 0x6502 has a bit for every DriveConfig::needed_modes entry (absent: not checked)
   kModeDisplay,     ///< 0x6061 shows the mode written to 0x6060 (absent: assumed)
+  /// 0x60C2:2 read after the drive refused to write it (read-only or
+  /// absent): the period must be expressible in the drive's unit (`read_value`
+  /// the drive's index, `expected` the period in ns).
+  kInterpolationIndex,
 };
+
+/// One sentence for a canopen::NodeEvent::Kind::kObjectAbsent (an optional
+/// boot object the drive lacks or refused as read-only, and the fallback the
+/// proxy took), e.g. "node 2: no 0x1016 (Consumer heartbeat time, SDO abort
+/// 0x06020000): the drive does not watch the master's heartbeat". Uses
+/// snprintf: call it from a non-RT thread.
+[[nodiscard]] std::string describe_notice(const canopen::NodeEvent& e);
 
 /// What the configuration expects of the drive's identity (`drive.identity`);
 /// unset members are not read (0x1018:2/3 are optional in CiA 301).
@@ -136,6 +151,11 @@ struct DriveConfig {
   std::int64_t sdo_timeout_ns = 200'000'000;        ///< per SDO response
   std::int64_t start_timeout_ns = 1'000'000'000;    ///< NMT start -> first TPDO
   std::int64_t transition_timeout_ns = 500'000'000; ///< per state machine transition
+  /// A drive refuses a fault reset while the fault's cause remains: the reset
+  /// edge (controlword bit 7 0 -> 1) is repeated this often (one RPDO with
+  /// bit 7 clear, then set again) until the drive leaves Fault or
+  /// transition_timeout_ns expires. 0 = one edge only.
+  std::int64_t fault_reset_repeat_ns = 50'000'000;
   std::int64_t mode_switch_timeout_ns = 500'000'000; ///< 0x6061 must show a set_mode() request within this; 0 = unchecked
   std::int64_t homing_timeout_ns = 60'000'000'000;   ///< start_homing() -> homing completed or error; 0 = unchecked
   DriveIdentity identity;         ///< checked against 0x1000 / 0x1018 at boot
@@ -150,8 +170,10 @@ struct DriveConfig {
   /// abort 0x06020000 / 0x06090011 is accepted.
   std::shared_ptr<const canopen::DeviceDictionary> dictionary;
   /// 0x1016:1 comes from a default, not from the configuration: a drive
-  /// without 0x1016 is fine (the write is optional, see `dictionary`).
-  bool consumer_heartbeat_optional = false;
+  /// without 0x1016 is fine (the write is optional, see `dictionary`). True
+  /// by default (consumer_heartbeat_ms's default is not a user's request);
+  /// canmotiond sets it false when the file sets master_heartbeat_timeout_ms.
+  bool consumer_heartbeat_optional = true;
 };
 
 /// One SDO transfer of the boot configuration, in the order the proxy makes
@@ -162,6 +184,9 @@ struct BootWrite {
   WriteOrigin origin = WriteOrigin::kMode;
   std::uint16_t extra = 0;  ///< kExtra: index in DriveConfig::extra_writes
   bool optional = false;    ///< a drive without the object is fine (abort 0x06020000 / 0x06090011 accepted)
+  /// Runs only after the drive refused 0x60C2:2 (the read of its index and
+  /// 0x60C2:1 written again in its unit); skipped otherwise.
+  bool ip_fallback = false;
   BootCheck check = BootCheck::kNone;  ///< not kNone: a read (upload) that checks the drive
   [[nodiscard]] constexpr bool is_read() const noexcept { return check != BootCheck::kNone; }
 };
@@ -277,6 +302,11 @@ class DriveProxy {
   static constexpr std::uint32_t kModeWriteTag = 0xFFFF0001u;
   /// Tag of the homing parameter writes (start_homing()).
   static constexpr std::uint32_t kHomingWriteTag = 0xFFFF0002u;
+  /// Tag of the read of 0x603F (error code) when the drive is in Fault
+  /// without having sent an EMCY: its code is taken as the EMCY's
+  /// (last_emcy_code(), Failure::emcy_code) and passed on as a
+  /// NodeEvent::Kind::kEmcy (poll_notice()).
+  static constexpr std::uint32_t kErrorCodeTag = 0xFFFF0003u;
 
   // ---- commands ---------------------------------------------------------
   /// Go to Operation enabled (2, 3, 4; a fault must be reset first). Clears a
@@ -357,6 +387,11 @@ class DriveProxy {
   /// lacks the object (unused PDOs, an optional 0x1016, no 0x6502 / 0x6061),
   /// since the last (re)start of the configuration.
   [[nodiscard]] std::size_t tolerated_aborts() const noexcept { return tolerated_; }
+  /// The next optional boot object the drive lacked (or refused as
+  /// read-only) and the fallback taken (NodeEvent::Kind::kObjectAbsent,
+  /// describe_notice()), each object once per proxy (not again at a
+  /// re-boot). DriveNetwork::update() passes them on as events. Realtime-safe.
+  bool poll_notice(canopen::NodeEvent& out) noexcept;
   /// The boot configuration's SDO transfers, in order: the checking reads
   /// (BootWrite::is_read(): 0x1000, 0x1018 as configured, 0x6502 first,
   /// 0x6061 last) and the writes (built at set-up; optional ones to objects
@@ -365,6 +400,9 @@ class DriveProxy {
   /// Boot-ups that (re-)ran the configuration: while running, while
   /// configuring, or after a failed boot.
   [[nodiscard]] std::uint32_t reboots() const noexcept { return reboots_; }
+  /// Fault-reset rising edges (controlword bit 7 0 -> 1) sent so far
+  /// (DriveConfig::fault_reset_repeat_ns).
+  [[nodiscard]] std::uint32_t fault_reset_edges() const noexcept { return reset_edges_; }
   /// Clear the recorded failure (the state machine keeps its state).
   void clear_failure() noexcept { failure_ = Failure{}; }
   [[nodiscard]] std::uint16_t last_emcy_code() const noexcept { return emcy_code_; }
@@ -394,6 +432,12 @@ class DriveProxy {
   std::size_t next_write_ = 0;
   std::size_t done_writes_ = 0;
   std::size_t tolerated_ = 0;
+  bool ip_fallback_ = false;  // 0x60C2:2 refused: the BootWrite::ip_fallback entries run
+  std::uint32_t ip_abort_ = 0;  // the abort 0x60C2:2's write got
+  std::vector<std::uint8_t> noticed_;  // per writes_ entry: its notice was made (said once)
+  std::array<canopen::NodeEvent, 16> notices_{};  // bound: at most one per optional boot object, 16 is ample
+  std::size_t notice_head_ = 0, notice_count_ = 0;
+  void notice(std::size_t write, std::uint32_t abort, std::int32_t detail = 0) noexcept;
   std::uint32_t reboots_ = 0;
   bool nmt_left_ = false;  // heartbeat showed pre-operational / stopped while operational
 
@@ -422,6 +466,14 @@ class DriveProxy {
   State flight_from_ = State::kUnknown;
   std::int64_t flight_since_ns_ = 0;
   std::uint32_t flight_cycles_ = 0;
+  std::int64_t reset_edge_ns_ = 0;     // when the last fault-reset rising edge went out
+  // 0x603F read (kErrorCodeTag) for a Fault without EMCY.
+  bool in_fault_ = false;              // the statusword shows Fault / Fault reaction active
+  bool emcy_in_fault_ = false;         // an EMCY (not 0000h) came since the last fault ended
+  bool error_code_asked_ = false;      // 0x603F queued for this fault
+  std::int64_t fault_since_ns_ = 0;
+  void step_error_code(std::int64_t now_ns) noexcept;
+  std::uint32_t reset_edges_ = 0;      // fault-reset rising edges sent (fault_reset_edges())
 
   Mode mode_ = Mode::kCsp;
   Mode sdo_mode_pending_ = Mode::kNoMode;

@@ -17,8 +17,10 @@ void Emulator::reset_direct_model() noexcept {
 }
 
 double Emulator::csv_ramp(double target, double dt) noexcept {
-  const auto vpos = static_cast<double>(val(hot_.ramp_vpos));
-  const auto vneg = static_cast<double>(val(hot_.ramp_vneg));
+  // A drive without 0x2010 (EmulatorBehaviour::optional_objects_absent) has
+  // no ramp velocity limit but its own maximum velocity.
+  const double vpos = hot_.ramp_vpos != nullptr ? static_cast<double>(val(hot_.ramp_vpos)) : cfg_.max_velocity;
+  const double vneg = hot_.ramp_vneg != nullptr ? static_cast<double>(val(hot_.ramp_vneg)) : cfg_.max_velocity;
   target = std::clamp(target, -vneg, vpos);
   const double v = vel_;
   const double e = target - v;

@@ -122,19 +122,6 @@ struct EmulatorBehaviour {
 
   [[nodiscard]] static EmulatorBehaviour strict() noexcept { return EmulatorBehaviour{}; }
   [[nodiscard]] static EmulatorBehaviour permissive() noexcept;
-  /// What the loop rigs (SimRig, SimWorld via config::emulator_config, the
-  /// controller test rigs) use: strict except the two behaviours today's
-  /// master fails on at every boot (issue 15 items 5/6, being fixed in
-  /// fieldbus/cia402): it writes 0x1016 and the MDS objects 0x2010..0x2022
-  /// to every drive (optional_objects_absent) and 0x60C2:2
-  /// (ip_index_read_only), and stops at the abort. Make it strict() when the
-  /// master copes with both.
-  [[nodiscard]] static EmulatorBehaviour loop_default() noexcept {
-    EmulatorBehaviour b;
-    b.optional_objects_absent = false;
-    b.ip_index_read_only = false;
-    return b;
-  }
 };
 
 /// The objects a drive may lack (EmulatorBehaviour::optional_objects_absent).

@@ -26,13 +26,9 @@ namespace canmotion::emulator {
 struct SimRigConfig {
   std::int64_t cycle_ns = 1'000'000;
   std::vector<std::uint8_t> nodes = {2, 3, 4};
-  /// Template; `node` is set per drive. Behaviour: EmulatorBehaviour::loop_default()
-  /// (strict but for two master gaps); a test may choose strict() or permissive().
-  EmulatorConfig emulator = [] {
-    EmulatorConfig e;
-    e.behaviour = EmulatorBehaviour::loop_default();
-    return e;
-  }();
+  /// Template; `node` is set per drive. Behaviour: EmulatorBehaviour::strict()
+  /// (the default); a test may choose permissive() or single flags.
+  EmulatorConfig emulator{};
   cia402::DriveConfig drive{};    ///< template; `node` and `cycle_ns` are set per drive
   canopen::MasterConfig master{};
   /// The master's interface queues this many frames per cycle (txqueuelen,

@@ -128,9 +128,12 @@ TEST(EdsConfig, BootWritesLeaveOutOptionalObjectsTheEdsLacks) {
   // minimal drive has RPDO2 and TPDO2, so 3, 4 and 0x1016 are left out.
   EXPECT_EQ(optional, 7);
   EXPECT_EQ(all.size(), w.size() + 5);
-  // The boot's optional reads (0x6502, 0x6061) stay: the minimal drive has both.
-  const auto optional_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.optional && b.is_read(); });
+  // The boot's optional reads (0x6502, 0x6061) stay: the minimal drive has
+  // both; so does the read of 0x60C2:2 made only if the drive refuses it.
+  const auto optional_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.optional && b.is_read() && !b.ip_fallback; });
   EXPECT_EQ(optional_reads, 2);
+  const auto fallback_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.ip_fallback && b.is_read(); });
+  EXPECT_EQ(fallback_reads, 1);
 }
 
 }  // namespace

@@ -58,7 +58,7 @@ struct FaultRig {
     x.drive.node = kNode;
     emulator::EmulatorConfig ec;
     ec.node = kNode;
-    ec.behaviour = emulator::EmulatorBehaviour::loop_default();
+    ec.behaviour = emulator::EmulatorBehaviour::strict();
     if (tweak) tweak(x, ec);
     spec.axes.push_back(x);
     world.add_drive(0, ec);
@@ -425,7 +425,8 @@ TEST(DriveFaults, DriveWithoutHeartbeatConsumerAndWithFewerPdosBoots) {
     e.absent_objects = {0x1016, 0x1402, 0x1403, 0x1602, 0x1603, 0x1802, 0x1803, 0x1A02, 0x1A03};
   });
   ASSERT_TRUE(r.operational()) << r.axis().failure.to_string();
-  EXPECT_EQ(r.ctl->network(0).at(0).tolerated_aborts(), 4u) << "RPDO3/4 and TPDO3/4 answered 0x06020000";
+  EXPECT_EQ(r.ctl->network(0).at(0).tolerated_aborts(), 5u)
+      << "RPDO3/4 and TPDO3/4 answered 0x06020000, 0x60C2:2 0x06010002 (read-only: 0x60C2:1 written in ms)";
   r.enable_and_move();
 }
 
@@ -434,6 +435,7 @@ TEST(DriveFaults, DriveWithoutHeartbeatConsumerAndWithFewerPdosBoots) {
 TEST(DriveFaults, RefusedHeartbeatConsumerNamesTheKeyThatLeavesItOut) {
   FaultRig r([](AxisSpec& x, emulator::EmulatorConfig& e) {
     x.drive.consumer_heartbeat_ms = 300;
+    x.drive.consumer_heartbeat_optional = false;  // asked for (canmotiond: master_heartbeat_timeout_ms in the file)
     x.drive.hints.consumer_heartbeat = "axes[0].drive.master_heartbeat_timeout_ms";
     e.absent_objects = {0x1016};
   });
@@ -499,14 +501,14 @@ TEST(DriveFaults, AbsentDriveFailsTheBootAndItsLaterBootUpConfiguresIt) {
 TEST(DriveFaults, BusOffFaultsTheAxisAndMasrRecoversOnceTheBusIsBack) {
   // No 0x1029 here: with it the drive also goes Pre-operational when it loses
   // the master's heartbeat, and the master, reading the state only from
-  // TPDOs, never sees its Fault. No lasting fault cause: MASR's one reset
-  // edge may come before the master's heartbeat is back, and is not repeated.
+  // TPDOs, never sees its Fault. (The fault's cause lasts as in the strict
+  // profile: the reset edge is repeated until the drive takes it.)
   // Instant boot: the MSO right after MASR's node restart fails (ERR 20)
   // while the drive is still in Not ready to switch on (issue 15, master side).
   FaultRig r([](AxisSpec&, emulator::EmulatorConfig& e) {
     e.behaviour.error_behaviour = false;
-    e.behaviour.fault_cause_syncs = 0;
     e.behaviour.boot_ns = 0;
+    e.behaviour.optional_objects_absent = false;  // the drive has 0x1016: it watches the master
   });
   r.enable_and_jog();
   const std::int64_t off_at = r.now;

@@ -57,9 +57,11 @@ for ((i = 0; i < 600; i++)); do   # the banner is printed after the buses are op
   sleep 0.05
 done
 grep -q '^canmotiond: .* buses (real time)' "$art/canmotiond.log" || { cat "$art/canmotiond.log" >&2; fail "canmotiond did not start"; }
-"$emu" --interface vcan0 --node 2 --node 3 --lag "$lag" --verbose > "$art/emu-vcan0.log" 2>&1 &
+# Strict drives (cia402-emu's default) with 0x1016: demo.yaml sets
+# master_heartbeat_timeout_ms, so the drives must watch the master.
+"$emu" --interface vcan0 --node 2 --node 3 --lag "$lag" --optional-objects-absent false --verbose > "$art/emu-vcan0.log" 2>&1 &
 pids+=($!)
-"$emu" --interface vcan1 --node 4 --lag "$lag" --verbose > "$art/emu-vcan1.log" 2>&1 &
+"$emu" --interface vcan1 --node 4 --lag "$lag" --optional-objects-absent false --verbose > "$art/emu-vcan1.log" 2>&1 &
 pids+=($!)
 echo "vcan-demo-run: canmotiond started (period $period ms, real time), then the three emulated drives (--lag $lag)"
 wait "$dpid" || status=$?

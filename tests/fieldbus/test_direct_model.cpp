@@ -23,7 +23,15 @@ namespace {
 constexpr std::uint8_t kNode = 2;
 constexpr double kDt = 0.001;
 
-SimRigConfig one_drive(std::vector<SdoWrite> writes, emulator::EmulatorConfig e = SimRigConfig{}.emulator) {
+/// A strict drive that has the MDS objects 0x2010..0x2022 (and 0x1016):
+/// these tests model the ramps and SLAT they configure.
+emulator::EmulatorConfig with_mds_objects() {
+  emulator::EmulatorConfig e;
+  e.behaviour.optional_objects_absent = false;
+  return e;
+}
+
+SimRigConfig one_drive(std::vector<SdoWrite> writes, emulator::EmulatorConfig e = with_mds_objects()) {
   SimRigConfig c;
   c.nodes = {kNode};
   c.drive.pdo_profile = cia402::PdoProfile::kCspCsvCst;
@@ -138,7 +146,7 @@ TEST(DirectModel, JerkControlGivesAnSCurveWithoutOvershoot) {
 
 TEST(DirectModel, CstPlainTorqueFollowsTheLoadModel) {
   emulator::EmulatorConfig e;
-  e.behaviour = emulator::EmulatorBehaviour::loop_default();  // 0x2010..0x2022 present
+  e.behaviour.optional_objects_absent = false;  // a drive with the MDS objects 0x2010..0x2022 (and 0x1016)
   e.lag_cycles = 0;
   e.rated_torque_acceleration = 1'000'000;
   e.viscous_friction = 0.01;
@@ -210,7 +218,7 @@ SlatRun run_slat(SimRig& rig, int mode, double set_point, int delay_ms, int cycl
 
 TEST(DirectModel, Slat1MinSpeedTorqueSwitchesPerTheSeed) {
   emulator::EmulatorConfig e;
-  e.behaviour = emulator::EmulatorBehaviour::loop_default();  // 0x2010..0x2022 present
+  e.behaviour.optional_objects_absent = false;  // a drive with the MDS objects 0x2010..0x2022 (and 0x1016)
   e.lag_cycles = 0;
   e.rated_torque_acceleration = 1'000'000;
   e.viscous_friction = 0.01;
@@ -242,7 +250,7 @@ TEST(DirectModel, Slat1MinSpeedTorqueSwitchesPerTheSeed) {
 
 TEST(DirectModel, Slat2MaxSpeedTorqueSwitchesPerTheSeed) {
   emulator::EmulatorConfig e;
-  e.behaviour = emulator::EmulatorBehaviour::loop_default();  // 0x2010..0x2022 present
+  e.behaviour.optional_objects_absent = false;  // a drive with the MDS objects 0x2010..0x2022 (and 0x1016)
   e.lag_cycles = 0;
   e.rated_torque_acceleration = 1'000'000;
   e.viscous_friction = 0.01;
@@ -271,7 +279,7 @@ TEST(DirectModel, Slat2MaxSpeedTorqueSwitchesPerTheSeed) {
 
 TEST(DirectModel, SlatObjectsRejectInvalidValues) {
   emulator::EmulatorConfig e;
-  e.behaviour = emulator::EmulatorBehaviour::loop_default();  // 0x2010..0x2022 present
+  e.behaviour.optional_objects_absent = false;  // a drive with the MDS objects 0x2010..0x2022 (and 0x1016)
   emulator::Emulator emu(e);
   const std::uint8_t three[] = {3};
   const std::uint8_t too_much[] = {101};

@@ -1,6 +1,8 @@
 // Deterministic master + emulated drives on the SimBus with a virtual clock.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "fieldbus/canopen/cob_id.hpp"
@@ -41,7 +43,6 @@ TEST(FieldbusLoop, BootConfigureEnable) {
     EXPECT_EQ(emu.read_int(0x60C2, 1), 1);
     EXPECT_EQ(emu.read_int(0x60C2, 2), -3);
     EXPECT_EQ(emu.read_int(0x1017), 100);
-    EXPECT_EQ(emu.read_int(0x1016, 1), (127 << 16) | 300);
     EXPECT_EQ(emu.read_int(0x1A00, 2), 0x60640020);
     EXPECT_EQ(emu.read_int(0x1801, 1) & 0x80000000LL, 0x80000000LL);  // unused TPDO2 disabled
     EXPECT_EQ(rig.drive(n).feedback().statusword & 0x6F, 0x27);
@@ -77,11 +78,7 @@ TEST(FieldbusLoop, CspRampFollowedWithinLag) {
 }
 
 TEST(FieldbusLoop, InjectedFaultEmcyResetReenable) {
-  SimRigConfig cfg = rig_config();
-  // Permissive here: the master sends one fault-reset edge and does not send
-  // another while the strict drive refuses it (the fault's cause lasts 20
-  // SYNCs), so the drive stays in Fault (issue 15, master side).
-  cfg.emulator.behaviour.fault_cause_syncs = 0;
+  SimRigConfig cfg = rig_config();  // strict: the fault's cause lasts 20 SYNCs, a reset meanwhile is refused
   SimRig rig(cfg);
   boot_and_enable(rig);
   // Inject over SDO: write 0x2310 to 0x2000 of node 3.
@@ -105,9 +102,93 @@ TEST(FieldbusLoop, InjectedFaultEmcyResetReenable) {
   d.fault_reset();
   ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kSwitchOnDisabled; }, 100));
   EXPECT_FALSE(d.failed());
+  // The first edge came while the cause lasted: the drive took a later one.
+  EXPECT_GE(d.fault_reset_edges(), 2u);
   EXPECT_EQ(rig.emulator(3).read_int(0x603F), 0);
   d.enable();
   ASSERT_TRUE(rig.run_until([&] { return d.enabled(); }, 100));
+}
+
+// A drive in Fault that sends no EMCY (its EMCY COB-ID 0x1014 invalid): the
+// master reads 0x603F and reports its code as the EMCY's.
+TEST(FieldbusLoop, FaultWithoutEmcyReads603F) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  auto& emu = rig.emulator(2);
+  const std::array<std::uint8_t, 4> off{0x82, 0x00, 0x00, 0x80};  // 0x1014 = 0x80000082: EMCY off
+  ASSERT_EQ(emu.sdo_write(0x1014, 0, off), canopen::SdoAbort::kNone);
+  can::SimBus::Endpoint& spy = rig.bus().add_endpoint("spy");
+  ASSERT_TRUE(rig.network().master().sdo(2).download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 100));
+  EXPECT_FALSE(d.has_emcy());
+  ASSERT_TRUE(rig.run_until([&] { return d.has_emcy(); }, 20)) << "0x603F not read";
+  EXPECT_EQ(d.last_emcy_code(), 0x2310);
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kDriveFault);
+  EXPECT_NE(d.failure().to_string().find("last EMCY 0x2310"), std::string::npos) << d.failure().to_string();
+  rig.step();  // the network passes the proxy's events on at the next cycle
+  bool event = false;
+  canopen::NodeEvent e;
+  while (rig.network().poll_event(e))
+    event = event || (e.kind == canopen::NodeEvent::Kind::kEmcy && e.node == 2 && e.emcy.code == 0x2310);
+  EXPECT_TRUE(event) << "the code is passed on as an EMCY event";
+  // Golden bytes: upload 0x603F, expedited 2-byte reply 0x2310.
+  std::array<can::TimedFrame, 512> buf{};
+  bool req = false, rsp = false;
+  for (std::size_t k; (k = spy.receive(buf)) > 0;)
+    for (std::size_t j = 0; j < k; ++j) {
+      const can::Frame& f = buf[j].frame;
+      const std::array<std::uint8_t, 8> up{0x40, 0x3F, 0x60, 0x00, 0, 0, 0, 0};
+      const std::array<std::uint8_t, 8> ans{0x4B, 0x3F, 0x60, 0x00, 0x10, 0x23, 0, 0};
+      if (f.id == 0x602 && std::equal(up.begin(), up.end(), f.data.begin())) req = true;
+      if (f.id == 0x582 && std::equal(ans.begin(), ans.end(), f.data.begin())) rsp = true;
+      EXPECT_NE(f.id, 0x082u) << "no EMCY was to be sent";
+    }
+  EXPECT_TRUE(req) << "602#403F600000000000";
+  EXPECT_TRUE(rsp) << "582#4B3F600010230000";
+  // With the EMCY on, no read: the EMCY's code is used.
+  SimRig rig2(cfg);
+  boot_and_enable(rig2);
+  can::SimBus::Endpoint& spy2 = rig2.bus().add_endpoint("spy");
+  ASSERT_TRUE(rig2.network().master().sdo(2).download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
+  ASSERT_TRUE(rig2.run_until([&] { return rig2.drive(2).state() == State::kFault; }, 100));
+  for (int i = 0; i < 20; ++i) rig2.step();
+  EXPECT_EQ(rig2.drive(2).last_emcy_code(), 0x2310);
+  for (std::size_t k; (k = spy2.receive(buf)) > 0;)
+    for (std::size_t j = 0; j < k; ++j)
+      EXPECT_FALSE(buf[j].frame.id == 0x602 && buf[j].frame.data[0] == 0x40 && buf[j].frame.data[1] == 0x3F)
+          << "0x603F read although the EMCY came";
+}
+
+TEST(FieldbusLoop, FaultResetEdgeRepeatedUntilTheTransitionTimeout) {
+  SimRigConfig cfg = rig_config();
+  cfg.nodes = {2};
+  cfg.emulator.behaviour.fault_cause_syncs = 1'000'000;  // the cause never goes
+  SimRig rig(cfg);
+  boot_and_enable(rig);
+  auto& d = rig.drive(2);
+  ASSERT_TRUE(rig.network().master().sdo(2).download_value<std::uint16_t>(0x2000, 0, 0x2310, 77));
+  ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 100));
+  d.fault_reset();
+  // Record bit 7 of every controlword: rising edges every 50 ms, each after one clear RPDO.
+  std::uint32_t rises = 0;
+  bool last = false;
+  for (int i = 0; i < 600 && !d.failed(); ++i) {
+    rig.step();
+    const bool bit7 = (d.controlword() & 0x0080) != 0;
+    rises += bit7 && !last ? 1 : 0;
+    last = bit7;
+  }
+  ASSERT_TRUE(d.failed());
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kTransitionTimeout);
+  EXPECT_EQ(d.failure().transition, 15);
+  EXPECT_EQ(d.state(), State::kFault);
+  // 500 ms transition timeout / 50 ms repeat: 10 or 11 edges (the first at once).
+  EXPECT_GE(rises, 10u);
+  EXPECT_LE(rises, 11u);
+  EXPECT_EQ(d.fault_reset_edges(), rises);
 }
 
 TEST(FieldbusLoop, FollowingErrorFaultsWith8611) {
@@ -143,6 +224,7 @@ TEST(FieldbusLoop, MasterHeartbeatLostFaultsDrive) {
   // Pre-operational and stops its TPDOs; the master takes the state only from
   // TPDOs and never sees the Fault (issue 15, master side).
   cfg.emulator.behaviour.error_behaviour = false;
+  cfg.emulator.behaviour.optional_objects_absent = false;  // the drive has 0x1016 (it watches the master)
   SimRig rig(cfg);
   boot_and_enable(rig);
   // CiA 301: a consumer starts monitoring at the first heartbeat it receives,

@@ -67,6 +67,7 @@ TEST(FieldbusNoAlloc, MdsRampSlatAndModeSwitchTimeoutWithoutAllocating) {
                             {obj::kSlatSetPoint, 0, 4, 1'000},       {obj::kSlatTimeDelay, 0, 2, 2}};
   cfg.emulator.viscous_friction = 0.01;
   cfg.emulator.rated_torque_acceleration = 1'000'000;
+  cfg.emulator.behaviour.optional_objects_absent = false;  // a drive with the MDS objects 0x2010..0x2022
   emulator::SimRig rig(cfg);
   rig.power_on();
   g_allocs = 0;

@@ -50,7 +50,7 @@ struct SimController {
     x.drive.node = kNode;
     emulator::EmulatorConfig ec;
     ec.node = kNode;
-    ec.behaviour = emulator::EmulatorBehaviour::loop_default();
+    ec.behaviour = emulator::EmulatorBehaviour::strict();
     if (tweak) tweak(x, ec);
     spec.axes.push_back(x);
     rt::CamSpec cam;

@@ -23,6 +23,7 @@
 #include "config/config.hpp"
 #include "config/eds_check.hpp"
 #include "config/runtime.hpp"
+#include "fieldbus/cia402/drive_proxy.hpp"
 #include "fieldbus/eds/dcf.hpp"
 #include "fieldbus/can/can_netlink.hpp"
 #include "fieldbus/can/candump_format.hpp"
@@ -148,6 +149,8 @@ class Outputs {
                    e.node.emcy.code, canopen::emcy_code_text(e.node.emcy.code));
       } else if (e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kHeartbeatLost) {
         fmt::print(stderr, "canmotiond: bus {} node {}: heartbeat lost\n", cfg_.buses[e.bus].name, e.node.node);
+      } else if (!quiet && e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kObjectAbsent) {
+        fmt::print(stderr, "canmotiond: bus {} {}\n", cfg_.buses[e.bus].name, cia402::describe_notice(e.node));
       } else if (e.kind == rt::Event::Kind::kBusState) {
         fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
         // On this (housekeeping) thread, never the cycle: rtnetlink, and a

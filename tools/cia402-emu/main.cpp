@@ -62,7 +62,7 @@ constexpr const char* kFooter = R"(Examples:
       strict, 2 s of DC bus charging, SDO replies 5 ms late, local control
 
 Profiles (--profile; a flag changes one behaviour of the profile):
-  strict      what a real drive does: 0x1016 and 0x2010..0x2022 absent
+  strict      (default) what a real drive does: 0x1016 and 0x2010..0x2022 absent
               (--optional-objects-absent), 0x60C2:2 read-only (--ip-index-ro), PDO
               changes only in Pre-operational (--remap-preop-only), CiA 402
               predefined PDO1 = controlword/statusword, type 255
@@ -76,9 +76,6 @@ Profiles (--profile; a flag changes one behaviour of the profile):
               refused (--refuse-unsupported-modes), homing moves per method
               (--homing-model)
   permissive  none of the above (each flag's off/0 value)
-  loop        (default) strict, but 0x1016, 0x2010..0x2022 present and
-              0x60C2:2 writable: today's master writes them to every drive
-              (the loop and vcan tests' profile until it no longer does)
 Both: TPDO types 0/1..240/254/255 and RPDO 254/255 per CiA 301, EMCY 8210h
 once with error register bits 0 and 4, 0000h when it clears.
 
@@ -127,7 +124,7 @@ int main(int argc, char** argv) {
   double rated_torque_accel = 0.0, load_torque = 0.0, viscous = 0.0;
   bool refuse_mode = false;
   std::vector<std::string> absent;
-  std::string profile = "loop";
+  std::string profile = "strict";
   std::optional<bool> f_optional, f_ip_ro, f_remap, f_pdos, f_long, f_sync, f_errb, f_one, f_modes, f_homing;
   std::optional<double> boot_ms, sdo_delay_ms;
   std::optional<std::uint32_t> fault_cause_syncs, mode_switch_syncs;
@@ -163,10 +160,9 @@ int main(int argc, char** argv) {
                  "counts, mapping flags, access types and defaults from the file")
       ->check(CLI::ExistingFile);
   app.add_option("--profile", profile,
-                 "strict (a real drive's behaviours), permissive (the lenient drive) or loop (strict but for the two "
-                 "master gaps, see below)")
-      ->check(CLI::IsMember({"strict", "permissive", "loop"}))
-      ->default_val("loop");
+                 "strict (a real drive's behaviours) or permissive (the lenient drive)")
+      ->check(CLI::IsMember({"strict", "permissive"}))
+      ->default_val("strict");
   auto flag_opt = [&app](const char* name, std::optional<bool>& v, const char* what) {
     app.add_option(name, v, std::string(what) + " (true/false; default: the profile's)");
   };
@@ -225,9 +221,8 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  emulator::EmulatorBehaviour behaviour = profile == "strict"       ? emulator::EmulatorBehaviour::strict()
-                                          : profile == "permissive" ? emulator::EmulatorBehaviour::permissive()
-                                                                    : emulator::EmulatorBehaviour::loop_default();
+  emulator::EmulatorBehaviour behaviour =
+      profile == "permissive" ? emulator::EmulatorBehaviour::permissive() : emulator::EmulatorBehaviour::strict();
   auto apply = [](bool& field, const std::optional<bool>& v) {
     if (v) field = *v;
   };
