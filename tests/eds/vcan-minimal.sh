@@ -35,6 +35,7 @@ WAIT UNTIL mso1.DN TIMEOUT 30;
 MAM(X, mam1, Incremental, 20, 20, UnitsPerSec, 200, UnitsPerSec2, 200, UnitsPerSec2, Trapezoidal, 100, 100, %ofTime, Disabled, Programmed, 0, None, 0, 0);
 WAIT UNTIL mam1.PC TIMEOUT 30;
 PRINT mam1.PC, X.AxisFault, X.ActualPosition;
+WAIT 0.2;
 S
 "$emu" --interface vcan0 --node 2 --eds "$eds" --verbose > "$art/emu.log" 2>&1 &
 epid=$!
@@ -45,7 +46,9 @@ timeout -s INT -k 30 300 "$daemon" --config "$art/minimal.yaml" --script "$art/m
 cat "$art/canmotiond.log"
 [[ $rc == 0 ]] || fail "canmotiond exit $rc"
 # The move completes without an axis fault (the actual position lags the
-# command on the real bus at PC), and the axis ends at 20 mm.
+# command on the real bus at PC: the strict drive applies an RPDO at the
+# next SYNC, so the script waits 0.2 s before its end disables the drive),
+# and the axis ends at 20 mm.
 grep -qE '^t=[0-9.]+ mam1\.PC=1 X\.AxisFault=0 X\.ActualPosition=' "$art/canmotiond.log" || fail "the move did not complete"
 grep -qE '^summary: axis X +node +2 .*final position 20\.0000 ' "$art/canmotiond.log" || fail "the axis did not end at 20 mm"
 grep -q "minimal-drive.eds has no 0x1016:01: the write is left out" "$art/canmotiond.log" || fail "no note on 0x1016"

@@ -58,12 +58,10 @@ for ((i = 0; i < 600; i++)); do
   kill -0 "$dpid" 2>/dev/null || break
   sleep 0.05
 done
-# --ip-index-ro false: canmotiond writes 0x60C2:2 (interpolation time index)
-# and a strict drive refuses it (0x06010002), which fails the boot; that is
-# one of the two master gaps the loop profile leaves out (see the report of
-# issue 15, branch net15). Everything else is strict: homing takes time,
-# optional objects (0x1016) absent, one transition per SYNC, boot 100 ms.
-"$emu" --interface vcan0 --node 2 --profile strict --ip-index-ro false --verbose > "$art/emu.log" 2>&1 &
+# The strict profile: homing takes time, optional objects (0x1016) absent,
+# 0x60C2:2 read-only (canmotiond falls back on 0x60C2:1 in the drive's
+# unit), one transition per SYNC, boot 100 ms.
+"$emu" --interface vcan0 --node 2 --profile strict --verbose > "$art/emu.log" 2>&1 &
 epid=$!
 wait "$dpid" || rc=$?
 cat "$art/canmotiond.log"
