@@ -191,6 +191,12 @@ std::size_t SocketCanBus::receive(std::span<TimedFrame> out) noexcept {
     }
     if (t_ns < 0)  // no stamp from the kernel: the time of reading
       t_ns = clock_ns(rx_clock_ == RxClock::kRealtime ? CLOCK_REALTIME : CLOCK_MONOTONIC);
+    // Never earlier than the frame before: the realtime-to-monotonic offset
+    // is read once per call, and a step or slew of CLOCK_REALTIME between two
+    // calls (NTP, a VM's clock sync) would otherwise put a later frame before
+    // an earlier one (seen in vcan.sendrecv in the VM).
+    if (t_ns < last_rx_ns_) t_ns = last_rx_ns_;
+    last_rx_ns_ = t_ns;
     if (drops != last_kernel_drops_) {
       counters_.rx_dropped += drops - last_kernel_drops_;
       push_event(BusEvent{BusEvent::Kind::kRxOverflow, state_, drops - last_kernel_drops_, t_ns});

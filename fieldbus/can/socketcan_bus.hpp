@@ -69,7 +69,10 @@ class SocketCanBus final : public Transport {
 
   /// Choose the clock of the receive stamps (default kMonotonic). Not realtime
   /// relevant: call it once after open().
-  void set_rx_clock(RxClock c) noexcept { rx_clock_ = c; }
+  void set_rx_clock(RxClock c) noexcept {
+    rx_clock_ = c;
+    last_rx_ns_ = 0;  // another scale: the order starts afresh
+  }
   [[nodiscard]] RxClock rx_clock() const noexcept { return rx_clock_; }
 
   /// The socket, for poll()/epoll in non-RT tools that want to block.
@@ -107,6 +110,7 @@ class SocketCanBus final : public Transport {
   int last_errno_ = 0;
   RxClock rx_clock_ = RxClock::kMonotonic;
   std::uint32_t last_kernel_drops_ = 0;
+  std::int64_t last_rx_ns_ = 0;  ///< stamp of the last frame received (receive stamps never go back)
   std::array<BusEvent, kEventCapacity> events_{};
   std::size_t ev_head_ = 0;  // next to read
   std::size_t ev_count_ = 0;
