@@ -41,19 +41,6 @@ Err check_request(Ctx& x) noexcept {
   return oc.ok ? Err::None : x.reject_operand(oc.index);
 }
 
-/// Program mode: the instructions that would start motion (ERR 24 Illegal
-/// Controller Mode); the others make an axis safe or ready, or compute.
-constexpr bool starts_motion(Instr i) noexcept {
-  switch (i) {
-    case Instr::MSO: case Instr::MSF: case Instr::MASD: case Instr::MASR: case Instr::MAFR: case Instr::MAS:
-    case Instr::MRP: case Instr::MCCP: case Instr::MGS: case Instr::MGSD: case Instr::MGSR: case Instr::MCS:
-    case Instr::MCSD:
-      return false;
-    default:
-      return true;
-  }
-}
-
 }  // namespace
 
 void Planner::set_controller_mode(ControllerMode m) noexcept {
@@ -79,7 +66,7 @@ Err Planner::execute(const Request& r) noexcept {
   tag.begin_execution();
   Ctx x{c_, r, tag, OwnerRef{r.control, tag.generation}};
   Err e = check_request(x);
-  if (e == Err::None && c_.mode == ControllerMode::Program && starts_motion(r.instr)) e = Err::IllegalControllerMode;
+  if (e == Err::None && c_.mode == ControllerMode::Program && signature(r.instr).starts_motion) e = Err::IllegalControllerMode;
   // the typed params (from the table-checked request) to the family's start()
   if (e == Err::None) e = std::visit([&x](const auto& p) noexcept { return start(x, p); }, decode(r));
   if (e != Err::None) tag.reject(e, x.exerr);

@@ -70,6 +70,9 @@ struct InstrSig {
   std::string_view name;
   std::span<const OperandSig> operands;
   bool executable;  ///< the planner runs it (else it is parsed and rejected with ERR 75)
+  /// It would start motion: refused in Program mode (ERR 24 Illegal
+  /// Controller Mode). The others make an axis safe or ready, or compute.
+  bool starts_motion;
 };
 
 /// THE table: constant data, in the header so that operand positions are
@@ -236,32 +239,32 @@ inline constexpr OperandSig kMdcc[] = {{"SlaveSystem", K::CoordSystem}, ax("Mast
                                        en("MasterReference", kMasterRef), real("NominalMasterVelocity")};
 
 inline constexpr std::array<InstrSig, kInstrCount> kTable{{
-    {Instr::MSO, "MSO", kAxisCtl, true},
-    {Instr::MSF, "MSF", kAxisCtl, true},
-    {Instr::MASD, "MASD", kAxisCtl, true},
-    {Instr::MASR, "MASR", kAxisCtl, true},
-    {Instr::MAFR, "MAFR", kAxisCtl, true},
-    {Instr::MAS, "MAS", kMas, true},
-    {Instr::MAH, "MAH", kAxisCtl, true},
-    {Instr::MAJ, "MAJ", kMaj, true},
-    {Instr::MAM, "MAM", kMam, true},
-    {Instr::MAG, "MAG", kMag, true},
-    {Instr::MCD, "MCD", kMcd, true},
-    {Instr::MRP, "MRP", kMrp, true},
-    {Instr::MCCP, "MCCP", kMccp, true},
-    {Instr::MAPC, "MAPC", kMapc, true},
-    {Instr::MATC, "MATC", kMatc, true},
-    {Instr::MDAC, "MDAC", kMdac, true},
-    {Instr::MDS, "MDS", kMds, true},
-    {Instr::MGS, "MGS", kMgs, true},
-    {Instr::MGSD, "MGSD", kGroupCtl, true},
-    {Instr::MGSR, "MGSR", kGroupCtl, true},
-    {Instr::MCLM, "MCLM", kMclm, true},
-    {Instr::MCCM, "MCCM", kMccm, true},
-    {Instr::MCS, "MCS", kMcs, true},
-    {Instr::MCSD, "MCSD", kCsCtl, true},
-    {Instr::MCCD, "MCCD", kMccd, true},
-    {Instr::MDCC, "MDCC", kMdcc, true},
+    {Instr::MSO, "MSO", kAxisCtl, true, false},
+    {Instr::MSF, "MSF", kAxisCtl, true, false},
+    {Instr::MASD, "MASD", kAxisCtl, true, false},
+    {Instr::MASR, "MASR", kAxisCtl, true, false},
+    {Instr::MAFR, "MAFR", kAxisCtl, true, false},
+    {Instr::MAS, "MAS", kMas, true, false},
+    {Instr::MAH, "MAH", kAxisCtl, true, true},
+    {Instr::MAJ, "MAJ", kMaj, true, true},
+    {Instr::MAM, "MAM", kMam, true, true},
+    {Instr::MAG, "MAG", kMag, true, true},
+    {Instr::MCD, "MCD", kMcd, true, true},
+    {Instr::MRP, "MRP", kMrp, true, false},
+    {Instr::MCCP, "MCCP", kMccp, true, false},
+    {Instr::MAPC, "MAPC", kMapc, true, true},
+    {Instr::MATC, "MATC", kMatc, true, true},
+    {Instr::MDAC, "MDAC", kMdac, true, true},
+    {Instr::MDS, "MDS", kMds, true, true},
+    {Instr::MGS, "MGS", kMgs, true, false},
+    {Instr::MGSD, "MGSD", kGroupCtl, true, false},
+    {Instr::MGSR, "MGSR", kGroupCtl, true, false},
+    {Instr::MCLM, "MCLM", kMclm, true, true},
+    {Instr::MCCM, "MCCM", kMccm, true, true},
+    {Instr::MCS, "MCS", kMcs, true, false},
+    {Instr::MCSD, "MCSD", kCsCtl, true, false},
+    {Instr::MCCD, "MCCD", kMccd, true, true},
+    {Instr::MDCC, "MDCC", kMdcc, true, true},
 }};
 
 static_assert([] {
