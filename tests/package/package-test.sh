@@ -5,7 +5,9 @@
 #      sysusers.d and modules-load.d file, the conffile, examples and documentation, at /usr paths;
 #      nothing under /usr/local, no build paths, no test programs;
 #   2. metadata (dpkg-deb -f / -I): name, version, architecture, Depends
-#      computed by dpkg-shlibdeps, maintainer scripts and the conffile;
+#      computed by dpkg-shlibdeps (it names the package of every shared
+#      library the programs link: readelf NEEDED, ldd, dpkg -S), maintainer
+#      scripts and the conffile;
 #   3. unpacked into a scratch root (dpkg -x): the programs need no library of
 #      ours (static) and no build path; the installed canmotiond runs
 #      `--sim --config <installed example> --duration 1`, the default
@@ -21,7 +23,7 @@
 #
 # Usage: package-test.sh SOURCE_DIR BUILD_DIR VERSION   (exit 0 = all good)
 set -uo pipefail
-[[ $# -eq 3 ]] || { sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+[[ $# -eq 3 ]] || { sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 src=$(cd "$1" && pwd) build=$(cd "$2" && pwd) version=$3
 work=$build/package-test
 rm -rf "$work"
@@ -87,9 +89,37 @@ field() { dpkg-deb -f "$deb" "$1"; }
 [[ $(field Architecture) == "$(dpkg --print-architecture)" ]] || fail "Architecture: $(field Architecture)"
 depends=$(field Depends)
 echo "Depends: $depends"
-for lib in libc6 libstdc++6 libyaml-cpp libfmt libspdlog; do
-  [[ $depends == *"$lib"* ]] || fail "Depends lacks $lib (dpkg-shlibdeps did not run?)"
+# Depends names the Debian package of every shared library the installed
+# programs need (their NEEDED entries, resolved by ldd, owned per dpkg -S):
+# so no list of libraries is kept here to drift.
+dpkg-deb -x "$deb" "$work/deps-root"
+declare -A lib_pkgs=()
+for p in canmotiond canmotionctl cia402-emu cantrace rt-latency; do
+  b=$work/deps-root/usr/bin/$p
+  while read -r soname; do
+    path=$(ldd "$b" | awk -v so="$soname" '$1 == so && $3 ~ /^\// { print $3; exit }')
+    [[ -n $path ]] || { fail "$p: NEEDED $soname not resolved by ldd"; continue; }
+    owner=""
+    for cand in "$path" "$(realpath "$path")" "${path/#\/usr\/lib\//\/lib\/}" "${path/#\/lib\//\/usr\/lib\/}"; do
+      owner=$(dpkg -S "$cand" 2>/dev/null | head -1 | sed 's/[:,].*//') && [[ -n $owner ]] && break
+    done
+    [[ -n $owner ]] || { fail "$p: no Debian package owns $path ($soname)"; continue; }
+    lib_pkgs[$owner]+="$p:$soname "
+  done < <(readelf -d "$b" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')
 done
+# The names Depends gives (versions and alternatives dropped).
+dep_names=" $(sed 's/([^)]*)//g; s/[,|]/ /g' <<<"$depends" | tr -s ' ') "
+for pkg in "${!lib_pkgs[@]}"; do
+  # The package itself, or a name it provides (libspdlog1.10 provides libspdlog1.10-fmt9, which its shlibs file names).
+  names=("$pkg")
+  read -ra provided <<<"$(dpkg-query -W -f='${Provides}' "$pkg" 2>/dev/null | sed 's/([^)]*)//g; s/,/ /g')"
+  names+=("${provided[@]}")
+  found=0
+  for n in "${names[@]}"; do [[ $dep_names == *" $n "* ]] && found=1; done
+  ((found)) || fail "Depends lacks ${names[*]} (needed by ${lib_pkgs[$pkg]% }; dpkg-shlibdeps did not run?)"
+done
+echo "packages of the libraries the programs link (each checked in Depends): $(printf '%s\n' "${!lib_pkgs[@]}" | sort | tr '\n' ' ')"
+rm -rf "$work/deps-root"
 for f in Maintainer Description Section Priority Installed-Size Homepage; do
   [[ -n $(field "$f") ]] || fail "control field $f empty"
 done
