@@ -93,19 +93,32 @@ echo "Depends: $depends"
 # programs need (their NEEDED entries, resolved by ldd, owned per dpkg -S):
 # so no list of libraries is kept here to drift.
 dpkg-deb -x "$deb" "$work/deps-root"
-declare -A lib_pkgs=()
+declare -A lib_users=() owner_of=()
 for p in canmotiond canmotionctl cia402-emu cantrace rt-latency; do
   b=$work/deps-root/usr/bin/$p
+  resolved=$(ldd "$b")
   while read -r soname; do
-    path=$(ldd "$b" | awk -v so="$soname" '$1 == so && $3 ~ /^\// { print $3; exit }')
+    path=$(awk -v so="$soname" '$1 == so && $3 ~ /^\// { print $3; exit }' <<<"$resolved")
     [[ -n $path ]] || { fail "$p: NEEDED $soname not resolved by ldd"; continue; }
-    owner=""
-    for cand in "$path" "$(realpath "$path")" "${path/#\/usr\/lib\//\/lib\/}" "${path/#\/lib\//\/usr\/lib\/}"; do
-      owner=$(dpkg -S "$cand" 2>/dev/null | head -1 | sed 's/[:,].*//') && [[ -n $owner ]] && break
-    done
-    [[ -n $owner ]] || { fail "$p: no Debian package owns $path ($soname)"; continue; }
-    lib_pkgs[$owner]+="$p:$soname "
+    lib_users[$path]+="$p:$soname "
   done < <(readelf -d "$b" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')
+done
+# One dpkg -S for all of them (it is slow), each path also as /lib <-> /usr/lib (merged /usr).
+cands=()
+for path in "${!lib_users[@]}"; do
+  cands+=("$path" "$(realpath "$path")" "${path/#\/usr\/lib\//\/lib\/}" "${path/#\/lib\//\/usr\/lib\/}")
+done
+while IFS= read -r line; do
+  owner_of[${line#*: }]=${line%%[:,]*}
+done < <(dpkg -S "${cands[@]}" 2>/dev/null)
+declare -A lib_pkgs=()
+for path in "${!lib_users[@]}"; do
+  owner=""
+  for cand in "$path" "$(realpath "$path")" "${path/#\/usr\/lib\//\/lib\/}" "${path/#\/lib\//\/usr\/lib\/}"; do
+    owner=${owner_of[$cand]:-} && [[ -n $owner ]] && break
+  done
+  [[ -n $owner ]] || { fail "no Debian package owns $path (${lib_users[$path]% })"; continue; }
+  lib_pkgs[$owner]+="${lib_users[$path]}"
 done
 # The names Depends gives (versions and alternatives dropped).
 dep_names=" $(sed 's/([^)]*)//g; s/[,|]/ /g' <<<"$depends" | tr -s ' ') "
