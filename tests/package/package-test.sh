@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # package-test.sh: the Debian package as a user gets it. Builds it with CPack
 # from the build tree the other tests use (no second build), then:
-#   1. file list (dpkg-deb -c): every program, man page, unit, networkd and
-#      sysusers file, the conffile, examples and documentation, at /usr paths;
+#   1. file list (dpkg-deb -c): every program, man page, unit, networkd,
+#      sysusers.d and modules-load.d file, the conffile, examples and documentation, at /usr paths;
 #      nothing under /usr/local, no build paths, no test programs;
 #   2. metadata (dpkg-deb -f / -I): name, version, architecture, Depends
-#      computed by dpkg-shlibdeps, maintainer scripts and the conffile;
+#      computed by dpkg-shlibdeps (it names the package of every shared
+#      library the programs link: readelf NEEDED, ldd, dpkg -S), maintainer
+#      scripts and the conffile;
 #   3. unpacked into a scratch root (dpkg -x): the programs need no library of
 #      ours (static) and no build path; the installed canmotiond runs
 #      `--sim --config <installed example> --duration 1`, the default
@@ -21,7 +23,7 @@
 #
 # Usage: package-test.sh SOURCE_DIR BUILD_DIR VERSION   (exit 0 = all good)
 set -uo pipefail
-[[ $# -eq 3 ]] || { sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+[[ $# -eq 3 ]] || { sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 src=$(cd "$1" && pwd) build=$(cd "$2" && pwd) version=$3
 work=$build/package-test
 rm -rf "$work"
@@ -61,10 +63,11 @@ required=(
 unitdir=$(pkg-config --variable=systemdsystemunitdir systemd 2>/dev/null || echo /usr/lib/systemd/system)
 sysusersdir=$(pkg-config --variable=sysusersdir systemd 2>/dev/null || echo /usr/lib/sysusers.d)
 networkdir=$(pkg-config --variable=systemdutildir systemd 2>/dev/null || echo /usr/lib/systemd)/network
+modloaddir=$(pkg-config --variable=modulesloaddir systemd 2>/dev/null || echo /usr/lib/modules-load.d)
 udevdir=$(dirname "$(pkg-config --variable=systemdutildir systemd 2>/dev/null || echo /usr/lib/systemd)")/udev/rules.d
 required+=("$unitdir/canmotiond.service" "$unitdir/cia402-emu@.service" "$unitdir/canmotion-vcan@.service"
            "$sysusersdir/canmotion.conf" "$networkdir/80-vcan0.netdev" "$networkdir/80-vcan0.network"
-           "$udevdir/60-canmotion-cpu-dma-latency.rules")
+           "$udevdir/60-canmotion-cpu-dma-latency.rules" "$modloaddir/canmotion-vcan.conf")
 # Every example of the source tree (EDS files included, wherever they are kept) is in the package.
 while IFS= read -r f; do required+=("/usr/share/canmotion/examples/${f#"$src"/config/examples/}"); done < <(
   find "$src/config/examples" -type f \( -name '*.yaml' -o -name '*.script' -o -iname '*.eds' \))
@@ -86,9 +89,50 @@ field() { dpkg-deb -f "$deb" "$1"; }
 [[ $(field Architecture) == "$(dpkg --print-architecture)" ]] || fail "Architecture: $(field Architecture)"
 depends=$(field Depends)
 echo "Depends: $depends"
-for lib in libc6 libstdc++6 libyaml-cpp libfmt libspdlog; do
-  [[ $depends == *"$lib"* ]] || fail "Depends lacks $lib (dpkg-shlibdeps did not run?)"
+# Depends names the Debian package of every shared library the installed
+# programs need (their NEEDED entries, resolved by ldd, owned per dpkg -S):
+# so no list of libraries is kept here to drift.
+dpkg-deb -x "$deb" "$work/deps-root"
+declare -A lib_users=() owner_of=()
+for p in canmotiond canmotionctl cia402-emu cantrace rt-latency; do
+  b=$work/deps-root/usr/bin/$p
+  resolved=$(ldd "$b")
+  while read -r soname; do
+    path=$(awk -v so="$soname" '$1 == so && $3 ~ /^\// { print $3; exit }' <<<"$resolved")
+    [[ -n $path ]] || { fail "$p: NEEDED $soname not resolved by ldd"; continue; }
+    lib_users[$path]+="$p:$soname "
+  done < <(readelf -d "$b" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')
 done
+# One dpkg -S for all of them (it is slow), each path also as /lib <-> /usr/lib (merged /usr).
+cands=()
+for path in "${!lib_users[@]}"; do
+  cands+=("$path" "$(realpath "$path")" "${path/#\/usr\/lib\//\/lib\/}" "${path/#\/lib\//\/usr\/lib\/}")
+done
+while IFS= read -r line; do
+  owner_of[${line#*: }]=${line%%[:,]*}
+done < <(dpkg -S "${cands[@]}" 2>/dev/null)
+declare -A lib_pkgs=()
+for path in "${!lib_users[@]}"; do
+  owner=""
+  for cand in "$path" "$(realpath "$path")" "${path/#\/usr\/lib\//\/lib\/}" "${path/#\/lib\//\/usr\/lib\/}"; do
+    owner=${owner_of[$cand]:-} && [[ -n $owner ]] && break
+  done
+  [[ -n $owner ]] || { fail "no Debian package owns $path (${lib_users[$path]% })"; continue; }
+  lib_pkgs[$owner]+="${lib_users[$path]}"
+done
+# The names Depends gives (versions and alternatives dropped).
+dep_names=" $(sed 's/([^)]*)//g; s/[,|]/ /g' <<<"$depends" | tr -s ' ') "
+for pkg in "${!lib_pkgs[@]}"; do
+  # The package itself, or a name it provides (libspdlog1.10 provides libspdlog1.10-fmt9, which its shlibs file names).
+  names=("$pkg")
+  read -ra provided <<<"$(dpkg-query -W -f='${Provides}' "$pkg" 2>/dev/null | sed 's/([^)]*)//g; s/,/ /g')"
+  names+=("${provided[@]}")
+  found=0
+  for n in "${names[@]}"; do [[ $dep_names == *" $n "* ]] && found=1; done
+  ((found)) || fail "Depends lacks ${names[*]} (needed by ${lib_pkgs[$pkg]% }; dpkg-shlibdeps did not run?)"
+done
+echo "packages of the libraries the programs link (each checked in Depends): $(printf '%s\n' "${!lib_pkgs[@]}" | sort | tr '\n' ' ')"
+rm -rf "$work/deps-root"
 for f in Maintainer Description Section Priority Installed-Size Homepage; do
   [[ -n $(field "$f") ]] || fail "control field $f empty"
 done
@@ -143,7 +187,7 @@ for u in "$root$unitdir"/*.service; do
     line=${line//\$CIA402_EMU_ARGS/$emu_args}
     read -ra words <<<"$line"
     exe=${words[0]}
-    [[ $exe == /* ]] || continue  # ip, modprobe: the system's
+    [[ $exe == /* ]] || continue  # ip: the system's
     [[ -x $root$exe ]] || { fail "${u##*/}: ExecStart=$exe is not in the package"; continue; }
     args=()
     for a in "${words[@]:1}"; do if [[ $a == /* && -e $root$a ]]; then args+=("$root$a"); else args+=("$a"); fi; done
@@ -159,6 +203,7 @@ step "systemd-analyze verify and security on the installed units"
 units=$work/units
 mkdir -p "$units"
 cp "$root$unitdir"/*.service "$root$networkdir"/80-vcan0.* "$root/usr/share/canmotion/examples/cia402-emu-example.conf" "$units/"
+cp "$root$modloaddir/canmotion-vcan.conf" "$units/canmotion-vcan.modules-load.conf"
 "$src/systemd/verify-units.sh" "$units" || fail "verify-units.sh on the installed units"
 
 step "maintainer scripts with DPKG_ROOT=<scratch root>"
