@@ -18,12 +18,9 @@ set(CANMOTION_SYSTEMD_UNIT_TEMPLATES canmotiond.service cia402-emu@.service)
 set(CANMOTION_SYSTEMD_UNITS canmotion-vcan@.service)
 set(CANMOTION_SYSTEMD_NETWORK 80-vcan0.netdev 80-vcan0.network)
 set(CANMOTION_SYSTEMD_UDEV 60-canmotion-cpu-dma-latency.rules)
-# modules-load.d: the vcan module for canmotion-vcan@.service, which may not
-# load modules itself (ProtectKernelModules=yes); installed as canmotion-vcan.conf.
-set(CANMOTION_SYSTEMD_MODULESLOAD canmotion-vcan.modules-load.conf)
 
 # canmotion_systemd_configure(OUT_DIR): the filled-in units and the plain files
-# (units, networkd files, sysusers.d and modules-load.d files, emulator example) in OUT_DIR, for
+# (units, networkd files, sysusers.d file, emulator example) in OUT_DIR, for
 # CMAKE_INSTALL_PREFIX as it is now.
 function(canmotion_systemd_configure out)
   include(GNUInstallDirs)  # CMAKE_INSTALL_FULL_* for the current prefix (/usr -> /etc)
@@ -31,14 +28,13 @@ function(canmotion_systemd_configure out)
   foreach(t IN LISTS CANMOTION_SYSTEMD_UNIT_TEMPLATES)
     configure_file("${CANMOTION_SYSTEMD_SRC}/${t}.in" "${out}/${t}" @ONLY)
   endforeach()
-  foreach(f IN LISTS CANMOTION_SYSTEMD_UNITS CANMOTION_SYSTEMD_NETWORK CANMOTION_SYSTEMD_UDEV CANMOTION_SYSTEMD_MODULESLOAD
-            ITEMS canmotion.sysusers.conf cia402-emu-example.conf)
+  foreach(f IN LISTS CANMOTION_SYSTEMD_UNITS CANMOTION_SYSTEMD_NETWORK CANMOTION_SYSTEMD_UDEV ITEMS canmotion.sysusers.conf cia402-emu-example.conf)
     configure_file("${CANMOTION_SYSTEMD_SRC}/${f}" "${out}/${f}" COPYONLY)
   endforeach()
 endfunction()
 
 # canmotion_systemd_dir(OUT KIND): where systemd looks for KIND (UNIT, SYSUSERS,
-# NETWORK, UDEV, MODULESLOAD) files of a package installed in CMAKE_INSTALL_PREFIX. A prefix equal
+# NETWORK, UDEV) files of a package installed in CMAKE_INSTALL_PREFIX. A prefix equal
 # to systemd's own (pkg-config systemd: prefix=/usr on Debian) gets systemd's
 # directories as they are (/lib/systemd/system on Debian 12); another prefix
 # the same path below it (/usr/local/lib/systemd/system, also searched by systemd).
@@ -68,7 +64,6 @@ function(canmotion_systemd_install staging)
   canmotion_systemd_dir(sysusersdir SYSUSERS)
   canmotion_systemd_dir(networkdir NETWORK)
   canmotion_systemd_dir(udevdir UDEV)
-  canmotion_systemd_dir(modloaddir MODULESLOAD)
   set(units ${CANMOTION_SYSTEMD_UNIT_TEMPLATES} ${CANMOTION_SYSTEMD_UNITS})
   list(TRANSFORM units PREPEND "${staging}/")
   set(network ${CANMOTION_SYSTEMD_NETWORK})
@@ -78,8 +73,6 @@ function(canmotion_systemd_install staging)
   set(udev ${CANMOTION_SYSTEMD_UDEV})
   list(TRANSFORM udev PREPEND "${staging}/")
   file(INSTALL ${udev} DESTINATION "${udevdir}" FILE_PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ WORLD_READ)
-  file(INSTALL "${staging}/${CANMOTION_SYSTEMD_MODULESLOAD}" DESTINATION "${modloaddir}" RENAME canmotion-vcan.conf
-       FILE_PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ WORLD_READ)
   file(INSTALL "${staging}/canmotion.sysusers.conf" DESTINATION "${sysusersdir}" RENAME canmotion.conf
        FILE_PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ WORLD_READ)
   set(confdir "${CMAKE_INSTALL_FULL_SYSCONFDIR}/canmotion")

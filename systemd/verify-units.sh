@@ -7,20 +7,19 @@
 #    message counts as a failure (unknown keys only warn otherwise);
 #  - a deliberately broken copy must be caught (proves the check can fail);
 #  - the systemd-networkd files use only known sections and keys;
-#  - canmotion-vcan@.service gets vcan from modules-load.d, not by itself;
+#  - canmotion-vcan@.service gets vcan from modprobe@vcan.service, not by itself;
 #  - `systemd-analyze security --offline` exposure level of every unit stays
 #    at or under 1.5, and is printed.
 # Usage: verify-units.sh DIR   (exit 0 = all good)
 #   DIR holds the units filled in with their installed paths (the .service
-#   files, 80-vcan0.netdev/.network, cia402-emu-example.conf and the
-#   modules-load.d file as canmotion-vcan.modules-load.conf): <build>/systemd/
+#   files, 80-vcan0.netdev/.network, cia402-emu-example.conf): <build>/systemd/
 #   (ctest systemd_units_verify), or the files the Debian package installed
 #   (ctest package_deb).
 set -euo pipefail
-[[ $# -eq 1 && -d $1 ]] || { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+[[ $# -eq 1 && -d $1 ]] || { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 dir=$(cd "$1" && pwd)
 for f in canmotiond.service cia402-emu@.service canmotion-vcan@.service 80-vcan0.netdev 80-vcan0.network \
-         cia402-emu-example.conf canmotion-vcan.modules-load.conf; do
+         cia402-emu-example.conf; do
   [[ -f $dir/$f ]] || { echo "verify-units.sh: $dir/$f missing" >&2; exit 2; }
 done
 if grep -l '@[A-Z_]*@' "$dir"/*.service; then
@@ -107,18 +106,17 @@ else
   echo "      and $rules must give the group canmotion write access"; fail=1
 fi
 
-echo "== canmotion-vcan@.service: an unprivileged user with CAP_NET_ADMIN only; vcan from modules-load.d"
-unit="$dir/canmotion-vcan@.service" modload="$dir/canmotion-vcan.modules-load.conf" bad=()
+echo "== canmotion-vcan@.service: an unprivileged user with CAP_NET_ADMIN only; vcan from modprobe@vcan.service"
+unit="$dir/canmotion-vcan@.service" bad=()
 for want in DynamicUser=yes CapabilityBoundingSet=CAP_NET_ADMIN AmbientCapabilities=CAP_NET_ADMIN \
-            ProtectKernelModules=yes After=systemd-modules-load.service; do
+            ProtectKernelModules=yes Wants=modprobe@vcan.service After=modprobe@vcan.service; do
   grep -qx "$want" "$unit" || bad+=("lacks $want")
 done
 grep -q '^RestrictAddressFamilies=.*AF_NETLINK' "$unit" || bad+=("RestrictAddressFamilies= without AF_NETLINK (ip talks rtnetlink)")
 grep -qE '^PrivateNetwork=(yes|true|on|1)' "$unit" && bad+=("PrivateNetwork= on: the interface would be made in a private namespace")
 grep -v '^[#;]' "$unit" | grep -qiE '^Exec[A-Za-z]*=.*modprobe|SYS_MODULE' && bad+=("loads a module itself (modprobe / CAP_SYS_MODULE)")
-[[ $(sed 's/#.*//' "$modload" | tr -d '[:space:]') == vcan ]] || bad+=("canmotion-vcan.modules-load.conf does not list exactly vcan")
 if [[ ${#bad[@]} -eq 0 ]]; then
-  echo "ok: DynamicUser=yes, CAP_NET_ADMIN only, AF_NETLINK, host network, ProtectKernelModules=yes, vcan in modules-load.d"
+  echo "ok: DynamicUser=yes, CAP_NET_ADMIN only, AF_NETLINK, host network, ProtectKernelModules=yes, vcan from modprobe@vcan.service"
 else
   printf 'FAIL: canmotion-vcan@.service: %s\n' "${bad[@]}"; fail=1
 fi

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # package-test.sh: the Debian package as a user gets it. Builds it with CPack
 # from the build tree the other tests use (no second build), then:
-#   1. file list (dpkg-deb -c): every program, man page, unit, networkd,
-#      sysusers.d and modules-load.d file, the conffile, examples and documentation, at /usr paths;
+#   1. file list (dpkg-deb -c): every program, man page, unit, networkd and
+#      sysusers file, the conffile, examples and documentation, at /usr paths;
 #      nothing under /usr/local, no build paths, no test programs;
 #   2. metadata (dpkg-deb -f / -I): name, version, architecture, Depends
 #      computed by dpkg-shlibdeps (it names the package of every shared
@@ -63,11 +63,10 @@ required=(
 unitdir=$(pkg-config --variable=systemdsystemunitdir systemd 2>/dev/null || echo /usr/lib/systemd/system)
 sysusersdir=$(pkg-config --variable=sysusersdir systemd 2>/dev/null || echo /usr/lib/sysusers.d)
 networkdir=$(pkg-config --variable=systemdutildir systemd 2>/dev/null || echo /usr/lib/systemd)/network
-modloaddir=$(pkg-config --variable=modulesloaddir systemd 2>/dev/null || echo /usr/lib/modules-load.d)
 udevdir=$(dirname "$(pkg-config --variable=systemdutildir systemd 2>/dev/null || echo /usr/lib/systemd)")/udev/rules.d
 required+=("$unitdir/canmotiond.service" "$unitdir/cia402-emu@.service" "$unitdir/canmotion-vcan@.service"
            "$sysusersdir/canmotion.conf" "$networkdir/80-vcan0.netdev" "$networkdir/80-vcan0.network"
-           "$udevdir/60-canmotion-cpu-dma-latency.rules" "$modloaddir/canmotion-vcan.conf")
+           "$udevdir/60-canmotion-cpu-dma-latency.rules")
 # Every example of the source tree (EDS files included, wherever they are kept) is in the package.
 while IFS= read -r f; do required+=("/usr/share/canmotion/examples/${f#"$src"/config/examples/}"); done < <(
   find "$src/config/examples" -type f \( -name '*.yaml' -o -name '*.script' -o -iname '*.eds' \))
@@ -203,7 +202,6 @@ step "systemd-analyze verify and security on the installed units"
 units=$work/units
 mkdir -p "$units"
 cp "$root$unitdir"/*.service "$root$networkdir"/80-vcan0.* "$root/usr/share/canmotion/examples/cia402-emu-example.conf" "$units/"
-cp "$root$modloaddir/canmotion-vcan.conf" "$units/canmotion-vcan.modules-load.conf"
 "$src/systemd/verify-units.sh" "$units" || fail "verify-units.sh on the installed units"
 
 step "maintainer scripts with DPKG_ROOT=<scratch root>"
