@@ -130,8 +130,11 @@ void Master::send_sync(FrameSink& out) noexcept {
     f.len = 1;
     f.data[0] = counter_;
   }
-  out.send(f);
-  ++syncs_;
+  if (out.send(f)) {
+    ++syncs_;
+  } else {
+    ++syncs_refused_;
+  }
 }
 
 void Master::send_nmt(NmtCommand cs, std::uint8_t node, FrameSink& out) noexcept {

@@ -132,7 +132,11 @@ class Master {
   bool poll_event(NodeEvent& out) noexcept;
 
   [[nodiscard]] const MasterConfig& config() const noexcept { return cfg_; }
+  /// SYNCs handed to the sink (accepted by it).
   [[nodiscard]] std::uint64_t syncs_sent() const noexcept { return syncs_; }
+  /// SYNCs the sink refused (a full transmit queue, bus-off): the drives
+  /// missed those cycles. Realtime-safe.
+  [[nodiscard]] std::uint64_t syncs_refused() const noexcept { return syncs_refused_; }
   [[nodiscard]] std::uint8_t sync_counter() const noexcept { return counter_; }
   [[nodiscard]] std::uint64_t events_dropped() const noexcept { return events_dropped_; }
   [[nodiscard]] std::size_t node_count() const noexcept { return nodes_.size(); }
@@ -151,6 +155,7 @@ class Master {
   std::int64_t next_heartbeat_ns_ = 0;
   bool heartbeat_started_ = false;
   std::uint64_t syncs_ = 0;
+  std::uint64_t syncs_refused_ = 0;
   std::uint8_t counter_ = 0;
   std::uint64_t sdo_turn_ = 0;  // step_sdo(): the client that goes first this cycle
 };

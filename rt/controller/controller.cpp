@@ -492,6 +492,8 @@ void Controller::publish(std::int64_t now_ns) noexcept {
     s.buses[b].state = buses_[b].transport->state();
     s.buses[b].counters = buses_[b].transport->counters();
     s.buses[b].send_rejected = buses_[b].rejected;
+    s.buses[b].syncs_sent = buses_[b].network->master().syncs_sent();
+    s.buses[b].syncs_refused = buses_[b].network->master().syncs_refused();
   }
   s.trace_dropped = trace_dropped_;
   s.telemetry_dropped = telemetry_dropped_;

@@ -231,7 +231,9 @@ struct AxisSnapshot {
 struct BusSnapshot {
   can::BusState state = can::BusState::kErrorActive;
   can::BusCounters counters{};
-  std::uint64_t send_rejected = 0;
+  std::uint64_t send_rejected = 0;  ///< frames the transport refused (all kinds)
+  std::uint64_t syncs_sent = 0;     ///< SYNCs the transport took
+  std::uint64_t syncs_refused = 0;  ///< SYNCs it refused: cycles the drives missed
 };
 
 /// The status snapshot (step 8). Plain data, copied by readers.

@@ -519,8 +519,14 @@ TEST(DriveFaults, BusOffFaultsTheAxisAndMasrRecoversOnceTheBusIsBack) {
   EXPECT_EQ(r.status().time_ns, off_at) << "not in the first cycle after the bus-off";
   EXPECT_EQ(r.status().buses[0].state, can::BusState::kBusOff);
   EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+  const std::uint64_t sent_before = r.status().buses[0].syncs_sent;
+  const std::uint64_t refused_before = r.status().buses[0].syncs_refused;
   r.cycles(500);  // both heartbeat watches expire meanwhile
   EXPECT_TRUE(r.axis().failure.kind == cia402::FailureKind::kHeartbeatLost) << r.axis().failure.to_string();
+  // Every cycle on the off bus tried its SYNC and was refused: each one is
+  // counted (canmotiond's summary prints them per bus), none as sent.
+  EXPECT_EQ(r.status().buses[0].syncs_sent, sent_before);
+  EXPECT_EQ(r.status().buses[0].syncs_refused, refused_before + 500);
   // The drive's own watch of the master faulted it (no SYNC reaches it to
   // finish the fault reaction while the bus is off).
   EXPECT_TRUE(r.world.drive(0).state() == cia402::State::kFault ||

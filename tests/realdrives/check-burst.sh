@@ -8,7 +8,13 @@
 #     handed to the socket) is on the bus (candump);
 #  2. every cycle wrote one: SYNCs = the summary's cycle count less the few
 #     cycles after the controlled stop's NMT pre-operational (silence by
-#     design, rt/controller: at most 5 here; measured 3);
+#     design, rt/controller: at most 5 here; measured 3), less the SYNCs the
+#     socket refused (canmotiond counts them: "summary: bus can0: ... N
+#     refused"). A refused SYNC fails the check on a machine that kept its
+#     deadlines; under TCG emulation (missed deadlines) the kernel may not
+#     have drained the last cycle's burst when the next one comes, and the
+#     refusals are reported (one CI run: 25 of 1799 cycles, with 709 missed
+#     deadlines), not asserted: checks 1 and 3 still hold for every SYNC sent;
 #  3. while all nodes are operational, every node gets exactly one RPDO
 #     between two SYNCs on the bus: a dropped SYNC shows as two cycles'
 #     RPDOs between two SYNCs. Order, not time: vcan hands each frame to
@@ -51,9 +57,15 @@ cycles=$(sed -nE 's/^summary: ([0-9]+) cycles.*/\1/p' "$log")
 measure "cycles $cycles, SYNCs written by canmotiond $sync_master, SYNCs on the bus (candump) $sync_bus"
 [[ $sync_master -gt 0 ]] || fail "canmotiond wrote no SYNC"
 [[ $sync_bus == "$sync_master" ]] || fail "$sync_master SYNCs written, $sync_bus on the bus: $((sync_master - sync_bus)) lost"
-after_halt=$((cycles - sync_master))
+refused=$(sed -nE 's/^summary: bus can0: ([0-9]+) SYNCs sent, ([0-9]+) refused.*/\2/p' "$log")
+sent_summary=$(sed -nE 's/^summary: bus can0: ([0-9]+) SYNCs sent.*/\1/p' "$log")
+[[ -n $refused && -n $sent_summary ]] || fail "no 'summary: bus can0: N SYNCs sent, M refused' line in canmotiond's log"
+[[ $sent_summary == "$sync_master" ]] ||
+  fail "canmotiond's summary says $sent_summary SYNCs sent, its trace has $sync_master (trace records lost?)"
+measure "SYNCs refused by the socket (canmotiond's count) $refused"
+after_halt=$((cycles - sync_master - refused))
 [[ $after_halt -ge 0 && $after_halt -le 5 ]] ||
-  fail "$cycles cycles but $sync_master SYNCs written: $after_halt cycles without a SYNC (at most 5 after the stop)"
+  fail "$cycles cycles, $sync_master SYNCs written and $refused refused: $after_halt cycles without a SYNC (at most 5 after the stop)"
 
 # 2. Gaps between SYNCs on canmotiond's clock.
 read -r max_gap n_gaps <<<"$(awk -v T="$period_ms" '$3 ~ /^080#/ {
@@ -66,6 +78,7 @@ missed=$(sed -nE 's/^t=[0-9.]+ Controller\.cycles=[0-9]+ Controller\.overruns=[0
 measure "largest gap between SYNCs (canmotiond's clock) $max_gap ms (period $period_ms ms), gaps > 1.5 periods: $n_gaps, missed deadlines (executive) $missed"
 if [[ $missed == 0 ]]; then
   [[ $n_gaps == 0 ]] || fail "$n_gaps gaps longer than 1.5 periods between SYNCs in canmotiond's trace (largest $max_gap ms)"
+  [[ $refused == 0 ]] || fail "$refused SYNCs refused by the socket although no deadline was missed (txqueuelen too short?)"
 else
   echo "check-burst: the executive missed $missed deadlines (emulated CPU): the gap check is reported, not asserted"
 fi

@@ -264,9 +264,17 @@ void print_summary(const Options& o, config::Runtime& rt, rt::ControllerHost& ho
   const double sim_s = static_cast<double>(s.cycle) * c.period_s();
   fmt::print("summary: {} cycles, {:.3f} s of controller time in {:.3f} s wall ({:.0f}x real time)\n", s.cycle, sim_s,
              wall_s, wall_s > 0 ? sim_s / wall_s : 0.0);
-  if (real_time)
+  if (real_time) {
     fmt::print("summary: wake-up latency max {:.1f} us, p99 {:.1f} us; overruns {}\n", static_cast<double>(st.latency_max_ns) / 1e3,
                static_cast<double>(st.latency_p99_ns) / 1e3, st.overruns);
+    // A SYNC the transport refused is a cycle every drive on that bus missed.
+    for (std::size_t b = 0; b < c.spec().buses.size() && b < s.buses.size(); ++b) {
+      const rt::BusSnapshot& bs = s.buses[b];
+      fmt::print("summary: bus {}: {} SYNCs sent, {} refused by the transport (transmit queue full or bus-off); "
+                 "{} frames refused in all\n",
+                 c.spec().buses[b].name, bs.syncs_sent, bs.syncs_refused, bs.send_rejected);
+    }
+  }
   for (std::size_t a = 0; a < c.axis_count(); ++a) {
     const rt::AxisSnapshot& x = s.axes[a];
     const auto& cfg = c.axis_spec(static_cast<motion::AxisId>(a)).config;
