@@ -131,10 +131,18 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
     finish(static_cast<SdoAbort>(s.abort_code), true, now_ns);
     return;
   }
+  // An initiate answer naming another object while this transfer waits for
+  // its own: a late answer to an earlier transfer that timed out or was
+  // cancelled (cancel_all()) while the server's answer was on its way. Not
+  // this one's: ignored, its answer (or its timeout) is still to come.
+  const bool late = (phase_ == Phase::kInitDownload || phase_ == Phase::kInitUpload) &&
+                    (s.kind == sdo::SdoFrameKind::kInitiateDownloadResponse ||
+                     s.kind == sdo::SdoFrameKind::kInitiateUploadResponse) &&
+                    (s.index != cur_.index || s.sub != cur_.sub);
+  if (late) return;
   switch (phase_) {
     case Phase::kInitDownload:
       if (s.kind != sdo::SdoFrameKind::kInitiateDownloadResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
-      if (s.index != cur_.index || s.sub != cur_.sub) return abort_transfer(SdoAbort::kGeneral, now_ns);
       if (cur_.len <= 4) return finish(SdoAbort::kNone, false, now_ns);
       phase_ = Phase::kDownloadSegment;
       toggle_ = false;
@@ -149,7 +157,6 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
       return;
     case Phase::kInitUpload:
       if (s.kind != sdo::SdoFrameKind::kInitiateUploadResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
-      if (s.index != cur_.index || s.sub != cur_.sub) return abort_transfer(SdoAbort::kGeneral, now_ns);
       if (s.expedited) {
         res_.size = s.data_len;
         std::copy_n(s.data, s.data_len, res_.data.begin());

@@ -87,6 +87,8 @@ class SdoClient {
   bool upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag = 0) noexcept;
 
   /// Feed a frame from the server (ID 0x580 + node; other frames are ignored).
+  /// An initiate answer naming another object than the running transfer's
+  /// (a late answer to one that timed out or was cancelled) is ignored too.
   void on_frame(const can::Frame& f, std::int64_t now_ns) noexcept;
   /// Start the next transfer, send pending segments, check the timeout.
   void step(std::int64_t now_ns, FrameSink& out) noexcept;

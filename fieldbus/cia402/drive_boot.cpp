@@ -278,7 +278,9 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
     case Phase::kConfiguring: {
       canopen::SdoResult r;
       while (sdo.poll(r)) {
-        if (r.tag == kModeWriteTag) continue;
+        // Not the boot's: a run-time transfer (0x6060, homing, 0x603F, 0x6041)
+        // that finished, or was cancelled by the restart, before it was taken.
+        if (r.tag >= writes_.size()) continue;
         const BootWrite* bw = r.tag < writes_.size() ? &writes_[r.tag] : nullptr;
         if (!r.ok() && bw != nullptr && bw->origin == WriteOrigin::kInterpolationPeriod && bw->w.sub == 2 &&
             !bw->ip_fallback && (canopen::object_absent(r.abort) || r.abort == canopen::SdoAbort::kReadOnly)) {

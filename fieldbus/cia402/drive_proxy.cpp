@@ -230,10 +230,25 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
     }
     case FailureKind::kNmtState: {
       const auto st = canopen::nmt_state_name(nmt_state);
+      // What the drive's CiA 402 state is: read over SDO (Pre-operational
+      // answers SDO), or only its last TPDO's from before it left.
+      char drive[192];
+      if (statusword_read) {
+        std::snprintf(drive, sizeof drive, "; the drive is in %.*s (statusword 0x%04X, read over SDO)",
+                      static_cast<int>(sn.size()), sn.data(), statusword);
+      } else if (nmt_state == canopen::NmtState::kStopped) {
+        std::snprintf(drive, sizeof drive,
+                      "; a stopped node answers no SDO: its CiA 402 state is not known (its last TPDO showed %.*s, "
+                      "statusword 0x%04X)",
+                      static_cast<int>(sn.size()), sn.data(), statusword);
+      } else {
+        std::snprintf(drive, sizeof drive, "; its last TPDO showed %.*s (statusword 0x%04X)", static_cast<int>(sn.size()),
+                      sn.data(), statusword);
+      }
       n = std::snprintf(out.data(), out.size(),
                         "node %u: left NMT operational: its heartbeat shows %.*s (no PDOs are exchanged; many drives do "
-                        "this on a communication error, CiA 301 0x1029)%s",
-                        node, static_cast<int>(st.size()), st.data(), emcy);
+                        "this on a communication error, CiA 301 0x1029)%s%s",
+                        node, static_cast<int>(st.size()), st.data(), drive, emcy);
       break;
     }
   }
@@ -351,6 +366,13 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
         has_emcy_ = true;
         emcy_code_ = e.emcy.code;
         emcy_in_fault_ = true;
+        // A failure recorded before the EMCY came (e.g. at the heartbeat
+        // that showed the node out of NMT operational) names it too.
+        if (failed() && (!failure_.has_emcy || failure_.emcy_code != e.emcy.code)) {
+          failure_.has_emcy = true;
+          failure_.emcy_code = e.emcy.code;
+          ++failure_rev_;
+        }
       } else if (!in_fault_) {
         emcy_in_fault_ = false;  // error reset / no error: an earlier warning's EMCY is not this fault's
       }
@@ -370,10 +392,14 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
       if (phase_ != Phase::kOperational) break;
       if ((e.state == canopen::NmtState::kPreOperational || e.state == canopen::NmtState::kStopped) &&
           e.state != master_.status(cfg_.node).commanded) {  // not the master's own command (controlled stop)
+        if (!nmt_left_) sw_read_done_ = false;  // this departure's CiA 402 state: read it (step_left_operational)
         nmt_left_ = true;
         if (failure_.kind == FailureKind::kNone || failure_.kind == FailureKind::kTransitionTimeout) {
           fail(FailureKind::kNmtState, e.t_ns, 0, 0);
           failure_.nmt_state = e.state;
+        } else if (failure_.kind == FailureKind::kNmtState && failure_.nmt_state != e.state) {
+          failure_.nmt_state = e.state;  // e.g. pre-operational, then stopped
+          ++failure_rev_;
         }
         expect_tpdo_ = false;  // no PDOs in these states: not counted as missed
       } else if (e.state == canopen::NmtState::kOperational && nmt_left_) {
@@ -426,7 +452,17 @@ void DriveProxy::disable_operation() noexcept { set_wanted(State::kSwitchedOn); 
 void DriveProxy::quick_stop() noexcept { set_wanted(State::kQuickStopActive); }
 void DriveProxy::fault_reset() noexcept {
   if (phase_ == Phase::kFailed || nmt_left_ || failure_.kind == FailureKind::kNmtState) {
-    restart();  // boot and configure it again (NMT start included)
+    // Boot and configure it again (NMT enter pre-operational when it is
+    // stopped, the SDO configuration, NMT start), without NMT reset node: a
+    // node that left NMT operational on its own (CiA 301 0x1029, or another
+    // tool) may have kept its configuration, but what changed meanwhile is
+    // not known, and writing it again costs one configuration's SDO
+    // transfers; a reset would also clear the drive's fault history
+    // (0x1003) and, on many drives, its homing. The fault it took with the
+    // NMT change (EMCY 0x8130 on a lost master heartbeat) is reset once it
+    // is operational again (step()).
+    restart();
+    reset_after_start_ = true;
     return;
   }
   switch (failure_.kind) {
@@ -647,6 +683,7 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
     phase_since_ns_ = now_ns;
   }
   if (phase_ != Phase::kOperational) {
+    sw_read_out_ = sw_read_done_ = false;  // the boot owns the SDO client (a run-time read's result is dropped there)
     // Several boot phases may complete in one cycle (boot-up seen ->
     // configuring queues its first writes at once).
     for (int i = 0; i < 3 && phase_ != Phase::kOperational && phase_ != Phase::kFailed; ++i) {
@@ -654,7 +691,16 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
       step_boot(now_ns, out);
       if (phase_ == before) break;
     }
+    if (phase_ == Phase::kFailed) reset_after_start_ = false;  // the boot failed: nothing to reset
     if (phase_ != Phase::kOperational) return;
+    if (reset_after_start_) {
+      // fault_reset() restarted the node: a drive that shows Fault in its
+      // first TPDO gets the fault reset now (transition 15, the repeated edge).
+      reset_after_start_ = false;
+      reset_requested_ = true;
+      const State s = decode_state(fb_.statusword);
+      if (s == State::kFault || s == State::kFaultReactionActive) set_wanted(State::kSwitchOnDisabled);
+    }
   }
   // Missed TPDO accounting: a SYNC went out last cycle and TPDO1 did not come.
   if (expect_tpdo_ && !got_tpdo_) ++fb_.tpdo_missed;
@@ -683,6 +729,7 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
     }
   }
   if (mdisp_slot_.pdo < 0 && fb_.mode_display == 0) fb_.mode_display = static_cast<std::int8_t>(cfg_.mode);
+  if (nmt_left_ || sw_read_out_) step_left_operational();
   step_error_code(now_ns);
   check_mode_switch(now_ns);
   step_homing(now_ns);
@@ -719,6 +766,7 @@ void DriveProxy::step_error_code(std::int64_t now_ns) noexcept {
   if (failure_.kind != FailureKind::kNone && !failure_.has_emcy) {
     failure_.has_emcy = true;
     failure_.emcy_code = code;
+    ++failure_rev_;
   }
   if (notice_count_ < notices_.size()) {
     canopen::NodeEvent& e = notices_[(notice_head_ + notice_count_) % notices_.size()];
@@ -731,6 +779,40 @@ void DriveProxy::step_error_code(std::int64_t now_ns) noexcept {
     e.emcy.code = code;
     e.index = obj::kErrorCode;  // read from 0x603F, not received as an EMCY
   }
+}
+
+// A node that left NMT operational while running sends no TPDO: the
+// statusword of its last one says nothing of the fault it may have taken
+// with the NMT change (CiA 301 0x1029 on a communication error, e.g. EMCY
+// 0x8130 and Fault on a lost master heartbeat). A Pre-operational node still
+// answers SDO: 0x6041 is read once per departure (again while it shows Fault
+// reaction active, which goes on to Fault), and the state it shows is the
+// proxy's (a Fault faults the axis as a drive fault too; without an EMCY,
+// step_error_code() then reads 0x603F). A Stopped node answers only NMT: not
+// read, the failure says so.
+void DriveProxy::step_left_operational() noexcept {
+  canopen::SdoClient& sdo = master_.sdo(cfg_.node);
+  if (sw_read_out_ && sdo.results() > 0) {
+    canopen::SdoResult r;
+    if (sdo.poll_tag(kStatuswordTag, r)) {
+      sw_read_out_ = false;
+      sw_read_done_ = true;
+      if (r.ok() && nmt_left_) {
+        fb_.statusword = static_cast<std::uint16_t>(r.u32() & 0xFFFFu);
+        const State s = decode_state(fb_.statusword);
+        sw_read_done_ = s != State::kFaultReactionActive;
+        if (failure_.kind == FailureKind::kNmtState) {
+          failure_.statusword = fb_.statusword;
+          failure_.reached = s;
+          failure_.statusword_read = true;
+          ++failure_rev_;
+        }
+      }
+    }
+  }
+  if (!nmt_left_ || sw_read_out_ || sw_read_done_) return;
+  if (master_.status(cfg_.node).state != canopen::NmtState::kPreOperational) return;
+  sw_read_out_ = sdo.upload(obj::kStatusword, 0, kStatuswordTag);  // queue full: next cycle
 }
 
 void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {

@@ -255,6 +255,10 @@ struct Failure {
   /// nullptr. Points into the DriveProxy's configuration: valid while it lives.
   const char* hint = nullptr;
   canopen::NmtState nmt_state = canopen::NmtState::kUnknown;  ///< kNmtState: the state shown
+  /// kNmtState: `statusword` (and `reached`) were read over SDO (0x6041)
+  /// after the node left NMT operational; false: they are its last TPDO's,
+  /// from before it left (a Stopped node answers no SDO).
+  bool statusword_read = false;
   BootCheck check = BootCheck::kNone;  ///< kBootCheck: what did not match
   std::uint32_t read_value = 0;        ///< kBootCheck: what the drive has
   std::uint32_t expected = 0;          ///< kBootCheck: what the configuration expects (kSupportedModes: the missing mode)
@@ -307,6 +311,11 @@ class DriveProxy {
   /// (last_emcy_code(), Failure::emcy_code) and passed on as a
   /// NodeEvent::Kind::kEmcy (poll_notice()).
   static constexpr std::uint32_t kErrorCodeTag = 0xFFFF0003u;
+  /// Tag of the read of 0x6041 (statusword) when the node left NMT
+  /// operational while running: it sends no TPDO there, so its CiA 402 state
+  /// (a Fault it took with the NMT change, CiA 301 0x1029) is read over SDO,
+  /// which a Pre-operational node still answers (a Stopped one does not).
+  static constexpr std::uint32_t kStatuswordTag = 0xFFFF0004u;
 
   // ---- commands ---------------------------------------------------------
   /// Go to Operation enabled (2, 3, 4; a fault must be reset first). Clears a
@@ -322,7 +331,10 @@ class DriveProxy {
   /// fault reset (15, on the 0 -> 1 edge of bit 7: in the next RPDO, since
   /// the proxy sends bit 7 clear in Fault) and ends in Switch on disabled; a
   /// drive that is not in Fault keeps its state. After a failed boot, or a
-  /// node that left NMT operational, the boot and configuration run again.
+  /// node that left NMT operational, the boot and configuration run again
+  /// (restart(): without NMT reset node, so the drive keeps its fault
+  /// history and homing), and once the node is operational again a drive in
+  /// Fault gets the fault reset as above.
   void fault_reset() noexcept;
   /// Switch between CSP, CSV, CST and homing (through RPDO2 with
   /// PdoProfile::kCspCsvCst, otherwise an SDO write of 0x6060). The new
@@ -377,6 +389,10 @@ class DriveProxy {
   [[nodiscard]] std::int16_t target_torque() const noexcept { return target_torque_; }
   [[nodiscard]] std::uint16_t controlword() const noexcept { return cw_; }
   [[nodiscard]] const Failure& failure() const noexcept { return failure_; }
+  /// Changes when the recorded failure gains detail after it was recorded:
+  /// an EMCY that came later, 0x603F, or the statusword read over SDO from a
+  /// node that left NMT operational (the controller then reports it again).
+  [[nodiscard]] std::uint32_t failure_revision() const noexcept { return failure_rev_; }
   [[nodiscard]] bool failed() const noexcept { return failure_.kind != FailureKind::kNone; }
   /// The conditions behind the failures, as they are now (the planner latches
   /// them): the master's heartbeat consumer has the node lost, or the node's
@@ -474,6 +490,14 @@ class DriveProxy {
   std::int64_t fault_since_ns_ = 0;
   void step_error_code(std::int64_t now_ns) noexcept;
   std::uint32_t reset_edges_ = 0;      // fault-reset rising edges sent (fault_reset_edges())
+  std::uint32_t failure_rev_ = 0;      // failure_revision()
+  // Out of NMT operational while running (nmt_left_): 0x6041 read over SDO.
+  bool sw_read_out_ = false;           // the read is queued or running (its result not yet taken)
+  bool sw_read_done_ = false;          // read for this departure (again while Fault reaction active)
+  void step_left_operational() noexcept;
+  // fault_reset() restarted the node: once it is operational again, reset
+  // its CiA 402 fault (reset_requested_, the repeated bit 7 edge).
+  bool reset_after_start_ = false;
 
   Mode mode_ = Mode::kCsp;
   Mode sdo_mode_pending_ = Mode::kNoMode;

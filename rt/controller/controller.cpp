@@ -269,7 +269,9 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   f.homing_attained = hr == HR::kCompleted;
   f.homing_error = hr == HR::kError || hr == HR::kTimeout || hr == HR::kRefused;
   f.homing_exerr = hr == HR::kRefused ? std::int8_t{3} : std::int8_t{16};  // invalid value / device in wrong state
-  if (p.failed() && !ax.failure_reported) {
+  // Reported when recorded, and again when it gains detail (an EMCY that
+  // came later, the statusword read from a node out of NMT operational).
+  if (p.failed() && (!ax.failure_reported || ax.failure_rev != p.failure_revision())) {
     Event e;
     e.kind = Event::Kind::kDriveFailed;
     e.bus = static_cast<std::uint8_t>(ax.bus);
@@ -279,6 +281,7 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
     emit(e);
   }
   ax.failure_reported = p.failed();
+  ax.failure_rev = p.failure_revision();
 }
 
 // Called once per axis per cycle from cycle() only: inlined there (no call per axis).

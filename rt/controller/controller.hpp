@@ -177,7 +177,7 @@ static_assert(std::is_trivially_copyable_v<Command>, "a Command travels through 
 struct Event {
   enum class Kind : std::uint8_t {
     kNode,         ///< a CANopen node event (boot-up, heartbeat lost/recovered, EMCY, NMT state)
-    kDriveFailed,  ///< a drive proxy recorded a failure (see Status axes[].failure)
+    kDriveFailed,  ///< a drive proxy recorded a failure, or it gained detail (see Status axes[].failure)
     kBusState,     ///< a bus changed error state
     kRingOverflow, ///< the trace or telemetry ring was full; `value` records were lost
     kBusError,     ///< CAN error frames of other classes (no ACK, protocol, transceiver, ...):
@@ -361,6 +361,7 @@ class Controller {
     bool have_prev = false;
     std::int32_t prev_counts = 0;
     bool failure_reported = false;
+    std::uint32_t failure_rev = 0;  ///< DriveProxy::failure_revision() when the failure was last reported
     bool homing_out = false;  ///< the planner's homing_start as last handed to the proxy (its edges start/cancel)
   };
   class RecordingSink;

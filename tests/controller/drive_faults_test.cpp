@@ -373,6 +373,149 @@ TEST_P(NmtStateWhileRunning, FaultsTheAxisAtTheHeartbeatAndMasrRestartsTheNode) 
 INSTANTIATE_TEST_SUITE_P(DriveFaults, NmtStateWhileRunning, ::testing::Values(std::uint8_t{0x80}, std::uint8_t{0x02}));
 
 // ---------------------------------------------------------------------------
+// The master's heartbeat no longer reaches a strict drive that watches it
+// (0x1016): the drive faults (EMCY 0x8130) and, per its 0x1029:1 error
+// behaviour, leaves NMT operational: 0 (the default) Pre-operational, 2
+// Stopped. It sends no more TPDOs, so its Fault never shows in one.
+// Reaction: at its next heartbeat the axis faults (node lost: ModuleFault);
+// a Pre-operational node still answers SDO: the master reads 0x6041, and the
+// drive's Fault shows as a drive fault too (PhysicalAxisFault, drive state
+// Fault); the message names the node, the NMT state, the statusword and the
+// EMCY. A Stopped node answers no SDO (CiA 301): nothing is read, and the
+// message says so. Recovery once the heartbeat reaches the drive again: MASR
+// configures the node again without resetting it (NMT enter pre-operational
+// when Stopped, the SDO configuration, NMT start) and resets the Fault it
+// took; MSO and a move work. On main these drives ran without 0x1029
+// (error_behaviour = false): with it the Fault was not seen, and MASR ended
+// with ERR 12 (EXERR 16) with the re-started drive still in Fault.
+class MasterHeartbeatLost : public ::testing::TestWithParam<std::uint32_t> {};
+
+TEST_P(MasterHeartbeatLost, DriveLeavesOperationalItsFaultIsReportedAndMasrRecovers) {
+  const std::uint32_t behaviour = GetParam();  // 0x1029:1
+  const bool stopped = behaviour == 2;
+  FaultRig r([&](AxisSpec& x, emulator::EmulatorConfig& e) {
+    e.behaviour.optional_objects_absent = false;  // the drive has 0x1016: it watches the master
+    if (behaviour != 0) x.drive.extra_writes.push_back({0x1029, 1, 1, behaviour});
+  });
+  // What goes over the bus (the tap runs inside the cycle: no allocation).
+  std::int64_t emcy_at = -1;
+  int sdo_requests = 0, nmt_preop = 0, nmt_start = 0, nmt_reset = 0;
+  r.world.bus(0).set_tap([&](const can::TimedFrame& f, std::string_view) {
+    const can::Frame& c = f.frame;
+    if (c.id == 0x080u + kNode && c.len >= 2 && c.data[0] == 0x30 && c.data[1] == 0x81 && emcy_at < 0) emcy_at = f.t_ns;
+    if (c.id == 0x600u + kNode) ++sdo_requests;
+    if (c.id == 0 && c.len == 2 && c.data[1] == kNode) {
+      nmt_preop += c.data[0] == 0x80 ? 1 : 0;
+      nmt_start += c.data[0] == 0x01 ? 1 : 0;
+      nmt_reset += c.data[0] == 0x81 || c.data[0] == 0x82 ? 1 : 0;
+    }
+  });
+  std::vector<std::string> reported;  // kDriveFailed messages, as canmotiond logs them
+  std::int64_t read_at = -1;         // the cycle that reported the statusword read over SDO
+  r.each_cycle = [&] {
+    Event e;
+    while (r.ctl->pop_event(e)) {
+      if (e.kind != Event::Kind::kDriveFailed) continue;
+      reported.push_back(e.failure.to_string());
+      if (read_at < 0 && reported.back().find("read over SDO") != std::string::npos) read_at = r.status().time_ns;
+    }
+  };
+  r.enable_and_jog();
+  ASSERT_EQ(r.world.drive(0).read_int(0x1029, 1), static_cast<std::int64_t>(behaviour));
+  const std::uint64_t boot_ups = r.world.drive(0).counters().boot_ups;
+  reported.clear();
+  sdo_requests = 0;
+  r.world.bus(0).add_fault({0x77Fu, can::SimFault::Action::kDrop, 0, 0});  // the master's heartbeat (node 127)
+  const std::int64_t dropped_at = r.now;
+  ASSERT_TRUE(r.run_until([&] { return module_fault(r.read("X.AxisFault")); }, 1000));
+  const std::int64_t faulted_at = r.status().time_ns;
+  ASSERT_GT(emcy_at, 0) << "no EMCY 0x8130 from the drive";
+  EXPECT_EQ(r.axis().failure.kind, cia402::FailureKind::kNmtState) << r.axis().failure.to_string();
+  EXPECT_EQ(r.axis().failure.nmt_state, stopped ? canopen::NmtState::kStopped : canopen::NmtState::kPreOperational);
+  EXPECT_EQ(r.world.drive(0).nmt_state(), stopped ? canopen::NmtState::kStopped : canopen::NmtState::kPreOperational);
+  // (Stopped, the drive processes no SYNC: its fault reaction does not end)
+  EXPECT_TRUE(r.world.drive(0).state() == cia402::State::kFault ||
+              (stopped && r.world.drive(0).state() == cia402::State::kFaultReactionActive));
+  EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+  EXPECT_EQ(r.read("X.LastEmcy"), 0x8130);
+  // The statusword read (Pre-operational) takes an SDO round trip.
+  r.cycles(20);
+  const cia402::Failure f = r.axis().failure;
+  const std::string why = f.to_string();
+  std::printf("0x1029:1 = %u: master heartbeat dropped at %.0f ms, EMCY 0x8130 at %.0f ms, axis faulted in the cycle of "
+              "%.0f ms, statusword read reported in the cycle of %.0f ms: %s\n",
+              behaviour, ms(dropped_at), ms(emcy_at), ms(faulted_at), ms(read_at), why.c_str());
+  for (const char* part : {"node 2: left NMT operational: its heartbeat shows ", stopped ? "stopped" : "pre-operational",
+                           "CiA 301 0x1029", "last EMCY 0x8130 (life guard error or heartbeat error)"})
+    EXPECT_NE(why.find(part), std::string::npos) << "missing '" << part << "' in: " << why;
+  if (stopped) {
+    EXPECT_NE(why.find("a stopped node answers no SDO: its CiA 402 state is not known (its last TPDO showed Operation "
+                       "enabled, statusword 0x"),
+              std::string::npos)
+        << why;
+    EXPECT_EQ(sdo_requests, 0) << "SDO requests to a stopped node";
+  } else {
+    EXPECT_NE(why.find("; the drive is in Fault (statusword 0x0228, read over SDO)"), std::string::npos) << why;
+    EXPECT_EQ(sdo_requests, 1) << "one read of 0x6041 (the EMCY came: no read of 0x603F)";
+    EXPECT_EQ(r.axis().drive_state, cia402::State::kFault);
+    EXPECT_TRUE(physical_fault(r.read("X.AxisFault"))) << "the drive's own Fault is not seen";
+  }
+  // canmotiond logs the failure when it is recorded, and again with the detail that came later.
+  ASSERT_FALSE(reported.empty());
+  EXPECT_EQ(reported.back(), why);
+  // Recovery: the master's heartbeat reaches the drive again.
+  r.world.bus(0).clear_faults();
+  r.cycles(150);  // at least one heartbeat (100 ms): the drive's cause is gone
+  nmt_preop = nmt_start = nmt_reset = 0;
+  sdo_requests = 0;
+  const std::uint32_t edges = r.ctl->network(0).at(0).fault_reset_edges();
+  const std::int64_t masr_at = r.now;
+  r.exec("MASR(X, rst)");
+  ASSERT_TRUE(r.run_until([&] { return r.read("rst.DN") != 0.0 || r.read("rst.ER") != 0.0; }, 5000));
+  ASSERT_EQ(r.read("rst.DN"), 1.0) << "MASR ERR " << r.read("rst.ERR") << " EXERR " << r.read("rst.EXERR")
+                                   << "; failure: " << r.axis().failure.to_string();
+  std::printf("MASR at %.0f ms: DN %.0f ms later (%d SDO requests of the configuration, %u fault-reset edge(s))\n",
+              ms(masr_at), ms(r.status().time_ns - masr_at), sdo_requests,
+              r.ctl->network(0).at(0).fault_reset_edges() - edges);
+  EXPECT_EQ(nmt_reset, 0) << "the node was reset";
+  EXPECT_EQ(r.world.drive(0).counters().boot_ups, boot_ups) << "the node was reset";
+  EXPECT_EQ(nmt_preop, stopped ? 1 : 0) << "NMT enter pre-operational (only from Stopped, before its configuration)";
+  EXPECT_EQ(nmt_start, 1);
+  EXPECT_GT(sdo_requests, 20) << "the node was not configured again";
+  EXPECT_GE(r.ctl->network(0).at(0).fault_reset_edges(), edges + 1) << "the drive's Fault was not reset";
+  EXPECT_EQ(r.world.drive(0).nmt_state(), canopen::NmtState::kOperational);
+  EXPECT_NE(r.world.drive(0).state(), cia402::State::kFault);
+  r.enable_and_move();
+  r.world.bus(0).set_tap(nullptr);
+  r.each_cycle = nullptr;
+}
+
+// MASR at once, while the read of 0x6041 is still out (a drive that takes
+// 5 ms to answer SDO): the restart cancels it, and its cancelled result is
+// not taken for one of the boot's transfers (it failed the boot as "configuration
+// ... aborted with 0x08000000" before the boot skipped results it did not ask for).
+TEST(DriveFaults, MasrWhileTheStatuswordReadIsOutRunsTheBoot) {
+  FaultRig r([](AxisSpec&, emulator::EmulatorConfig& e) {
+    e.behaviour.optional_objects_absent = false;  // the drive has 0x1016: it watches the master
+    e.behaviour.sdo_reply_delay_ns = 5'000'000;
+  });
+  r.enable_and_jog();
+  r.world.bus(0).add_fault({0x77Fu, can::SimFault::Action::kDrop, 0, 0});  // the master's heartbeat
+  ASSERT_TRUE(r.run_until([&] { return module_fault(r.read("X.AxisFault")); }, 1000));
+  r.world.bus(0).clear_faults();
+  r.exec("MASR(X, rst)");  // the next cycle: the read went out in the last one
+  EXPECT_EQ(r.axis().phase, cia402::Phase::kConfiguring) << r.axis().failure.to_string();
+  ASSERT_TRUE(r.run_until([&] { return r.read("rst.DN") != 0.0 || r.read("rst.ER") != 0.0; }, 5000));
+  ASSERT_EQ(r.read("rst.DN"), 1.0) << "MASR ERR " << r.read("rst.ERR") << "; failure: " << r.axis().failure.to_string();
+  r.enable_and_move();
+}
+
+INSTANTIATE_TEST_SUITE_P(DriveFaults, MasterHeartbeatLost, ::testing::Values(0u, 2u),
+                         [](const ::testing::TestParamInfo<std::uint32_t>& i) {
+                           return i.param == 0 ? std::string("PreOperational0x1029is0") : std::string("Stopped0x1029is2");
+                         });
+
+// ---------------------------------------------------------------------------
 // Boot failures. An axis whose drive refused its configuration, or never
 // answered, is not configured: MSO, MAH (and MDS) end with ERR 11 at once, a
 // MSO issued while it was booting with ERR 12 (EXERR 16) as soon as the boot
@@ -499,14 +642,11 @@ TEST(DriveFaults, AbsentDriveFailsTheBootAndItsLaterBootUpConfiguresIt) {
 // stayed in the Fault of its 0x8130 reaction), and MASR resets the axis; MSO
 // and a move work.
 TEST(DriveFaults, BusOffFaultsTheAxisAndMasrRecoversOnceTheBusIsBack) {
-  // No 0x1029 here: with it the drive also goes Pre-operational when it loses
-  // the master's heartbeat, and the master, reading the state only from
-  // TPDOs, never sees its Fault. (The fault's cause lasts as in the strict
-  // profile: the reset edge is repeated until the drive takes it.)
+  // The strict drive with 0x1029 = 0: it also goes Pre-operational when it
+  // loses the master's heartbeat (the NMT reset node re-boots it anyway).
   // Instant boot: the MSO right after MASR's node restart fails (ERR 20)
   // while the drive is still in Not ready to switch on (issue 15, master side).
   FaultRig r([](AxisSpec&, emulator::EmulatorConfig& e) {
-    e.behaviour.error_behaviour = false;
     e.behaviour.boot_ns = 0;
     e.behaviour.optional_objects_absent = false;  // the drive has 0x1016: it watches the master
   });

@@ -168,8 +168,18 @@ case $scn in
       fail "frames of canmotiond after it was killed"
     n2=$(first ' vcan0 000#0102$' "$rs")
     [[ $n2 -gt 0 ]] || fail "the restarted canmotiond did not start the node"
-    p=$(first ' vcan0 000#8002$' "$rs")
-    [[ $p -gt 0 && $p -lt $n2 ]] || fail "the restarted canmotiond did not put the operational node into pre-operational before configuring it"
+    # The strict drive (0x1029:1 = 0) went pre-operational with its fault: its
+    # heartbeat shows 0x7F between the EMCY and the NMT start. The restarted
+    # canmotiond configures it as it is (0x6060 = 8 written before the NMT
+    # start) and needs no NMT enter pre-operational (000#8002, sent only to
+    # an operational or stopped node).
+    pre=$(awk -v a="$e" -v b="$n2" 'NR > a && NR < b && $3 == "702#7F" { n++ } END { print n + 0 }' "$trace")
+    [[ $pre -gt 0 ]] || fail "the drive's heartbeat never showed pre-operational (702#7F) after its EMCY 0x8130 (0x1029:1 = 0)"
+    c2=$(first ' vcan0 602#2F60600008' "$rs")
+    [[ $c2 -gt 0 && $c2 -lt $n2 ]] || fail "the restarted canmotiond did not configure the node (0x6060 = 8) before starting it"
+    [[ $(awk -v a="$rs" -v b="$n2" 'NR > a && NR < b && $3 == "000#8002" { n++ } END { print n + 0 }' "$trace") -eq 0 ]] ||
+      fail "NMT enter pre-operational sent to a node that was pre-operational"
+    say "the drive was pre-operational after its EMCY ($pre heartbeats 702#7F); configured at line $c2, started at line $n2"
     reenabled_after "$n2"
     ;;
   fewer)

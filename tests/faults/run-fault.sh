@@ -23,8 +23,9 @@
 #              watch the master: the refused write names the key; MSO ERR
 #              11; then a drive with 0x1016 replaces it, MSO + a move
 #   master     canmotiond is killed (SIGKILL) while the drive jogs: the drive
-#              faults (EMCY 0x8130) after its 0x1016 time (1 s); canmotiond started
-#              again configures it, MAFR + MSO + a move
+#              faults (EMCY 0x8130) after its 0x1016 time (1 s) and goes
+#              pre-operational (0x1029:1 = 0); canmotiond started again
+#              configures it, MAFR + MSO + a move
 #   fewer      a drive without 0x1016 and with two PDOs per direction, not
 #              asked to watch the master: boots, enables, moves
 # Artefacts: faults.yaml, canmotiond*.log, canmotiond-trace*.log, emu-*.log.
@@ -187,11 +188,10 @@ case $scn in
     ;;
   master)
     start_daemon "$script" ""
-    # --error-behaviour false: without 0x1029 the drive stays NMT operational
-    # when it loses the master's heartbeat, which is what this scenario checks
-    # (the restarted master puts an operational node into pre-operational).
-    # With 0x1029 (loop profile) the drive is already pre-operational.
-    start_emu emu-1.log --heartbeat-reaction fault --error-behaviour false
+    # The strict drive's 0x1029:1 = 0: with the master's heartbeat it also
+    # leaves NMT operational (pre-operational); the restarted master
+    # configures it from there.
+    start_emu emu-1.log --heartbeat-reaction fault
     wait_tag Step 1 60
     sleep 0.5
     mark kill

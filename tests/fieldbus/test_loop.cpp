@@ -218,12 +218,14 @@ TEST(FieldbusLoop, LostHeartbeatGivesNodeLost) {
   EXPECT_FALSE(rig.drive(2).failed());
 }
 
+// The strict drive (0x1029:1 = 0, the default) that loses the master's
+// heartbeat faults (EMCY 0x8130) and goes Pre-operational: no more TPDOs.
+// The proxy sees the NMT change at the drive's next heartbeat and reads
+// 0x6041 over SDO (Pre-operational answers SDO): its state is the drive's
+// Fault, not the last TPDO's Operation enabled. (On main the state stayed
+// Operation enabled: this test ran with error_behaviour = false.)
 TEST(FieldbusLoop, MasterHeartbeatLostFaultsDrive) {
   SimRigConfig cfg = rig_config();
-  // Permissive here: with 0x1029 (default 0) the strict drive also enters
-  // Pre-operational and stops its TPDOs; the master takes the state only from
-  // TPDOs and never sees the Fault (issue 15, master side).
-  cfg.emulator.behaviour.error_behaviour = false;
   cfg.emulator.behaviour.optional_objects_absent = false;  // the drive has 0x1016 (it watches the master)
   SimRig rig(cfg);
   boot_and_enable(rig);
@@ -231,11 +233,41 @@ TEST(FieldbusLoop, MasterHeartbeatLostFaultsDrive) {
   // so let one master heartbeat (100 ms period) through first.
   for (int i = 0; i < 150; ++i) rig.step();
   ASSERT_TRUE(rig.drive(2).enabled());
+  can::SimBus::Endpoint& spy = rig.bus().add_endpoint("spy");
+  can::SimBus::Endpoint::IdSet sdo_ids{};  // only node 2's SDO request and response
+  for (const std::uint32_t id : {0x602u, 0x582u}) sdo_ids[id / 64] |= std::uint64_t{1} << (id % 64);
+  spy.set_accept(sdo_ids, {});
   // Drop the master's heartbeat from now on: drives notice after 0x1016 (300 ms).
   rig.bus().add_fault(can::SimFault{0x77F, can::SimFault::Action::kDrop, 0, 0});
   auto& d = rig.drive(2);
   ASSERT_TRUE(rig.run_until([&] { return d.state() == State::kFault; }, 600));
   EXPECT_EQ(d.last_emcy_code(), 0x8130);
+  EXPECT_EQ(rig.emulator(2).nmt_state(), canopen::NmtState::kPreOperational);
+  EXPECT_TRUE(d.left_operational());
+  EXPECT_EQ(d.failure().kind, cia402::FailureKind::kNmtState);
+  EXPECT_EQ(d.failure().statusword, 0x0228);  // Fault, quick stop bit, remote
+  const std::string why = d.failure().to_string();
+  EXPECT_EQ(why,
+            "node 2: left NMT operational: its heartbeat shows pre-operational (no PDOs are exchanged; many drives do "
+            "this on a communication error, CiA 301 0x1029); the drive is in Fault (statusword 0x0228, read over SDO), "
+            "last EMCY 0x8130 (life guard error or heartbeat error)");
+  // The read on the bus: 602#4041600000000000, answered 582#4B41600028020000.
+  bool req = false, rsp = false;
+  std::array<can::TimedFrame, 64> buf{};
+  for (std::size_t k; (k = spy.receive(buf)) > 0;) {
+    for (std::size_t j = 0; j < k; ++j) {
+      const can::Frame& f = buf[j].frame;
+      const std::array<std::uint8_t, 8> b{f.data[0], f.data[1], f.data[2], f.data[3], f.data[4], f.data[5], f.data[6], f.data[7]};
+      req = req || (f.id == 0x602 && b == std::array<std::uint8_t, 8>{0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0});
+      rsp = rsp || (f.id == 0x582 && b == std::array<std::uint8_t, 8>{0x4B, 0x41, 0x60, 0x00, 0x28, 0x02, 0, 0});
+    }
+  }
+  EXPECT_TRUE(req) << "602#4041600000000000";
+  EXPECT_TRUE(rsp) << "582#4B41600028020000";
+  // The other drives also lost the master: each its own Fault, read the same way.
+  for (std::uint8_t n : {std::uint8_t{3}, std::uint8_t{4}}) {
+    ASSERT_TRUE(rig.run_until([&] { return rig.drive(n).state() == State::kFault; }, 100)) << "node " << int{n};
+  }
 }
 
 TEST(FieldbusLoop, DroppedTpdoCounted) {

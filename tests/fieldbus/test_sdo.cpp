@@ -245,6 +245,35 @@ TEST(FieldbusSdo, AbortNamingAnotherObjectEndsTheTransferWithItsCode) {
   EXPECT_TRUE(c.idle());
 }
 
+// A transfer cancelled (cancel_all(), e.g. a drive proxy restarting the
+// node's boot) while the server's answer is on its way: that late answer
+// names another object than the next transfer, which keeps waiting for its
+// own (before, the late answer aborted it with 0x08000000).
+TEST(FieldbusSdo, LateAnswerToACancelledTransferIsIgnored) {
+  canopen::SdoClient c(2, 100 * kMs);
+  VecSink out;
+  ASSERT_TRUE(c.upload(0x6041, 0, 1));
+  c.step(0, out);
+  EXPECT_EQ(hex(out.frames.back()), "602#4041600000000000");
+  c.cancel_all();
+  ASSERT_TRUE(c.upload(0x1000, 0, 2));
+  c.step(1 * kMs, out);  // the running upload is aborted
+  EXPECT_EQ(hex(out.frames.back()), "602#8041600000000008");
+  c.step(2 * kMs, out);  // the next one starts
+  EXPECT_EQ(hex(out.frames.back()), "602#4000100000000000");
+  canopen::SdoResult r;
+  ASSERT_TRUE(c.poll(r));
+  EXPECT_EQ(r.tag, 1u);
+  EXPECT_EQ(r.abort, SdoAbort::kGeneral);
+  c.on_frame(frame("582#4B41600028020000"), 3 * kMs);  // 0x6041's answer, late
+  EXPECT_FALSE(c.poll(r)) << "the late answer ended the next transfer";
+  c.on_frame(frame("582#4300100092010200"), 4 * kMs);  // 0x1000's own answer
+  ASSERT_TRUE(c.poll(r));
+  EXPECT_EQ(r.tag, 2u);
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.u32(), 0x00020192u);
+}
+
 TEST(FieldbusSdo, TimeoutOnVirtualClockThenNextTransferRuns) {
   canopen::SdoClient c(2, 100 * kMs);
   VecSink out;
