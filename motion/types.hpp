@@ -281,9 +281,9 @@ inline constexpr unsigned MotionStatus = 2;
 inline constexpr unsigned AxisInhibitStatus = 3;
 }  // namespace coordinate_system_status
 
-/// Programmed Stop Mode of an axis (used by MGS programmed).
 /// Controller mode (Logix Run / Program; Planner::set_controller_mode).
 enum class ControllerMode : std::uint8_t { Run = 0, Program = 1 };
+/// Programmed Stop Mode of an axis (used by MGS programmed).
 enum class ProgrammedStopMode : std::uint8_t { FastStop = 0, FastDisable = 1, HardDisable = 2, FastShutdown = 3, HardShutdown = 4 };
 
 }  // namespace canmotion::motion

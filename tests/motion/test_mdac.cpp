@@ -250,6 +250,44 @@ TEST(Mdac, McdOnAMasterDrivenMoveReplansPerMasterUnitWithoutAJump) {
             Err::MdscInvalidModeOrMasterChange);
 }
 
+// Issue 16 item 1, the jog: MCD changes "the active jog or move on the fly"
+// [RM002H p.142]; a master-driven jog (MDAC ... jog, MAJ in units per master
+// unit) is re-planned in units per master unit, without a jump, and
+// time-driven units on it are a mode change (ERR 105, as MCCD [seed 001]).
+TEST(Mdac, McdOnAMasterDrivenJogReplansPerMasterUnitWithoutAJump) {
+  Rig r = rig3();
+  ASSERT_EQ(r.exec("MDAC(Z, X, l, jog, command);"), Err::None);
+  ASSERT_EQ(r.exec("MAJ(Z, j, forward, 0.5, unitspermasterunit, 10, unitspermasterunit2, 10, unitspermasterunit2, "
+                   "trapezoidal, 0, 0, unitspermasterunit3, disabled, programmed, 0, immediateforwardonly);"),
+            Err::None)
+      << r.tag("j").err;
+  r.exec(maj("X", "jx", 0, 10, 1e6, 1e6));
+  r.step(500);  // the master runs at 10 u/s, the slave jogs at 0.5 u/mu = 5 u/s
+  ASSERT_NEAR(r.axis("Z").command_velocity, 5.0, 1e-6);
+  ASSERT_EQ(r.exec("MCD(Z, c1, jog, yes, 1.0, no, 0, no, 0, no, 0, no, 0, unitspermasterunit, unitspermasterunit2, "
+                   "unitspermasterunit2, unitspermasterunit3);"),
+            Err::None)
+      << r.tag("c1").err;
+  EXPECT_TRUE(r.tag("c1").dn());
+  // 0.5 -> 1.0 u/mu at 10 u/mu^2 over the master's 0.01 u per cycle: no jump
+  double prev = r.axis("Z").command_position;
+  for (int i = 0; i < 100; ++i) {
+    r.step();
+    const double p = r.axis("Z").command_position;
+    EXPECT_GE(p - prev, 0.005 - 1e-9) << "cycle " << i;
+    EXPECT_LE(p - prev, 0.010 + 1e-9) << "cycle " << i;
+    prev = p;
+  }
+  EXPECT_NEAR(r.axis("Z").command_velocity, 10.0, 1e-6);  // 1.0 u/mu x 10 u/s
+  EXPECT_TRUE(r.tag("j").ip());
+  ASSERT_EQ(r.exec("MCD(Z, c2, jog, yes, 3, no, 0, no, 0, no, 0, no, 0, unitspersec, unitspersec2, unitspersec2, "
+                   "unitspersec3);"),
+            Err::MdscInvalidModeOrMasterChange);
+  EXPECT_EQ(r.tag("c2").err, 105);
+  r.step(10);
+  EXPECT_NEAR(r.axis("Z").command_velocity, 10.0, 1e-6);
+}
+
 // Issue 16 item 4. "A mode change (Rem Run to Rem Prog or Rem Prog to Rem Run)
 // or an axis fault also breaks the MDAC link"; on the master "MASD, MCSD, and
 // MGSD ... MAS and MCS for any Stop Type, including All, do NOT break the MDAC
