@@ -112,6 +112,13 @@ struct DriveSettings {
   std::optional<std::int16_t> quick_stop_option;  ///< written to 0x605A when given (CiA 402: 0..8 or manufacturer-specific < 0)
   std::vector<SdoWrite> sdo_writes;
   DriveIdentitySettings identity;
+  /// `sync_watch:` the drive watches the master's SYNC: 0x1006 = the period
+  /// (us) is written after 0x1019, and a drive that refuses it fails its
+  /// boot. False (default): 0x1006 is written 0 (before 0x1019) and left so,
+  /// as a drive that watches the SYNC leaves NMT operational when one cycle
+  /// comes more than half a period late (CANopenNode: 1.5 x 0x1006, EMCY
+  /// 8100h); the drive watches the master's heartbeat (0x1016) instead.
+  bool sync_watch = false;
   /// master_heartbeat_timeout_ms is written in the file (not the default):
   /// then 0x1016 is required, else optional (left out for a drive whose EDS
   /// lacks it, accepted missing without an EDS).

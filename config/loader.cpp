@@ -293,7 +293,7 @@ class Loader {
 
   void drive(const YAML::Node& n, const std::string& path, DriveSettings& d) {
     if (!check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
-                             "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds"}))
+                             "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds", "sync_watch"}))
       return;
     if (std::int16_t q = 0; scalar(n, path, "quick_stop_option", q, std::int16_t{-32768}, std::int16_t{8},
                                    "(0x605A: 0 coast, 1/2 ramp then Switch on disabled, 5/6 ramp and stay in Quick stop "
@@ -328,6 +328,7 @@ class Loader {
            std::uint16_t{65535}, "ms");
     scalar(n, path, "following_error_window", d.following_error_window, std::uint16_t{0}, std::uint16_t{65535},
            "counts");
+    scalar(n, path, "sync_watch", d.sync_watch, false, true);
     if (const YAML::Node w = n["sdo_writes"]) {
       if (!w.IsSequence()) {
         error(w, path + ".sdo_writes", "must be a list of {index, sub, size, value}");

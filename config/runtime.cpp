@@ -109,6 +109,9 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   d.hints.consumer_heartbeat = drive_key("master_heartbeat_timeout_ms");
   d.hints.identity = fmt::format("{}.drive.identity", axis);
   d.hints.mode_switch_timeout = drive_key("timeouts.mode_switch_ms");
+  d.hints.sync_watch = drive_key("sync_watch");
+  d.hints.sync_counter = fmt::format("buses[].sync_counter_overflow of bus '{}' (line {})", bus.name, bus.where.line);
+  d.sync_watch = a.drive.sync_watch;
   const DriveIdentitySettings& id = a.drive.identity;
   d.identity.has_device_type = id.device_type.has_value();
   d.identity.device_type = id.device_type.value_or(0);

@@ -83,6 +83,13 @@ inline constexpr std::uint16_t kTargetVelocity = 0x60FF;
 inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
 inline constexpr std::uint16_t kDeviceType = 0x1000;  ///< CiA 301; bits 0..15 the device profile number
 inline constexpr std::uint16_t kIdentity = 0x1018;    ///< CiA 301; sub1 vendor, sub2 product, sub3 revision, sub4 serial
+/// CiA 301, UNSIGNED32 in us: a SYNC consumer with a value other than 0
+/// watches the SYNC (CANopenNode: EMCY 8100h after 1.5 x the period without one).
+inline constexpr std::uint16_t kCommunicationCyclePeriod = 0x1006;
+/// CiA 301, UNSIGNED8: 0 = SYNC without counter, 2..240 = the counter's
+/// overflow value (the SYNC then carries it in one byte). Changes only while
+/// 0x1006 is 0 (SDO abort 0x08000022 otherwise).
+inline constexpr std::uint16_t kSyncCounterOverflow = 0x1019;
 
 // ---- MDS drive-side ramps and SLAT (Logix seed 002) --------------------------
 // Standard objects carry the ramp accelerations: RampAcceleration ->

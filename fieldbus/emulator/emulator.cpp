@@ -236,6 +236,13 @@ void Emulator::build_dictionary() {
     for (Entry& e : od_)
       if (e.key == key(obj::kInterpolationTimePeriod, 2)) e.access = canopen::Access::kRo;
   }
+  for (const ObjectPreset& p : cfg_.presets) {
+    for (Entry& e : od_) {
+      if (e.key != key(p.index, p.sub)) continue;
+      e.value = e.default_value = p.value & e.mask;
+      if (p.read_only) e.access = canopen::Access::kRo;
+    }
+  }
   if (!cfg_.served.empty()) apply_served();  // a drive described by an EDS
   std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
   od_.shrink_to_fit();  // od_ never changes size after this: Entry pointers stay valid
@@ -475,7 +482,11 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   }
   if (index == obj::kModesOfOperation && !mode_supported(static_cast<std::int8_t>(v))) return SdoAbort::kInvalidValue;
   if (index == obj::kHomingMethod && !homing_method_supported(static_cast<std::int8_t>(v))) return SdoAbort::kInvalidValue;
-  if (index == 0x1019 && cfg_.behaviour.check_sync_length && (v == 1 || v > 240)) return SdoAbort::kInvalidValue;
+  if (index == obj::kSyncCounterOverflow && cfg_.behaviour.check_sync_length) {
+    // CiA 301, as CANopenNode's CO_ODF_1019: only while 0x1006 is 0, and 0 or 2..240.
+    if (get(obj::kCommunicationCyclePeriod) != 0) return SdoAbort::kDeviceState;
+    if (v == 1 || v > 240) return SdoAbort::kInvalidValue;
+  }
   if (index == 0x1029 && sub == 1 && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 1 && v == 0) return SdoAbort::kInvalidValue;
   if (index == obj::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;

@@ -89,7 +89,9 @@ struct EmulatorBehaviour {
   bool rpdo_too_long_emcy = true;
   /// The SYNC's length is checked against 0x1019 (0 bytes when 0x1019 = 0,
   /// 1 byte otherwise): a SYNC of the wrong length is not processed and sends
-  /// EMCY 8240h once. 0x1019 writes take only 0 and 2..240 (0x06090030).
+  /// EMCY 8240h once. 0x1019 writes take only 0 and 2..240 (0x06090030), and
+  /// only while 0x1006 is 0 (0x08000022), as CiA 301 and CANopenNode's
+  /// CO_ODF_1019 say.
   bool check_sync_length = true;
   /// 0x1029:1 (error behaviour, communication error) exists and acts on a
   /// communication error (lost master heartbeat): 0 = Pre-operational
@@ -129,6 +131,15 @@ inline constexpr std::array<std::uint16_t, 6> kOptionalObjects = {0x1016, cia402
                                                                   cia402::obj::kRampJerkControl,
                                                                   cia402::obj::kSlatConfiguration,
                                                                   cia402::obj::kSlatSetPoint, cia402::obj::kSlatTimeDelay};
+
+/// A power-on value other than the emulator's own, and optionally read-only
+/// (EmulatorConfig::presets), e.g. a drive whose 0x1006 comes preset.
+struct ObjectPreset {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  std::uint64_t value = 0;  ///< raw bits, in the object's size
+  bool read_only = false;   ///< SDO writes abort 0x06010002
+};
 
 struct EmulatorConfig {
   std::uint8_t node = 2;
@@ -171,6 +182,12 @@ struct EmulatorConfig {
   /// 0x06020000 (object does not exist), as on a real drive without them.
   /// A PDO whose communication object is absent is never valid.
   std::vector<std::uint16_t> absent_objects;
+  /// Power-on values (and read-only objects) other than the emulator's own,
+  /// e.g. {0x1006, 0, 1000}: a drive that watches the SYNC from power-on and
+  /// so refuses 0x1019 writes until 0x1006 is 0; {0x1019, 0, 5, true}: a
+  /// drive whose SYNC counter overflow is fixed at 5. Objects it lacks are
+  /// ignored. Applied after EmulatorBehaviour's and before `served`.
+  std::vector<ObjectPreset> presets;
   /// Not empty (cia402-emu --eds): the drive serves exactly these
   /// sub-objects over SDO and PDO mapping, with their access, PDO mapping
   /// flags and defaults. Its own objects not listed abort 0x06020000 /

@@ -548,3 +548,31 @@ TEST(EmulatorStrict, HomingTakesTimePerMethodFamily) {
     EXPECT_EQ(p.emu.position(), 77);
   }
 }
+
+// CiA 301 0x1019 (as CANopenNode's CO_ODF_1019): written only while 0x1006
+// is 0 (0x08000022 otherwise), and only 0 or 2..240 (issue 15 item 5).
+TEST(EmulatorStrict, SyncCounterOverflowWrittenOnlyWhile1006IsZero) {
+  Drive s(Drive::strict());
+  ASSERT_EQ(s.write(0x1006, 0, 1000, 4), 0u);
+  EXPECT_EQ(s.write(0x1019, 0, 5, 1), kDeviceState);
+  EXPECT_EQ(s.emu.read_int(0x1019), 0);
+  ASSERT_EQ(s.write(0x1006, 0, 0, 4), 0u);
+  EXPECT_EQ(s.write(0x1019, 0, 5, 1), 0u);
+  EXPECT_EQ(s.emu.read_int(0x1019), 5);
+  ASSERT_EQ(s.write(0x1006, 0, 1000, 4), 0u);  // 0x1006 itself may change at any time
+  EXPECT_EQ(s.write(0x1019, 0, 0, 1), kDeviceState);
+  // A drive whose 0x1006 is set from power-on (EmulatorConfig::presets).
+  EmulatorConfig c = Drive::strict();
+  c.presets = {emulator::ObjectPreset{0x1006, 0, 2000}};
+  Drive preset(c);
+  EXPECT_EQ(preset.emu.read_int(0x1006), 2000);
+  EXPECT_EQ(preset.write(0x1019, 0, 5, 1), kDeviceState);
+  // A read-only preset.
+  c.presets = {emulator::ObjectPreset{0x1019, 0, 5, true}};
+  Drive fixed(c);
+  EXPECT_EQ(fixed.emu.read_int(0x1019), 5);
+  EXPECT_EQ(fixed.write(0x1019, 0, 5, 1), kReadOnly);
+  Drive p(Drive::permissive());
+  ASSERT_EQ(p.write(0x1006, 0, 1000, 4), 0u);
+  EXPECT_EQ(p.write(0x1019, 0, 5, 1), 0u);
+}

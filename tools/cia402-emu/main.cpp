@@ -67,7 +67,8 @@ Profiles (--profile; a flag changes one behaviour of the profile):
               changes only in Pre-operational (--remap-preop-only), CiA 402
               predefined PDO1 = controlword/statusword, type 255
               (--cia402-pdos), over-long RPDO EMCY 8220h (--long-rpdo-emcy),
-              SYNC length checked against 0x1019, EMCY 8240h (--sync-length),
+              SYNC length checked against 0x1019, EMCY 8240h, 0x1019 written
+              only while 0x1006 is 0 (--sync-length),
               0x1029 error behaviour (--error-behaviour), 100 ms in Not ready
               to switch on (--boot-ms), SDO replies a call later
               (--sdo-delay-ms), one transition per SYNC (--one-transition),
@@ -171,7 +172,8 @@ int main(int argc, char** argv) {
   flag_opt("--remap-preop-only", f_remap, "PDO parameters change only in Pre-operational (abort 0x08000022)");
   flag_opt("--cia402-pdos", f_pdos, "CiA 402 predefined PDO1 (controlword / statusword, type 255) at power-on");
   flag_opt("--long-rpdo-emcy", f_long, "an over-long RPDO sends EMCY 8220h");
-  flag_opt("--sync-length", f_sync, "SYNC length checked against 0x1019 (EMCY 8240h)");
+  flag_opt("--sync-length", f_sync,
+           "SYNC length checked against 0x1019 (EMCY 8240h); 0x1019 takes 0, 2..240, only while 0x1006 is 0 (0x08000022)");
   flag_opt("--error-behaviour", f_errb, "0x1029 exists and acts on a lost master heartbeat");
   flag_opt("--one-transition", f_one, "one commanded transition per SYNC (3 and 4 in two SYNCs)");
   flag_opt("--refuse-unsupported-modes", f_modes, "an RPDO's mode outside 0x6502 is not taken");
