@@ -51,6 +51,7 @@ EmulatorBehaviour EmulatorBehaviour::permissive() noexcept {
   b.cia402_default_pdos = false;
   b.rpdo_too_long_emcy = false;
   b.check_sync_length = false;
+  b.sync_timeout = false;
   b.error_behaviour = false;
   b.boot_ns = 0;
   b.sdo_reply_delay_ns = 0;
@@ -547,7 +548,8 @@ void Emulator::power_on(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   settled_cw_ = {};
   active_fault_ = pending_fault_ = 0;
   fault_cause_syncs_left_ = 0;
-  rpdo_short_error_ = rpdo_long_error_ = sync_length_error_ = false;
+  rpdo_short_error_ = rpdo_long_error_ = sync_length_error_ = sync_timeout_error_ = false;
+  last_sync_ns_ = -1;
   rpdo_short_mask_ = rpdo_long_mask_ = 0;
   homing_active_ = homing_done_ = homing_error_ = false;
   homing_phase_ = HomingPhase::kIdle;
@@ -575,6 +577,8 @@ void Emulator::handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::Fra
     case 0x81: power_on(now_ns, out); break;
     case 0x82:
       reset_dictionary(true);
+      last_sync_ns_ = -1;  // 0x1006 back to its default: the SYNC watch starts again
+      sync_timeout_error_ = false;
       sdo_.reset();
       sdo_queue_size_ = 0;
       nmt_ = canopen::NmtState::kPreOperational;
@@ -633,6 +637,8 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
       if (bad) {
         ++counters_.sync_length_errors;  // not processed
       } else {
+        last_sync_ns_ = now_ns_;
+        comm_error(sync_timeout_error_, false, canopen::emcy_code::kCommunication, out);
         handle_sync(now_ns_, out);
       }
     }
@@ -745,6 +751,16 @@ void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
       automatic_transitions(false, out);  // 13 now, not at the next SYNC (the master may be gone)
       apply_error_behaviour();
     }
+  }
+  // The SYNC watch (0x1006, EmulatorBehaviour::sync_timeout): 1.5 periods
+  // without a SYNC, once one came (CANopenNode's CO_SYNC_process).
+  const auto period_us = static_cast<std::int64_t>(get(cia402::obj::kCommunicationCyclePeriod));
+  if (cfg_.behaviour.sync_timeout && period_us > 0 && last_sync_ns_ >= 0 && !sync_timeout_error_ &&
+      (nmt_ == canopen::NmtState::kOperational || nmt_ == canopen::NmtState::kPreOperational) &&
+      now_ns - last_sync_ns_ > period_us * 1'500) {
+    ++counters_.sync_timeouts;
+    comm_error(sync_timeout_error_, true, canopen::emcy_code::kCommunication, out);
+    apply_error_behaviour();
   }
   automatic_transitions(false, out);
   sdo_.step(now_ns, out);
@@ -1083,7 +1099,7 @@ bool Emulator::fault_cause_remains() const noexcept {
 
 void Emulator::refresh_error_register() noexcept {
   std::uint8_t r = active_fault_ != 0 ? error_register_for(active_fault_) : 0;
-  bool comm = rpdo_short_error_ || rpdo_long_error_ || sync_length_error_;
+  bool comm = rpdo_short_error_ || rpdo_long_error_ || sync_length_error_ || sync_timeout_error_;
   for (const Consumer& k : consumers_) comm = comm || k.lost;
   if (comm) r |= canopen::kErrGeneric | canopen::kErrCommunication;
   put(hot_.error_register, r);

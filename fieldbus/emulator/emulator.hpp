@@ -93,8 +93,14 @@ struct EmulatorBehaviour {
   /// only while 0x1006 is 0 (0x08000022), as CiA 301 and CANopenNode's
   /// CO_ODF_1019 say.
   bool check_sync_length = true;
+  /// With 0x1006 (communication cycle period) not 0 the drive watches the
+  /// SYNC, as CANopenNode's CO_SYNC_process: once a SYNC came, none for
+  /// 1.5 x 0x1006 (in Pre-operational or Operational) sends EMCY 8100h once
+  /// (error register bit 4) and takes 0x1029:1's reaction (error_behaviour:
+  /// 0 leaves Operational); the next SYNC clears it (EMCY 0000h).
+  bool sync_timeout = true;
   /// 0x1029:1 (error behaviour, communication error) exists and acts on a
-  /// communication error (lost master heartbeat): 0 = Pre-operational
+  /// communication error (lost master heartbeat, SYNC watch): 0 = Pre-operational
   /// (default), 1 = no change, 2 = Stopped.
   bool error_behaviour = true;
   /// After power-on the drive stays in Not ready to switch on (statusword
@@ -217,6 +223,7 @@ struct EmulatorCounters {
   std::uint64_t boot_ups = 0;
   std::uint64_t rpdo_length_errors = 0;
   std::uint64_t sync_length_errors = 0;     ///< SYNCs dropped for their length (0x1019)
+  std::uint64_t sync_timeouts = 0;          ///< SYNC watch (0x1006) timeouts, EMCY 8100h
   std::uint64_t refused_fault_resets = 0;   ///< fault resets refused while the cause remained
   std::uint64_t sdo_replies_dropped = 0;    ///< delayed SDO replies lost to a full queue
 };
@@ -531,6 +538,8 @@ class Emulator final : public canopen::SdoServerBackend {
   bool rpdo_short_error_ = false;           // EMCY 8210h sent, not yet cleared
   bool rpdo_long_error_ = false;            // EMCY 8220h sent, not yet cleared
   bool sync_length_error_ = false;          // EMCY 8240h sent, not yet cleared
+  bool sync_timeout_error_ = false;         // EMCY 8100h sent (no SYNC for 1.5 x 0x1006), not yet cleared
+  std::int64_t last_sync_ns_ = -1;          // the last SYNC processed (-1: none since power-on / reset)
   std::uint8_t rpdo_short_mask_ = 0;        // bit p: RPDO p + 1's last frame was short
   std::uint8_t rpdo_long_mask_ = 0;         // bit p: RPDO p + 1's last frame was long
   // TPDO event state (types 0, 254, 255).

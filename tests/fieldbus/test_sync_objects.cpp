@@ -19,6 +19,7 @@
 #include "fieldbus/cia402/cia402.hpp"
 #include "fieldbus/cia402/drive_proxy.hpp"
 #include "fieldbus/emulator/sim_rig.hpp"
+#include "test_support.hpp"
 
 namespace canmotion {
 namespace {
@@ -276,6 +277,51 @@ TEST(SyncObjects, SyncWatchOnADriveWithout1006FailsNamingTheKey) {
   const std::string why = rig.drive(kNode).failure().to_string();
   for (const char* part : {"node 2", "write to 0x1006:0", "0x06020000", "axes[0].drive.sync_watch"})
     EXPECT_NE(why.find(part), std::string::npos) << part << " in: " << why;
+}
+
+/// With drive.sync_watch the drive watches the SYNC at 1.5 x 0x1006 (the
+/// emulator as CANopenNode): a master that stalls for more than half a period
+/// makes it send EMCY 8100h and leave Operational (0x1029:1 = 0), which is
+/// why sync_watch is off by default; without it the same stall is harmless.
+TEST(SyncObjects, SyncWatchAStalledMasterTakesTheDriveOutOfOperational) {
+  for (const bool watch : {true, false}) {
+    SimRigConfig c = one_drive(0);
+    c.drive.sync_watch = watch;
+    SimRig rig(c);
+    rig.power_on();
+    ASSERT_TRUE(boot(rig)) << rig.drive(kNode).failure().to_string();
+    rig.network().enable_all();
+    ASSERT_TRUE(rig.run_until([&] { return rig.network().all_enabled(); }, 2000));
+    emulator::Emulator& emu = rig.emulator(kNode);
+    EXPECT_EQ(emu.read_int(0x1006), watch ? 1000 : 0);
+    // The last SYNC came at rig.now_ns(); the master stalls (no frames), the
+    // drive's own timers go on.
+    const std::int64_t t = rig.now_ns();
+    fbtest::VecSink out;
+    emu.step(t + 1'500'000, out);  // 1.5 periods: not yet
+    EXPECT_EQ(emu.nmt_state(), canopen::NmtState::kOperational);
+    emu.step(t + 1'600'000, out);
+    std::vector<std::string> emcy;
+    for (const can::Frame& f : out.frames)
+      if (f.id == 0x080u + kNode) emcy.push_back(fbtest::hex(f));
+    if (!watch) {
+      EXPECT_TRUE(emcy.empty()) << emcy.size() << " EMCY";
+      EXPECT_EQ(emu.nmt_state(), canopen::NmtState::kOperational);
+      EXPECT_EQ(emu.counters().sync_timeouts, 0u);
+      continue;
+    }
+    EXPECT_EQ(emcy, std::vector<std::string>{"082#0081110000000000"}) << "EMCY 8100h, error register 0x11";
+    EXPECT_EQ(emu.nmt_state(), canopen::NmtState::kPreOperational) << "0x1029:1 = 0";
+    EXPECT_EQ(emu.counters().sync_timeouts, 1u);
+    // The next SYNC clears it (EMCY 0000h); the NMT state stays until the master starts it again.
+    out.clear();
+    emu.set_time(t + 1'700'000);
+    emu.on_frame(can::TimedFrame{fbtest::frame("080#"), t + 1'700'000}, out);
+    emcy.clear();
+    for (const can::Frame& f : out.frames)
+      if (f.id == 0x080u + kNode) emcy.push_back(fbtest::hex(f));
+    EXPECT_EQ(emcy, std::vector<std::string>{"082#0000000000000000"});
+  }
 }
 
 }  // namespace

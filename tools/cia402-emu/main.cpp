@@ -68,7 +68,8 @@ Profiles (--profile; a flag changes one behaviour of the profile):
               predefined PDO1 = controlword/statusword, type 255
               (--cia402-pdos), over-long RPDO EMCY 8220h (--long-rpdo-emcy),
               SYNC length checked against 0x1019, EMCY 8240h, 0x1019 written
-              only while 0x1006 is 0 (--sync-length),
+              only while 0x1006 is 0 (--sync-length), SYNC watched at 1.5 x
+              0x1006 when it is not 0, EMCY 8100h (--sync-timeout),
               0x1029 error behaviour (--error-behaviour), 100 ms in Not ready
               to switch on (--boot-ms), SDO replies a call later
               (--sdo-delay-ms), one transition per SYNC (--one-transition),
@@ -126,7 +127,7 @@ int main(int argc, char** argv) {
   bool refuse_mode = false;
   std::vector<std::string> absent;
   std::string profile = "strict";
-  std::optional<bool> f_optional, f_ip_ro, f_remap, f_pdos, f_long, f_sync, f_errb, f_one, f_modes, f_homing;
+  std::optional<bool> f_optional, f_ip_ro, f_remap, f_pdos, f_long, f_sync, f_sync_to, f_errb, f_one, f_modes, f_homing;
   std::optional<double> boot_ms, sdo_delay_ms;
   std::optional<std::uint32_t> fault_cause_syncs, mode_switch_syncs;
   bool no_remote = false;
@@ -174,7 +175,9 @@ int main(int argc, char** argv) {
   flag_opt("--long-rpdo-emcy", f_long, "an over-long RPDO sends EMCY 8220h");
   flag_opt("--sync-length", f_sync,
            "SYNC length checked against 0x1019 (EMCY 8240h); 0x1019 takes 0, 2..240, only while 0x1006 is 0 (0x08000022)");
-  flag_opt("--error-behaviour", f_errb, "0x1029 exists and acts on a lost master heartbeat");
+  flag_opt("--sync-timeout", f_sync_to,
+           "with 0x1006 not 0, no SYNC for 1.5 x 0x1006 sends EMCY 8100h and takes 0x1029's reaction");
+  flag_opt("--error-behaviour", f_errb, "0x1029 exists and acts on a lost master heartbeat or SYNC");
   flag_opt("--one-transition", f_one, "one commanded transition per SYNC (3 and 4 in two SYNCs)");
   flag_opt("--refuse-unsupported-modes", f_modes, "an RPDO's mode outside 0x6502 is not taken");
   flag_opt("--homing-model", f_homing, "homing moves per method family over several SYNCs");
@@ -234,6 +237,7 @@ int main(int argc, char** argv) {
   apply(behaviour.cia402_default_pdos, f_pdos);
   apply(behaviour.rpdo_too_long_emcy, f_long);
   apply(behaviour.check_sync_length, f_sync);
+  apply(behaviour.sync_timeout, f_sync_to);
   apply(behaviour.error_behaviour, f_errb);
   apply(behaviour.one_transition_per_sync, f_one);
   apply(behaviour.refuse_unsupported_modes, f_modes);
