@@ -201,13 +201,6 @@ void Emulator::build_dictionary() {
   // Ramps of CSV (MDS): by default as fast as the model can go.
   add(obj::kProfileAcceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
   add(obj::kProfileDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
-  add(obj::kRampVelocityLimit, 0, 2);
-  add(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub, static_cast<std::uint32_t>(cfg_.max_velocity));
-  add(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub, static_cast<std::uint32_t>(cfg_.max_velocity));
-  add(obj::kRampJerkControl, 0, 0);
-  add(obj::kSlatConfiguration, 0, 0);
-  add(obj::kSlatSetPoint, 0, 0);
-  add(obj::kSlatTimeDelay, 0, 0);
   add(obj::kQuickStopDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
   add(obj::kHomingMethod, 0, 35);
   add(obj::kHomingSpeeds, 0, 2);
@@ -224,12 +217,13 @@ void Emulator::build_dictionary() {
   add(obj::kDigitalInputs, 0, 0);
   add(obj::kTargetVelocity, 0, 0);
   add(obj::kSupportedDriveModes, 0, cfg_.supported_modes);
+  const std::vector<std::uint32_t> mds_keys = add_mds_objects();
   // A drive without some optional objects (EmulatorConfig::absent_objects,
-  // EmulatorBehaviour::optional_objects_absent).
-  std::erase_if(od_, [this](const Entry& e) {
+  // EmulatorBehaviour::optional_objects_absent: 0x1016 and the MDS objects).
+  std::erase_if(od_, [&](const Entry& e) {
     const auto index = static_cast<std::uint16_t>(e.key >> 8);
     if (cfg_.behaviour.optional_objects_absent &&
-        std::find(kOptionalObjects.begin(), kOptionalObjects.end(), index) != kOptionalObjects.end())
+        (index == 0x1016 || std::find(mds_keys.begin(), mds_keys.end(), e.key) != mds_keys.end()))
       return true;
     return std::find(cfg_.absent_objects.begin(), cfg_.absent_objects.end(), index) != cfg_.absent_objects.end();
   });
@@ -248,6 +242,46 @@ void Emulator::build_dictionary() {
   std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
   od_.shrink_to_fit();  // od_ never changes size after this: Entry pointers stay valid
   rebuild_pdos();
+}
+
+std::vector<std::uint32_t> Emulator::add_mds_objects() {
+  using cia402::MdsObject;
+  const cia402::MdsObjects& m = cfg_.mds_objects;
+  std::vector<std::uint32_t> keys;
+  // Ramps of CSV (MDS): by default no limit beyond the model's own velocity.
+  const auto vmax = static_cast<std::uint32_t>(cfg_.max_velocity);
+  for (std::size_t i = 0; i < cia402::kMdsObjectCount; ++i) {
+    const auto o = static_cast<MdsObject>(i);
+    const cia402::ObjectAddress a = m[o];
+    const std::uint64_t v = o == MdsObject::kRampVelocityPositive || o == MdsObject::kRampVelocityNegative ? vmax : 0;
+    const std::size_t size = cia402::info(o).size;
+    const canopen::DataType t = size == 1 ? canopen::DataType::kUnsigned8
+                                : size == 2 ? canopen::DataType::kUnsigned16
+                                            : canopen::DataType::kUnsigned32;
+    // One of the emulator's own objects at that address becomes the MDS object.
+    std::erase_if(od_, [&](const Entry& e) { return e.key == key(a.index, a.sub); });
+    add(a.index, a.sub, v);
+    Entry& e = od_.back();
+    set_type(e, t);
+    e.access = canopen::Access::kRw;
+    e.pdo = canopen::PdoMappable::kNo;
+    keys.push_back(e.key);
+  }
+  // A record's sub-index 0 (highest sub-index supported), unless the index has one.
+  for (const cia402::ObjectAddress& a : m.at) {
+    if (a.sub == 0 || std::any_of(od_.begin(), od_.end(), [&](const Entry& e) { return e.key == key(a.index, 0); }))
+      continue;
+    std::uint8_t highest = 0;
+    for (const cia402::ObjectAddress& b : m.at)
+      if (b.index == a.index) highest = std::max(highest, b.sub);
+    add(a.index, 0, highest);
+    Entry& e = od_.back();
+    set_type(e, canopen::DataType::kUnsigned8);
+    e.access = canopen::Access::kRo;
+    e.pdo = canopen::PdoMappable::kNo;
+    keys.push_back(e.key);
+  }
+  return keys;
 }
 
 std::vector<Emulator::ObjectDescription> Emulator::dictionary() const {
@@ -303,12 +337,13 @@ void Emulator::resolve_hot() noexcept {
   h.target_velocity = must_find(obj::kTargetVelocity);
   h.profile_accel = must_find(obj::kProfileAcceleration);
   h.profile_decel = must_find(obj::kProfileDeceleration);
-  h.ramp_vpos = must_find(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub);
-  h.ramp_vneg = must_find(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub);
-  h.ramp_jerk = must_find(obj::kRampJerkControl);
-  h.slat_config = must_find(obj::kSlatConfiguration);
-  h.slat_set_point = must_find(obj::kSlatSetPoint);
-  h.slat_delay = must_find(obj::kSlatTimeDelay);
+  auto mds = [&](cia402::MdsObject o) { return must_find(cfg_.mds_objects[o].index, cfg_.mds_objects[o].sub); };
+  h.ramp_vpos = mds(cia402::MdsObject::kRampVelocityPositive);
+  h.ramp_vneg = mds(cia402::MdsObject::kRampVelocityNegative);
+  h.ramp_jerk = mds(cia402::MdsObject::kRampJerkControl);
+  h.slat_config = mds(cia402::MdsObject::kSlatConfiguration);
+  h.slat_set_point = mds(cia402::MdsObject::kSlatSetPoint);
+  h.slat_delay = mds(cia402::MdsObject::kSlatTimeDelay);
 }
 
 std::int64_t Emulator::sval(const Entry* e) noexcept {
@@ -490,8 +525,9 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   }
   if (index == 0x1029 && sub == 1 && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 1 && v == 0) return SdoAbort::kInvalidValue;
-  if (index == obj::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;
-  if (index == obj::kSlatConfiguration && v > 2) return SdoAbort::kInvalidValue;
+  const std::optional<cia402::MdsObject> mds = cfg_.mds_objects.find(index, sub);
+  if (mds == cia402::MdsObject::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;
+  if (mds == cia402::MdsObject::kSlatConfiguration && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 2) {
     const auto i = static_cast<std::int8_t>(v);
     if (i < -9) return SdoAbort::kValueTooLow;
@@ -511,7 +547,7 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   if (pdo_obj) rebuild_pdos();
   if (index == 0x1017) next_heartbeat_ns_ = now_ns_ + static_cast<std::int64_t>(v) * 1'000'000;
   if (index == 0x1016) consumers_[static_cast<std::size_t>(std::min<std::uint8_t>(sub, 4) - 1)] = Consumer{};
-  if (index == kFaultInjection && v != 0) inject_fault(static_cast<std::uint16_t>(v));
+  if (index == kFaultInjection && sub == 0 && v != 0 && !mds) inject_fault(static_cast<std::uint16_t>(v));
   if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled && !cfg_.refuse_mode_switch &&
       cfg_.behaviour.mode_switch_syncs == 0)
     mode_display_ = static_cast<std::int8_t>(v);

@@ -70,8 +70,8 @@ struct ServedObject {
 /// with the error register and 0000h when they clear) are the same in both.
 struct EmulatorBehaviour {
   /// The optional objects a drive may lack are absent: 0x1016 (consumer
-  /// heartbeat) and the project's vendor-area MDS objects 0x2010..0x2022
-  /// (SDO abort 0x06020000).
+  /// heartbeat) and the vendor-area MDS objects (EmulatorConfig::mds_objects,
+  /// by default the project's 0x2010..0x2022; SDO abort 0x06020000).
   bool optional_objects_absent = true;
   /// 0x60C2:2 (interpolation time index) is read-only (abort 0x06010002):
   /// the drive only takes periods in milliseconds (index -3).
@@ -132,11 +132,6 @@ struct EmulatorBehaviour {
   [[nodiscard]] static EmulatorBehaviour permissive() noexcept;
 };
 
-/// The objects a drive may lack (EmulatorBehaviour::optional_objects_absent).
-inline constexpr std::array<std::uint16_t, 6> kOptionalObjects = {0x1016, cia402::obj::kRampVelocityLimit,
-                                                                  cia402::obj::kRampJerkControl,
-                                                                  cia402::obj::kSlatConfiguration,
-                                                                  cia402::obj::kSlatSetPoint, cia402::obj::kSlatTimeDelay};
 
 /// A power-on value other than the emulator's own, and optionally read-only
 /// (EmulatorConfig::presets), e.g. a drive whose 0x1006 comes preset.
@@ -188,6 +183,14 @@ struct EmulatorConfig {
   /// 0x06020000 (object does not exist), as on a real drive without them.
   /// A PDO whose communication object is absent is never valid.
   std::vector<std::uint16_t> absent_objects;
+  /// Where this drive keeps the MDS objects CiA 402 lacks (ramp velocity
+  /// limits, ramp jerk, SLAT): the project's 0x2010..0x2022 by default, or
+  /// other indices (cia402-emu --mds-objects), as a real drive may. Nothing is
+  /// then at the default indices. An address that is also one of the
+  /// emulator's own objects (e.g. 0x2000 fault injection) becomes the MDS
+  /// object; a record's sub-index 0 (highest sub-index) is added when an
+  /// object sits at sub-index 1 or above.
+  cia402::MdsObjects mds_objects{};
   /// Power-on values (and read-only objects) other than the emulator's own,
   /// e.g. {0x1006, 0, 1000}: a drive that watches the SYNC from power-on and
   /// so refuses 0x1019 writes until 0x1006 is 0; {0x1019, 0, 5, true}: a
@@ -376,12 +379,13 @@ class Emulator final : public canopen::SdoServerBackend {
     // MDS ramps and SLAT (direct_model.cpp)
     Entry* profile_accel;       // 0x6083 RampAcceleration
     Entry* profile_decel;       // 0x6084 RampDeceleration
-    Entry* ramp_vpos;           // 0x2010:1
-    Entry* ramp_vneg;           // 0x2010:2
-    Entry* ramp_jerk;           // 0x2011
-    Entry* slat_config;         // 0x2020
-    Entry* slat_set_point;      // 0x2021
-    Entry* slat_delay;          // 0x2022
+    // EmulatorConfig::mds_objects (by default 0x2010:1/2, 0x2011, 0x2020..0x2022)
+    Entry* ramp_vpos;           // ramp velocity - positive
+    Entry* ramp_vneg;           // ramp velocity - negative
+    Entry* ramp_jerk;           // ramp jerk - control
+    Entry* slat_config;         // SLAT configuration
+    Entry* slat_set_point;      // SLAT set point
+    Entry* slat_delay;          // SLAT time delay
   };
   /// Per mapped PDO entry: the dictionary entry (nullptr if absent); where
   /// it sits in the payload is in the PDO's packing plan.
@@ -394,6 +398,9 @@ class Emulator final : public canopen::SdoServerBackend {
     return (static_cast<std::uint32_t>(index) << 8) | sub;
   }
   void build_dictionary();
+  /// The MDS objects at EmulatorConfig::mds_objects (and their records'
+  /// sub-index 0); returns their keys (optional_objects_absent removes them).
+  std::vector<std::uint32_t> add_mds_objects();
   void add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, const std::string* text = nullptr);
   Entry* find(std::uint16_t index, std::uint8_t sub) noexcept;
   void resolve_hot() noexcept;  // after build_dictionary(): fills hot_
