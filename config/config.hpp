@@ -7,6 +7,7 @@
 ///
 /// Not realtime-safe: everything here runs at start-up.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "fieldbus/canopen/device_dictionary.hpp"
+#include "fieldbus/cia402/cia402.hpp"
 #include "fieldbus/cia402/drive_pdos.hpp"
 #include "fieldbus/eds/eds.hpp"
 #include "motion/axis.hpp"
@@ -112,6 +114,21 @@ struct DriveSettings {
   std::optional<std::int16_t> quick_stop_option;  ///< written to 0x605A when given (CiA 402: 0..8 or manufacturer-specific < 0)
   std::vector<SdoWrite> sdo_writes;
   DriveIdentitySettings identity;
+  /// `sync_watch:` the drive watches the master's SYNC: 0x1006 = the period
+  /// (us) is written after 0x1019, and a drive that refuses it fails its
+  /// boot. False (default): 0x1006 is written 0 (before 0x1019) and left so,
+  /// as a drive that watches the SYNC leaves NMT operational when one cycle
+  /// comes more than half a period late (CANopenNode: 1.5 x 0x1006, EMCY
+  /// 8100h); the drive watches the master's heartbeat (0x1016) instead.
+  bool sync_watch = false;
+  /// `mds_objects:` where the drive keeps the MDS objects CiA 402 lacks
+  /// (ramp velocity limits, ramp jerk, SLAT), written with `direct_control:`;
+  /// the project's own 0x2010..0x2022 by default. Per object the key that
+  /// placed it ("drives.mds_objects.slat_set_point", "axes[1].drive.
+  /// mds_objects.slat_set_point"; empty: the default) and its location.
+  cia402::MdsObjects mds_objects;
+  std::array<std::string, cia402::kMdsObjectCount> mds_object_keys;
+  std::array<Location, cia402::kMdsObjectCount> mds_object_where;
   /// master_heartbeat_timeout_ms is written in the file (not the default):
   /// then 0x1016 is required, else optional (left out for a drive whose EDS
   /// lacks it, accepted missing without an EDS).
@@ -132,12 +149,14 @@ struct DriveSettings {
 
 /// An axis's `direct_control:` block (MDS, seed 002): the direct command's
 /// kind and the drive-side ramps and SLAT, in user units; written to the
-/// drive at boot (cia402.hpp obj::kProfileAcceleration .. kSlatTimeDelay).
+/// drive at boot (0x6083/0x6084 and the MDS objects at DriveSettings::mds_objects,
+/// by default cia402.hpp obj::kRampVelocityLimit .. kSlatTimeDelay).
 /// The planner part (mode, max_torque, velocity_command) is in AxisSettings::axis.
 struct DirectControlSettings {
   bool present = false;
   std::optional<double> ramp_acceleration;       ///< units/s^2 -> 0x6083
   std::optional<double> ramp_deceleration;       ///< units/s^2 -> 0x6084
+  // The objects below are at DriveSettings::mds_objects (default addresses shown).
   std::optional<double> ramp_velocity_positive;  ///< units/s -> 0x2010:1
   std::optional<double> ramp_velocity_negative;  ///< units/s -> 0x2010:2
   std::optional<std::uint8_t> ramp_jerk_control; ///< % 0..100 -> 0x2011

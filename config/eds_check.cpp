@@ -20,6 +20,7 @@ std::vector<cia402::BootWrite> proxy_writes(const cia402::DriveConfig& d, const 
   canopen::MasterConfig mc;
   mc.node_id = bus.master_node;
   mc.heartbeat_period_ms = bus.master_heartbeat_ms;
+  mc.sync_counter_overflow = bus.sync_counter_overflow;
   canopen::Master master(mc);
   const cia402::DriveProxy proxy(d, master);
   return {proxy.boot_writes().begin(), proxy.boot_writes().end()};
@@ -51,8 +52,10 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
       u.usage = eds::Usage::kRead;
       // A read the configuration asks for names drive.identity; the others
       // (0x1000's profile, 0x6061) are the master's own (the EDS key then).
-      if (w.check != cia402::BootCheck::kModeDisplay &&
-          (w.check != cia402::BootCheck::kDeviceType || d.identity.has_device_type))
+      if (w.check == cia402::BootCheck::kSyncCounter)
+        u.key = d.hints.sync_counter;
+      else if (w.check != cia402::BootCheck::kModeDisplay && w.check != cia402::BootCheck::kInterpolationIndex &&
+               (w.check != cia402::BootCheck::kDeviceType || d.identity.has_device_type))
         u.key = d.hints.identity;
       req.uses.push_back(std::move(u));
       continue;
@@ -61,6 +64,14 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
     u.size = w.w.size;
     // The value as the object's type reads it (INTEGERn sign-extended).
     const eds::SubObject* s = e != nullptr ? e->find(w.w.index, w.w.sub) : nullptr;
+    // A read-only 0x1006 or 0x1019 is what the boot falls back on: 0x1006 = 0
+    // is then not written (the drive keeps its own), and 0x1019 is fine when
+    // it already holds the master's value (else refused below, naming the key).
+    if (s != nullptr && !eds::writable(s->access) && w.optional &&
+        (w.origin == cia402::WriteOrigin::kSyncPeriod ||
+         (w.origin == cia402::WriteOrigin::kSyncCounter && s->default_value &&
+          s->default_value->resolve(a.node, 1) == w.w.value)))
+      continue;
     const bool is_signed = s != nullptr && canopen::data_type_signed(s->type);
     u.value = is_signed ? canopen::sign_extend(w.w.value, 8u * w.w.size) : static_cast<std::int64_t>(w.w.value);
     if (const std::string* k = cia402::write_hint_key(d.hints, w); k != nullptr) u.key = *k;
@@ -145,6 +156,13 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
                          fmt::format("{}: {} has no 0x{:04X}:{:02X}: the write is left out and the drive does not "
                                      "watch the master's heartbeat (set {} to 0 to say so)",
                                      who, ds.eds, u.index, u.sub, u.key)});
+      else if (u.index == cia402::obj::kSyncCounterOverflow && u.usage == eds::Usage::kWrite &&
+               bus->sync_counter_overflow != 0)
+        diags.push_back({Severity::kWarning, cfg.path, ds.eds_where, u.key,
+                         fmt::format("{}: {} has no 0x1019 (synchronous counter overflow value): the drive is not "
+                                     "told that the master's SYNC carries a counter (sync_counter_overflow: {} on "
+                                     "bus '{}'); it must take such SYNCs as they are",
+                                     who, ds.eds, bus->sync_counter_overflow, bus->name)});
       else if (u.index == cia402::obj::kSupportedDriveModes && !std::exchange(said_modes, true))
         diags.push_back({Severity::kWarning, cfg.path, ds.eds_where, ds.eds_key,
                          fmt::format("{}: {} has no 0x6502 (supported drive modes): the modes the master uses "

@@ -293,7 +293,8 @@ class Loader {
 
   void drive(const YAML::Node& n, const std::string& path, DriveSettings& d) {
     if (!check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
-                             "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds"}))
+                             "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds", "sync_watch",
+                             "mds_objects"}))
       return;
     if (std::int16_t q = 0; scalar(n, path, "quick_stop_option", q, std::int16_t{-32768}, std::int16_t{8},
                                    "(0x605A: 0 coast, 1/2 ramp then Switch on disabled, 5/6 ramp and stay in Quick stop "
@@ -328,6 +329,8 @@ class Loader {
            std::uint16_t{65535}, "ms");
     scalar(n, path, "following_error_window", d.following_error_window, std::uint16_t{0}, std::uint16_t{65535},
            "counts");
+    scalar(n, path, "sync_watch", d.sync_watch, false, true);
+    if (const YAML::Node m = n["mds_objects"]) mds_objects(m, path + ".mds_objects", d);
     if (const YAML::Node w = n["sdo_writes"]) {
       if (!w.IsSequence()) {
         error(w, path + ".sdo_writes", "must be a list of {index, sub, size, value}");
@@ -381,6 +384,39 @@ class Loader {
           d.sdo_writes.push_back(s);
         }
       }
+    }
+  }
+
+  /// `mds_objects:` {ramp_velocity_positive: "0x3000:1", ...}: each an
+  /// INDEX:SUB in the manufacturer-specific or device-profile area. Clashes
+  /// are checked per axis, once `drives:` and the axis's own are merged
+  /// (mds_object_checks).
+  void mds_objects(const YAML::Node& m, const std::string& path, DriveSettings& d) {
+    std::vector<std::string_view> keys;
+    for (const cia402::MdsObjectInfo& i : cia402::kMdsObjectInfo) keys.push_back(i.key);
+    if (!check_map(m, path, keys)) return;
+    for (std::size_t i = 0; i < cia402::kMdsObjectCount; ++i) {
+      const cia402::MdsObjectInfo& info = cia402::kMdsObjectInfo[i];
+      const YAML::Node v = m[std::string(info.key)];
+      if (!v) continue;
+      const std::string k = sub(path, info.key);
+      const std::optional<cia402::ObjectAddress> a = v.IsScalar() ? cia402::parse_object_address(v.Scalar()) : std::nullopt;
+      if (!a) {
+        error(v, k, fmt::format("'{}' is not an object INDEX:SUB (e.g. \"0x{:04X}:{}\", or \"0x2011\" for sub-index 0; "
+                                "sub-index 0 .. 254)",
+                                v.IsScalar() ? v.Scalar() : std::string("<non-scalar>"), info.standard.index,
+                                info.standard.sub));
+        continue;
+      }
+      if (a->index < 0x2000 || a->index > 0x9FFF) {
+        error(v, k, fmt::format("0x{:04X}:{} is outside the manufacturer-specific (0x2000 .. 0x5FFF) and device profile "
+                                "(0x6000 .. 0x9FFF) areas where a drive keeps such objects",
+                                a->index, a->sub));
+        continue;
+      }
+      d.mds_objects.at[i] = *a;
+      d.mds_object_keys[i] = k;
+      d.mds_object_where[i] = loc(v);
     }
   }
 
@@ -824,6 +860,62 @@ class Loader {
     }
   }
 
+  /// An axis's MDS objects (drives: and its own merged): no two at one
+  /// address, a record's sub-index 0 not taken while its other sub-indices
+  /// are, none on a CiA 402 object the master writes, maps or reads, none of
+  /// another size than the standard object there, and (with direct_control,
+  /// when they are written) none written by drive.sdo_writes too. Each
+  /// problem once, at the key that placed the object.
+  void mds_object_checks(const Config& cfg, std::set<std::string>& said) {
+    for (std::size_t ai = 0; ai < cfg.axes.size(); ++ai) {
+      const AxisSettings& a = cfg.axes[ai];
+      if (a.axis.type != motion::AxisType::CipDrive) continue;
+      const DriveSettings& d = a.drive;
+      auto report = [&](std::size_t i, const std::string& msg) {
+        if (said.insert(d.mds_object_keys[i] + msg).second) error_at(d.mds_object_where[i], d.mds_object_keys[i], msg);
+      };
+      auto name_of = [&](std::size_t j) {
+        return d.mds_object_keys[j].empty() ? fmt::format("{} (the default)", cia402::kMdsObjectInfo[j].key)
+                                            : d.mds_object_keys[j];
+      };
+      for (std::size_t i = 0; i < cia402::kMdsObjectCount; ++i) {
+        if (d.mds_object_keys[i].empty()) continue;  // the defaults do not clash among themselves
+        const cia402::ObjectAddress at = d.mds_objects.at[i];
+        const std::string where = fmt::format("0x{:04X}:{}", at.index, at.sub);
+        for (std::size_t j = 0; j < cia402::kMdsObjectCount; ++j) {
+          if (j == i) continue;
+          const cia402::ObjectAddress other = d.mds_objects.at[j];
+          if (other == at && (j < i || d.mds_object_keys[j].empty()))
+            report(i, fmt::format("{} is also {}: each MDS object needs its own", where, name_of(j)));
+          else if (other.index == at.index && at.sub == 0 && other.sub != 0)
+            report(i, fmt::format("{} is sub-index 0 of a record whose sub-index {} is {} (sub-index 0 holds the "
+                                  "record's highest sub-index)",
+                                  where, other.sub, name_of(j)));
+        }
+        if (std::find(cia402::kMasterProfileObjects.begin(), cia402::kMasterProfileObjects.end(), at.index) !=
+            cia402::kMasterProfileObjects.end()) {
+          const std::string_view n = canopen::object_name(at.index, at.sub);
+          report(i, fmt::format("{} is 0x{:04X} ({}), which the master itself writes, maps or reads; choose the "
+                                "drive's own object",
+                                where, at.index, n.empty() ? canopen::object_name(at.index, 0) : n));
+          continue;
+        }
+        const std::uint8_t size = cia402::kMdsObjectInfo[i].size;
+        if (const canopen::ObjectInfo* o = canopen::object_info(at.index, at.sub);
+            o != nullptr && at.index >= 0x6000 && canopen::data_type_size(o->type) != size)
+          report(i, fmt::format("{} is {} ({} byte{}), but {} is {} byte{}", where, o->name, canopen::data_type_size(o->type),
+                                canopen::data_type_size(o->type) == 1 ? "" : "s", cia402::kMdsObjectInfo[i].key, size,
+                                size == 1 ? "" : "s"));
+        if (a.direct.present)
+          for (std::size_t wi = 0; wi < d.sdo_writes.size(); ++wi)
+            if (d.sdo_writes[wi].index == at.index && d.sdo_writes[wi].sub == at.sub)
+              report(i, fmt::format("{} is also written by sdo_writes[{}] (line {}) of axis '{}', and its "
+                                    "direct_control writes it: remove one",
+                                    where, wi, d.sdo_writes[wi].where.line, a.name));
+      }
+    }
+  }
+
   void cross_check(Config& cfg) {
     std::map<std::string, Location> names;
     auto unique = [&](const std::string& name, Location l, const std::string& key, const char* what) {
@@ -842,6 +934,8 @@ class Loader {
     }
     array_checks(cfg, unique);
     coordinate_system_checks(cfg, unique);
+    std::set<std::string> said;
+    mds_object_checks(cfg, said);
 
     const auto ip = interpolation_period(cfg.controller.period_s);
     if (!ip)

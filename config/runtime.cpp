@@ -46,24 +46,44 @@ std::vector<motion::cam::CamPoint> motion_points(const std::vector<CamPoint>& po
 
 }  // namespace
 
-std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
-  std::vector<cia402::SdoWrite> w;
+namespace {
+/// direct_control_writes() with the `direct_control:` key behind each write
+/// (relative to the axis, e.g. "direct_control.ramp.velocity_positive"), and
+/// for an MDS object placed by `drive.mds_objects` that key too.
+struct KeyedWrite {
+  cia402::SdoWrite write;
+  std::string key;
+};
+std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
+  std::vector<KeyedWrite> w;
+  w.reserve(8);  // at most 8 writes: 0x6083, 0x6084 and the six MDS objects
   const DirectControlSettings& d = a.direct;
   if (!d.present || a.axis.type != motion::AxisType::CipDrive) return w;
   namespace obj = cia402::obj;
+  using cia402::MdsObject;
   const double conv = a.axis.conversion_constant;
-  auto write = [&](cia402::SdoWrite x, std::uint32_t value) {
+  auto counts = [&](double v) { return static_cast<std::uint32_t>(std::llround(v * conv)); };
+  auto standard = [&](cia402::SdoWrite x, std::uint32_t value, const char* key) {
     x.value = value;
-    w.push_back(x);
+    w.push_back(KeyedWrite{x, std::string(key)});
   };
-  auto counts = [&](const cia402::SdoWrite& x, double v) { write(x, static_cast<std::uint32_t>(std::llround(v * conv))); };
-  if (d.ramp_acceleration) counts(od_write(obj::kProfileAcceleration, 0), *d.ramp_acceleration);
-  if (d.ramp_deceleration) counts(od_write(obj::kProfileDeceleration, 0), *d.ramp_deceleration);
+  // An object CiA 402 lacks, where this drive keeps it (drive.mds_objects).
+  auto mds = [&](MdsObject o, std::uint32_t value, const char* key) {
+    const cia402::ObjectAddress at = a.drive.mds_objects[o];
+    const std::string& placed = a.drive.mds_object_keys[static_cast<std::size_t>(o)];
+    std::string k = key;
+    if (!placed.empty()) k += fmt::format(" (written to 0x{:04X}:{}, placed by {})", at.index, at.sub, placed);
+    w.push_back(KeyedWrite{cia402::SdoWrite{at.index, at.sub, cia402::info(o).size, value}, std::move(k)});
+  };
+  if (d.ramp_acceleration)
+    standard(od_write(obj::kProfileAcceleration, 0), counts(*d.ramp_acceleration), "direct_control.ramp.acceleration");
+  if (d.ramp_deceleration)
+    standard(od_write(obj::kProfileDeceleration, 0), counts(*d.ramp_deceleration), "direct_control.ramp.deceleration");
   if (d.ramp_velocity_positive)
-    counts(od_write(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub), *d.ramp_velocity_positive);
+    mds(MdsObject::kRampVelocityPositive, counts(*d.ramp_velocity_positive), "direct_control.ramp.velocity_positive");
   if (d.ramp_velocity_negative)
-    counts(od_write(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub), *d.ramp_velocity_negative);
-  if (d.ramp_jerk_control) write(od_write(obj::kRampJerkControl, 0), *d.ramp_jerk_control);
+    mds(MdsObject::kRampVelocityNegative, counts(*d.ramp_velocity_negative), "direct_control.ramp.velocity_negative");
+  if (d.ramp_jerk_control) mds(MdsObject::kRampJerkControl, *d.ramp_jerk_control, "direct_control.ramp.jerk_control");
   // The SLAT objects are vendor-area (cia402.hpp): written always, so that a
   // drive keeps no SLAT from an earlier configuration, but without `slat:`
   // in the file (SLAT disabled) a drive that lacks them is fine (it has no
@@ -72,31 +92,19 @@ std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
   // naming the key: MDS is validated only if the drive supports the ramp
   // attributes the configuration asks for [seed 002].
   const std::size_t slat_first = w.size();
-  write(od_write(obj::kSlatConfiguration, 0), d.slat_configuration);
-  counts(od_write(obj::kSlatSetPoint, 0), d.slat_set_point);
-  write(od_write(obj::kSlatTimeDelay, 0), d.slat_time_delay_ms);
-  for (std::size_t i = slat_first; i < w.size(); ++i) w[i].optional = !d.slat_set;
+  mds(MdsObject::kSlatConfiguration, d.slat_configuration, "direct_control.slat.configuration");
+  mds(MdsObject::kSlatSetPoint, counts(d.slat_set_point), "direct_control.slat.set_point");
+  mds(MdsObject::kSlatTimeDelay, d.slat_time_delay_ms, "direct_control.slat.time_delay_ms");
+  for (std::size_t i = slat_first; i < w.size(); ++i) w[i].write.optional = !d.slat_set;
   return w;
 }
-
-namespace {
-/// The `direct_control:` key behind one of direct_control_writes()'s objects.
-std::string direct_control_key(const cia402::SdoWrite& w) {
-  namespace obj = cia402::obj;
-  switch (w.index) {
-    case obj::kProfileAcceleration: return "direct_control.ramp.acceleration";
-    case obj::kProfileDeceleration: return "direct_control.ramp.deceleration";
-    case obj::kRampVelocityLimit:
-      return w.sub == obj::kRampVelocityPositiveSub ? "direct_control.ramp.velocity_positive"
-                                                    : "direct_control.ramp.velocity_negative";
-    case obj::kRampJerkControl: return "direct_control.ramp.jerk_control";
-    case obj::kSlatConfiguration: return "direct_control.slat.configuration";
-    case obj::kSlatSetPoint: return "direct_control.slat.set_point";
-    case obj::kSlatTimeDelay: return "direct_control.slat.time_delay_ms";
-    default: return "direct_control";
-  }
-}
 }  // namespace
+
+std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
+  std::vector<cia402::SdoWrite> w;
+  for (const KeyedWrite& k : keyed_direct_control_writes(a)) w.push_back(k.write);
+  return w;
+}
 
 cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s, std::size_t axis_index) {
   cia402::DriveConfig d;
@@ -109,6 +117,9 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   d.hints.consumer_heartbeat = drive_key("master_heartbeat_timeout_ms");
   d.hints.identity = fmt::format("{}.drive.identity", axis);
   d.hints.mode_switch_timeout = drive_key("timeouts.mode_switch_ms");
+  d.hints.sync_watch = drive_key("sync_watch");
+  d.hints.sync_counter = fmt::format("buses[].sync_counter_overflow of bus '{}' (line {})", bus.name, bus.where.line);
+  d.sync_watch = a.drive.sync_watch;
   const DriveIdentitySettings& id = a.drive.identity;
   d.identity.has_device_type = id.device_type.has_value();
   d.identity.device_type = id.device_type.value_or(0);
@@ -158,9 +169,9 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   }
   d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
   d.homing_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.homing_ms) * 1'000'000;
-  for (const cia402::SdoWrite& w : direct_control_writes(a)) {
-    d.extra_writes.push_back(w);
-    d.hints.extra.push_back(fmt::format("{}.{}", axis, direct_control_key(w)));
+  for (const KeyedWrite& k : keyed_direct_control_writes(a)) {
+    d.extra_writes.push_back(k.write);
+    d.hints.extra.push_back(fmt::format("{}.{}", axis, k.key));
   }
   for (std::size_t i = 0; i < a.drive.sdo_writes.size(); ++i) {
     const SdoWrite& w = a.drive.sdo_writes[i];
@@ -174,16 +185,18 @@ emulator::EmulatorConfig emulator_config(const AxisSettings& a) {
   emulator::EmulatorConfig e;
   e.node = a.node;
   e.behaviour = emulator::EmulatorBehaviour::strict();  // --sim drives behave like real ones (README "Emulator profiles")
-  // The simulated drive lacks the optional objects (emulator::kOptionalObjects)
-  // except those the configuration asks for: 0x1016 when the file sets
-  // master_heartbeat_timeout_ms, 0x2010..0x2022 with `direct_control:`. Those
-  // a real drive must have (its boot fails naming the key otherwise).
+  // The simulated drive lacks the optional objects (EmulatorBehaviour::
+  // optional_objects_absent) except those the configuration asks for: 0x1016
+  // when the file sets master_heartbeat_timeout_ms, the MDS objects (where
+  // drive.mds_objects puts them) with `direct_control:`. Those a real drive
+  // must have (its boot fails naming the key otherwise).
   e.behaviour.optional_objects_absent = false;
-  for (const std::uint16_t index : emulator::kOptionalObjects) {
-    const bool asked = index == 0x1016 ? a.drive.master_heartbeat_timeout_set && a.drive.master_heartbeat_timeout_ms > 0
-                                       : a.direct.present;
-    if (!asked) e.absent_objects.push_back(index);
-  }
+  e.mds_objects = a.drive.mds_objects;
+  if (!(a.drive.master_heartbeat_timeout_set && a.drive.master_heartbeat_timeout_ms > 0)) e.absent_objects.push_back(0x1016);
+  if (!a.direct.present)
+    for (const cia402::ObjectAddress& at : a.drive.mds_objects.at)
+      if (std::find(e.absent_objects.begin(), e.absent_objects.end(), at.index) == e.absent_objects.end())
+        e.absent_objects.push_back(at.index);
   const double conv = a.axis.conversion_constant;
   // Give the model headroom over the axis's own limits, so that the emulated
   // drive follows any profile the planner may command.

@@ -44,8 +44,9 @@ struct Runtime {
 [[nodiscard]] cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s,
                                                std::size_t axis_index = 0);
 
-/// The SDO writes of an axis's `direct_control:` (ramps 0x6083, 0x6084,
-/// 0x2010:1/2, 0x2011; SLAT 0x2020..0x2022) in drive units; empty without one.
+/// The SDO writes of an axis's `direct_control:` (ramps 0x6083, 0x6084 and
+/// the MDS objects where `drive.mds_objects` puts them, by default 0x2010:1/2,
+/// 0x2011, SLAT 0x2020..0x2022) in drive units; empty without one.
 [[nodiscard]] std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a);
 
 /// The emulated drive standing in for a CIP axis in a simulated bus: its

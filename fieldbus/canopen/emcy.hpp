@@ -40,6 +40,7 @@ inline constexpr std::uint16_t kGeneric = 0x1000;
 inline constexpr std::uint16_t kContinuousOverCurrent = 0x2310;
 inline constexpr std::uint16_t kDcLinkOverVoltage = 0x3210;
 inline constexpr std::uint16_t kExcessDriveTemperature = 0x4310;
+inline constexpr std::uint16_t kCommunication = 0x8100;   ///< generic communication error (CANopenNode: SYNC timeout)
 inline constexpr std::uint16_t kCanOverrun = 0x8110;
 inline constexpr std::uint16_t kCanErrorPassive = 0x8120;
 inline constexpr std::uint16_t kHeartbeatError = 0x8130;   ///< life guard / heartbeat consumer timeout
@@ -77,6 +78,7 @@ inline constexpr std::uint16_t kFollowingError = 0x8611;   ///< CiA 402
     case 0x7305: return "incremental sensor 1 fault";
     case 0x7310: return "speed sensor error";
     case 0x7320: return "position sensor error";
+    case 0x8100: return "communication (generic)";
     case 0x8110: return "CAN overrun (objects lost)";
     case 0x8120: return "CAN in error passive mode";
     case 0x8130: return "life guard error or heartbeat error";

@@ -83,6 +83,13 @@ inline constexpr std::uint16_t kTargetVelocity = 0x60FF;
 inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
 inline constexpr std::uint16_t kDeviceType = 0x1000;  ///< CiA 301; bits 0..15 the device profile number
 inline constexpr std::uint16_t kIdentity = 0x1018;    ///< CiA 301; sub1 vendor, sub2 product, sub3 revision, sub4 serial
+/// CiA 301, UNSIGNED32 in us: a SYNC consumer with a value other than 0
+/// watches the SYNC (CANopenNode: EMCY 8100h after 1.5 x the period without one).
+inline constexpr std::uint16_t kCommunicationCyclePeriod = 0x1006;
+/// CiA 301, UNSIGNED8: 0 = SYNC without counter, 2..240 = the counter's
+/// overflow value (the SYNC then carries it in one byte). Changes only while
+/// 0x1006 is 0 (SDO abort 0x08000022 otherwise).
+inline constexpr std::uint16_t kSyncCounterOverflow = 0x1019;
 
 // ---- MDS drive-side ramps and SLAT (Logix seed 002) --------------------------
 // Standard objects carry the ramp accelerations: RampAcceleration ->
@@ -107,6 +114,113 @@ inline constexpr std::uint16_t kSlatSetPoint = 0x2021;
 /// set point before the drive switches from torque to speed control).
 inline constexpr std::uint16_t kSlatTimeDelay = 0x2022;
 }  // namespace obj
+
+// ---- where a drive keeps the MDS objects CiA 402 lacks ----------------------
+/// One object of a drive's dictionary: index and sub-index.
+struct ObjectAddress {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  friend constexpr bool operator==(const ObjectAddress&, const ObjectAddress&) = default;
+};
+
+/// The MDS objects above that CiA 402 does not define (the vendor-area ones;
+/// 0x6083/0x6084 are standard and fixed), by what they do.
+enum class MdsObject : std::uint8_t {
+  kRampVelocityPositive,  ///< UNSIGNED32 counts/s (obj::kRampVelocityLimit sub 1)
+  kRampVelocityNegative,  ///< UNSIGNED32 counts/s (sub 2)
+  kRampJerkControl,       ///< UNSIGNED8 % 0..100
+  kSlatConfiguration,     ///< UNSIGNED8 SlatConfiguration
+  kSlatSetPoint,          ///< UNSIGNED32 counts/s
+  kSlatTimeDelay,         ///< UNSIGNED16 ms
+};
+inline constexpr std::size_t kMdsObjectCount = 6;
+
+/// Per MdsObject: its configuration key (`drive.mds_objects.<key>`, the
+/// cia402-emu --mds-objects name), its size in bytes (the data type's:
+/// UNSIGNED8/16/32) and the project's own address.
+struct MdsObjectInfo {
+  std::string_view key;
+  std::uint8_t size;
+  ObjectAddress standard;
+};
+inline constexpr std::array<MdsObjectInfo, kMdsObjectCount> kMdsObjectInfo = {{
+    {"ramp_velocity_positive", 4, {obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub}},
+    {"ramp_velocity_negative", 4, {obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub}},
+    {"ramp_jerk_control", 1, {obj::kRampJerkControl, 0}},
+    {"slat_configuration", 1, {obj::kSlatConfiguration, 0}},
+    {"slat_set_point", 4, {obj::kSlatSetPoint, 0}},
+    {"slat_time_delay", 2, {obj::kSlatTimeDelay, 0}},
+}};
+[[nodiscard]] constexpr const MdsObjectInfo& info(MdsObject o) noexcept { return kMdsObjectInfo[static_cast<std::size_t>(o)]; }
+
+/// Where one drive keeps the MDS objects (issue 15 item 6): the project's
+/// own vendor-area indices 0x2010..0x2022 by default; on a real drive those
+/// indices may mean something else, so the master (`drive.mds_objects`) and
+/// the emulator (EmulatorConfig::mds_objects, cia402-emu --mds-objects) take
+/// them from here.
+struct MdsObjects {
+  std::array<ObjectAddress, kMdsObjectCount> at = {
+      kMdsObjectInfo[0].standard, kMdsObjectInfo[1].standard, kMdsObjectInfo[2].standard,
+      kMdsObjectInfo[3].standard, kMdsObjectInfo[4].standard, kMdsObjectInfo[5].standard};
+  [[nodiscard]] constexpr ObjectAddress operator[](MdsObject o) const noexcept { return at[static_cast<std::size_t>(o)]; }
+  [[nodiscard]] constexpr ObjectAddress& operator[](MdsObject o) noexcept { return at[static_cast<std::size_t>(o)]; }
+  /// The object at index:sub, if one is there.
+  [[nodiscard]] constexpr std::optional<MdsObject> find(std::uint16_t index, std::uint8_t sub) const noexcept {
+    for (std::size_t i = 0; i < kMdsObjectCount; ++i)
+      if (at[i] == ObjectAddress{index, sub}) return static_cast<MdsObject>(i);
+    return std::nullopt;
+  }
+  /// True when `index` holds one of them (any sub-index).
+  [[nodiscard]] constexpr bool uses_index(std::uint16_t index) const noexcept {
+    for (const ObjectAddress& a : at)
+      if (a.index == index) return true;
+    return false;
+  }
+  friend constexpr bool operator==(const MdsObjects&, const MdsObjects&) = default;
+};
+
+/// "0x2010:1", "0x2011" (sub-index 0), "8208:0x01": an index 1..0xFFFF and
+/// a sub-index 0..254, each decimal or 0x hex; nullopt when the text is not one.
+[[nodiscard]] constexpr std::optional<ObjectAddress> parse_object_address(std::string_view s) noexcept {
+  auto number = [](std::string_view t, std::uint32_t max) -> std::optional<std::uint32_t> {
+    unsigned base = 10;
+    if (t.size() > 2 && t[0] == '0' && (t[1] == 'x' || t[1] == 'X')) {
+      base = 16;
+      t.remove_prefix(2);
+    }
+    if (t.empty()) return std::nullopt;
+    std::uint32_t v = 0;
+    for (const char c : t) {
+      unsigned d = 0;
+      if (c >= '0' && c <= '9') d = static_cast<unsigned>(c - '0');
+      else if (base == 16 && c >= 'a' && c <= 'f') d = static_cast<unsigned>(c - 'a' + 10);
+      else if (base == 16 && c >= 'A' && c <= 'F') d = static_cast<unsigned>(c - 'A' + 10);
+      else return std::nullopt;
+      v = v * base + d;
+      if (v > max) return std::nullopt;
+    }
+    return v;
+  };
+  const std::size_t colon = s.find(':');
+  const auto index = number(s.substr(0, colon), 0xFFFF);
+  if (!index || *index == 0) return std::nullopt;
+  std::optional<std::uint32_t> sub = 0u;
+  if (colon != std::string_view::npos) sub = number(s.substr(colon + 1), 254);
+  if (!sub) return std::nullopt;
+  return ObjectAddress{static_cast<std::uint16_t>(*index), static_cast<std::uint8_t>(*sub)};
+}
+
+/// The CiA 402 objects the master writes (boot configuration, homing, mode
+/// switches), maps into its PDOs or reads (0x603F, 0x6502, 0x6061): an MDS
+/// object must not be placed on one of them (config/loader.cpp). Keep in
+/// step with drive_boot.cpp, drive_pdos.cpp and the homing writes.
+inline constexpr std::array<std::uint16_t, 21> kMasterProfileObjects = {
+    obj::kErrorCode,         obj::kControlword,          obj::kStatusword,          obj::kQuickStopOptionCode,
+    obj::kModesOfOperation,  obj::kModesOfOperationDisplay, obj::kPositionActualValue, obj::kFollowingErrorWindow,
+    obj::kVelocityActualValue, obj::kTargetTorque,       obj::kTorqueActualValue,   obj::kTargetPosition,
+    obj::kHomeOffset,        obj::kProfileAcceleration,  obj::kProfileDeceleration, obj::kHomingMethod,
+    obj::kHomingSpeeds,      obj::kHomingAcceleration,   obj::kInterpolationTimePeriod, obj::kTargetVelocity,
+    obj::kSupportedDriveModes};
 
 /// SLAT Configuration (0x2020) enumeration, numbers as in the Logix MDS page.
 enum class SlatConfiguration : std::uint8_t {

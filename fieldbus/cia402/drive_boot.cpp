@@ -20,7 +20,8 @@ void DriveProxy::build_configuration() {
   auto add = [&](WriteOrigin o, SdoWrite w, std::uint16_t extra = 0) {
     const bool optional = o == WriteOrigin::kUnusedPdo ||
                           (o == WriteOrigin::kConsumerHeartbeat && cfg_.consumer_heartbeat_optional) ||
-                          (o == WriteOrigin::kExtra && w.optional);
+                          ((o == WriteOrigin::kExtra || o == WriteOrigin::kSyncPeriod || o == WriteOrigin::kSyncCounter) &&
+                           w.optional);
     if (optional && absent(w)) return;
     writes_.push_back(BootWrite{w, o, extra, optional});
   };
@@ -55,6 +56,24 @@ void DriveProxy::build_configuration() {
                               BootCheck::kInterpolationIndex});
   writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value}, WriteOrigin::kInterpolationPeriod,
                               0, false, true});
+  // The SYNC consumer (CiA 301): 0x1019 may change only while 0x1006 is 0
+  // (abort 0x08000022 otherwise; CANopenNode's CO_ODF_1019 too), so 0x1006 is
+  // written 0 first, then 0x1019 = the master's counter overflow value (0: its
+  // SYNC carries no counter; a drive whose 0x1019 does not match drops every
+  // SYNC, EMCY 8240h), then with sync_watch 0x1006 = the period in us (the
+  // drive then watches the SYNC). A drive without 0x1006 / 0x1019 is fine
+  // (said once), as is a read-only 0x1006; a 0x1019 refused otherwise is read
+  // (the sync_fallback entry): it must already hold the master's value
+  // (BootCheck::kSyncCounter). The period write is required: asked for.
+  const std::uint8_t overflow = master_.config().sync_counter_overflow >= 2 ? master_.config().sync_counter_overflow : 0;
+  add(WriteOrigin::kSyncPeriod, SdoWrite{obj::kCommunicationCyclePeriod, 0, 4, 0, true});
+  add(WriteOrigin::kSyncCounter, SdoWrite{obj::kSyncCounterOverflow, 0, 1, overflow, true});
+  if (!writes_.empty() && writes_.back().origin == WriteOrigin::kSyncCounter)
+    writes_.push_back(BootWrite{SdoWrite{obj::kSyncCounterOverflow, 0, 1, 0}, WriteOrigin::kCheck, 0, true, false,
+                                BootCheck::kSyncCounter, true});
+  if (cfg_.sync_watch)
+    add(WriteOrigin::kSyncPeriod,
+        SdoWrite{obj::kCommunicationCyclePeriod, 0, 4, static_cast<std::uint32_t>(cfg_.cycle_ns / 1000)});
   // PDOs: the CiA 301 procedure for the used ones, COB-ID invalid for PDO 1..4 not used.
   auto add_map = [&](const canopen::PdoMap& m) {
     const std::uint32_t cob = m.cob_id & 0x7FFu;
@@ -186,6 +205,19 @@ bool DriveProxy::check_read(const BootWrite& bw, std::uint32_t v, std::int64_t n
       key = &cfg_.hints.interpolation_period;
       break;
     }
+    case BootCheck::kSyncCounter: {
+      // The drive refused 0x1019 (sync_abort_): fine when it holds the master's value.
+      const auto want = static_cast<std::uint32_t>(writes_[static_cast<std::size_t>(&bw - writes_.data()) - 1].w.value);
+      const std::uint32_t held = v & 0xFFu;
+      if (held == want) {
+        notice(static_cast<std::size_t>(&bw - writes_.data()) - 1, sync_abort_, static_cast<std::int32_t>(held));
+        return true;
+      }
+      ok = false;
+      expected = want;
+      key = &cfg_.hints.sync_counter;
+      break;
+    }
     case BootCheck::kNone: break;
   }
   if (ok) return true;
@@ -197,6 +229,7 @@ bool DriveProxy::check_read(const BootWrite& bw, std::uint32_t v, std::int64_t n
   failure_.sdo_index = bw.w.index;
   failure_.sdo_sub = bw.w.sub;
   failure_.sdo_origin = WriteOrigin::kCheck;
+  if (bw.check == BootCheck::kSyncCounter) failure_.sdo_abort = sync_abort_;  // the refused write's
   failure_.hint = key != nullptr && !key->empty() ? key->c_str() : nullptr;
   return false;
 }
@@ -213,7 +246,7 @@ void DriveProxy::forget_drive(std::int64_t now_ns) noexcept {
   nmt_left_ = false;
   mode_ = cfg_.mode;  // configured again with the boot mode
   next_write_ = done_writes_ = tolerated_ = 0;
-  ip_fallback_ = false;
+  ip_fallback_ = sync_fallback_ = false;
   in_fault_ = emcy_in_fault_ = error_code_asked_ = false;
   mode_shown_since_ns_ = -1;
   master_.sdo(cfg_.node).cancel_all();
@@ -289,6 +322,19 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
           ip_fallback_ = true;
           ip_abort_ = static_cast<std::uint32_t>(r.abort);
           ++tolerated_;
+        } else if (!r.ok() && bw != nullptr && bw->origin == WriteOrigin::kSyncCounter && !canopen::object_absent(r.abort) &&
+                   r.abort != canopen::SdoAbort::kTimeout) {
+          // 0x1019 refused (read-only, 0x08000022 while the drive's 0x1006 is
+          // not 0, a value it cannot take): the sync_fallback read decides.
+          sync_fallback_ = true;
+          sync_abort_ = static_cast<std::uint32_t>(r.abort);
+          ++tolerated_;
+        } else if (!r.ok() && bw != nullptr && bw->origin == WriteOrigin::kSyncPeriod && bw->optional &&
+                   r.abort == canopen::SdoAbort::kReadOnly) {
+          // 0x1006 = 0 on a drive where it is read-only: the drive keeps its
+          // own (0x1019's answer shows whether that matters). Said once.
+          ++tolerated_;
+          notice(r.tag, static_cast<std::uint32_t>(r.abort));
         } else if (!r.ok() && bw != nullptr && bw->optional && canopen::object_absent(r.abort)) {
           // The drive lacks an optional object: fewer PDOs than 4, no 0x1016;
           // no 0x6502 / 0x6061: the modes are not checked, the written mode is
@@ -324,6 +370,12 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
           if (bw != nullptr) {
             failure_.sdo_origin = bw->origin;
             const std::string* key = write_hint_key(cfg_.hints, *bw);
+            if (bw->check == BootCheck::kSyncCounter) {
+              // 0x1019 could not be read back either: the refused write is the failure.
+              failure_.sdo_abort = sync_abort_;
+              failure_.sdo_origin = WriteOrigin::kSyncCounter;
+              key = &cfg_.hints.sync_counter;
+            }
             failure_.hint = key != nullptr && !key->empty() ? key->c_str() : nullptr;
           }
           sdo.cancel_all();
@@ -336,10 +388,10 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
         // Nothing is written before the checks have passed.
         if (next_write_ >= leading_reads_ && done_writes_ < leading_reads_) break;
         const BootWrite& bw = writes_[next_write_];
-        if (bw.ip_fallback) {
-          if (done_writes_ < next_write_) break;  // 0x60C2:2's answer decides
-          if (!ip_fallback_) {
-            ++next_write_;  // 0x60C2:2 was written: nothing to fall back on
+        if (bw.ip_fallback || bw.sync_fallback) {
+          if (done_writes_ < next_write_) break;  // 0x60C2:2's (0x1019's) answer decides
+          if (!(bw.ip_fallback ? ip_fallback_ : sync_fallback_)) {
+            ++next_write_;  // it was written: nothing to fall back on
             ++done_writes_;
             continue;
           }

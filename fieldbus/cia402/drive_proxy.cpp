@@ -41,6 +41,15 @@ int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key)
       return std::snprintf(out, size, "; the write comes from %s: correct or remove it", k ? key : "the extra configuration writes");
     case WriteOrigin::kCheck:
       return std::snprintf(out, size, "; canmotiond reads it at boot to check the drive (CiA 301 mandatory object)");
+    case WriteOrigin::kSyncPeriod:
+      return std::snprintf(out, size, "; canmotiond writes 0x1006 = 0 before 0x1019 (CiA 301 allows a 0x1019 change only "
+                                      "while 0x1006 is 0), and the SYNC period after it when %s is true (false leaves "
+                                      "that write out)",
+                           k ? key : "the drive's sync_watch");
+    case WriteOrigin::kSyncCounter:
+      return std::snprintf(out, size, "; 0x1019 must match the SYNC the master sends (a drive drops SYNCs of another "
+                                      "length, EMCY 8240h): it comes from %s",
+                           k ? key : "the master's SYNC counter overflow");
   }
   return 0;
 }
@@ -53,6 +62,8 @@ const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) n
     case WriteOrigin::kProducerHeartbeat: return &hints.producer_heartbeat;
     case WriteOrigin::kConsumerHeartbeat: return &hints.consumer_heartbeat;
     case WriteOrigin::kExtra: return w.extra < hints.extra.size() ? &hints.extra[w.extra] : nullptr;
+    case WriteOrigin::kSyncPeriod: return &hints.sync_watch;
+    case WriteOrigin::kSyncCounter: return &hints.sync_counter;
     case WriteOrigin::kMode:
     case WriteOrigin::kUnusedPdo:
     case WriteOrigin::kCheck: return nullptr;
@@ -77,9 +88,21 @@ std::string describe_notice(const canopen::NodeEvent& e) {
     fallback = "the mode written to 0x6060 is taken as the one the drive runs";
   } else if (e.index == obj::kSlatConfiguration || e.index == obj::kSlatSetPoint || e.index == obj::kSlatTimeDelay) {
     fallback = "the drive has no SLAT: MDS runs without it (direct_control.slat is not set)";
+  } else if (e.index == obj::kCommunicationCyclePeriod) {
+    fallback = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly)
+                   ? "the drive keeps its own SYNC watch period"
+                   : "the drive has no SYNC watch period (0x1006) to set";
+  } else if (e.index == obj::kSyncCounterOverflow &&
+             canopen::object_absent(static_cast<canopen::SdoAbort>(e.abort))) {
+    fallback = "the drive has no SYNC counter setting: it must take the master's SYNC as it is (buses[].sync_counter_overflow)";
+  } else if (e.index == obj::kSyncCounterOverflow) {
+    std::snprintf(buf, sizeof buf, "it already holds %d, the master's SYNC counter overflow value", static_cast<int>(e.detail));
+    fallback = buf;
   }
   char out[512];
-  const char* what = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly) ? "read-only" : "absent";
+  const char* what = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly) ? "read-only"
+                     : canopen::object_absent(static_cast<canopen::SdoAbort>(e.abort)) || e.abort == 0 ? "absent"
+                                                                                                       : "refused";
   std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) %s (SDO abort 0x%08" PRIX32 " %.*s): %s",
                 e.node, e.index, e.sub, static_cast<int>(name.size()), name.data(), what, e.abort,
                 static_cast<int>(canopen::sdo_abort_text(e.abort).size()), canopen::sdo_abort_text(e.abort).data(),
@@ -222,6 +245,26 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                             "10^%d s) and the cycle period %.6g ms (%s) is not a whole number 1..255 of that unit: "
                             "choose a period the drive can take",
                             node, idx, idx, static_cast<double>(expected) / 1e6, k ? hint : "the cycle period");
+          break;
+        }
+        case BootCheck::kSyncCounter: {
+          const auto text = canopen::sdo_abort_text(sdo_abort);
+          char why[160];
+          if (expected == 0)
+            std::snprintf(why, sizeof why, "the drive expects SYNCs with a counter (up to %" PRIu32
+                          ") and would drop every SYNC of the master, which has none (EMCY 8240h)", read_value);
+          else if (read_value == 0)
+            std::snprintf(why, sizeof why, "the drive takes SYNCs without a counter and would drop every SYNC of the "
+                          "master, which carries one (EMCY 8240h)");
+          else
+            std::snprintf(why, sizeof why, "the drive counts SYNCs up to %" PRIu32 ", the master up to %" PRIu32,
+                          read_value, expected);
+          n = std::snprintf(out.data(), out.size(),
+                            "node %u: 0x1019:0 (Synchronous counter overflow value) refused the write of %" PRIu32
+                            " (SDO abort 0x%08" PRIX32 " %.*s) and holds %" PRIu32 ": %s; set %s: %" PRIu32
+                            ", or give the drive's 0x1019 the value %" PRIu32,
+                            node, expected, sdo_abort, static_cast<int>(text.size()), text.data(), read_value, why,
+                            k ? hint : "the master's SYNC counter overflow", read_value, expected);
           break;
         }
         case BootCheck::kNone: n = std::snprintf(out.data(), out.size(), "node %u: boot check failed", node); break;

@@ -5,9 +5,11 @@
 /// once per cycle.
 ///
 /// Per node: boot (wait for boot-up / heartbeat, or reset the node), SDO
-/// configuration (0x6060 mode, 0x60C2 interpolation period = cycle, PDO
-/// maps by the CiA 301 procedure, heartbeat producer 0x1017, the consumer
-/// 0x1016 watching the master when asked for, extra writes), NMT start, then
+/// configuration (0x6060 mode, 0x60C2 interpolation period = cycle, 0x1006 =
+/// 0 then 0x1019 = the master's SYNC counter overflow and, with
+/// DriveConfig::sync_watch, 0x1006 = the period; PDO maps by the CiA 301
+/// procedure, heartbeat producer 0x1017, the consumer 0x1016 watching the
+/// master when asked for, extra writes), NMT start, then
 /// the 402 state machine through its numbered transitions with a per-node
 /// timeout. Until Operation enabled is reached the targets follow the actual
 /// values, so enabling never jumps. A failure explains itself
@@ -61,6 +63,8 @@ struct WriteHints {
   std::vector<std::string> extra;    ///< one per DriveConfig::extra_writes entry, e.g. "axes[0].drive.sdo_writes[1]"
   std::string identity;              ///< DriveConfig::identity, e.g. "axes[0].drive.identity"
   std::string mode_switch_timeout;   ///< e.g. "axes[0].drive.timeouts.mode_switch_ms"
+  std::string sync_counter;          ///< 0x1019, e.g. "buses[0].sync_counter_overflow"
+  std::string sync_watch;            ///< 0x1006, e.g. "axes[0].drive.sync_watch"
 };
 
 /// What a boot configuration write is for.
@@ -74,6 +78,8 @@ enum class WriteOrigin : std::uint8_t {
   kConsumerHeartbeat,   ///< 0x1016:1
   kExtra,               ///< DriveConfig::extra_writes
   kCheck,               ///< a read at boot that checks the drive (BootCheck)
+  kSyncPeriod,          ///< 0x1006 communication cycle period: 0, then the period (DriveConfig::sync_watch)
+  kSyncCounter,         ///< 0x1019 synchronous counter overflow value (the master's SYNC counter)
 };
 
 /// What a read at boot checks (Failure::check for FailureKind::kBootCheck).
@@ -89,6 +95,11 @@ enum class BootCheck : std::uint8_t {
   /// absent): the period must be expressible in the drive's unit (`read_value`
   /// the drive's index, `expected` the period in ns).
   kInterpolationIndex,
+  /// 0x1019 read after the drive refused to write it (read-only, 0x08000022
+  /// while its 0x1006 != 0, ...): it must already hold the master's counter
+  /// overflow value (`read_value` the drive's, `expected` the master's,
+  /// `sdo_abort` the write's abort).
+  kSyncCounter,
 };
 
 /// One sentence for a canopen::NodeEvent::Kind::kObjectAbsent (an optional
@@ -174,6 +185,14 @@ struct DriveConfig {
   /// by default (consumer_heartbeat_ms's default is not a user's request);
   /// canmotiond sets it false when the file sets master_heartbeat_timeout_ms.
   bool consumer_heartbeat_optional = true;
+  /// The drive watches the SYNC: 0x1006 (communication cycle period) is
+  /// written with cycle_ns in us after 0x1019, and the write is required.
+  /// CANopenNode-based drives then send EMCY 8100h and (their default error
+  /// behaviour) leave NMT operational when no SYNC came for 1.5 periods.
+  /// False: 0x1006 is left at 0 (written 0 before 0x1019 in any case, as
+  /// CiA 301 allows a 0x1019 change only while 0x1006 = 0). 0x1019 gets the
+  /// master's MasterConfig::sync_counter_overflow (0: no counter).
+  bool sync_watch = false;
 };
 
 /// One SDO transfer of the boot configuration, in the order the proxy makes
@@ -188,6 +207,9 @@ struct BootWrite {
   /// 0x60C2:1 written again in its unit); skipped otherwise.
   bool ip_fallback = false;
   BootCheck check = BootCheck::kNone;  ///< not kNone: a read (upload) that checks the drive
+  /// Runs only after the drive refused 0x1019 other than as absent (the read
+  /// of its value, BootCheck::kSyncCounter); skipped otherwise.
+  bool sync_fallback = false;
   [[nodiscard]] constexpr bool is_read() const noexcept { return check != BootCheck::kNone; }
 };
 
@@ -450,6 +472,8 @@ class DriveProxy {
   std::size_t tolerated_ = 0;
   bool ip_fallback_ = false;  // 0x60C2:2 refused: the BootWrite::ip_fallback entries run
   std::uint32_t ip_abort_ = 0;  // the abort 0x60C2:2's write got
+  bool sync_fallback_ = false;  // 0x1019 refused: the BootWrite::sync_fallback read runs
+  std::uint32_t sync_abort_ = 0;  // the abort 0x1019's write got
   std::vector<std::uint8_t> noticed_;  // per writes_ entry: its notice was made (said once)
   std::array<canopen::NodeEvent, 16> notices_{};  // bound: at most one per optional boot object, 16 is ample
   std::size_t notice_head_ = 0, notice_count_ = 0;

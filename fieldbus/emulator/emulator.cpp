@@ -51,6 +51,7 @@ EmulatorBehaviour EmulatorBehaviour::permissive() noexcept {
   b.cia402_default_pdos = false;
   b.rpdo_too_long_emcy = false;
   b.check_sync_length = false;
+  b.sync_timeout = false;
   b.error_behaviour = false;
   b.boot_ns = 0;
   b.sdo_reply_delay_ns = 0;
@@ -200,13 +201,6 @@ void Emulator::build_dictionary() {
   // Ramps of CSV (MDS): by default as fast as the model can go.
   add(obj::kProfileAcceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
   add(obj::kProfileDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
-  add(obj::kRampVelocityLimit, 0, 2);
-  add(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub, static_cast<std::uint32_t>(cfg_.max_velocity));
-  add(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub, static_cast<std::uint32_t>(cfg_.max_velocity));
-  add(obj::kRampJerkControl, 0, 0);
-  add(obj::kSlatConfiguration, 0, 0);
-  add(obj::kSlatSetPoint, 0, 0);
-  add(obj::kSlatTimeDelay, 0, 0);
   add(obj::kQuickStopDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
   add(obj::kHomingMethod, 0, 35);
   add(obj::kHomingSpeeds, 0, 2);
@@ -223,12 +217,13 @@ void Emulator::build_dictionary() {
   add(obj::kDigitalInputs, 0, 0);
   add(obj::kTargetVelocity, 0, 0);
   add(obj::kSupportedDriveModes, 0, cfg_.supported_modes);
+  const std::vector<std::uint32_t> mds_keys = add_mds_objects();
   // A drive without some optional objects (EmulatorConfig::absent_objects,
-  // EmulatorBehaviour::optional_objects_absent).
-  std::erase_if(od_, [this](const Entry& e) {
+  // EmulatorBehaviour::optional_objects_absent: 0x1016 and the MDS objects).
+  std::erase_if(od_, [&](const Entry& e) {
     const auto index = static_cast<std::uint16_t>(e.key >> 8);
     if (cfg_.behaviour.optional_objects_absent &&
-        std::find(kOptionalObjects.begin(), kOptionalObjects.end(), index) != kOptionalObjects.end())
+        (index == 0x1016 || std::find(mds_keys.begin(), mds_keys.end(), e.key) != mds_keys.end()))
       return true;
     return std::find(cfg_.absent_objects.begin(), cfg_.absent_objects.end(), index) != cfg_.absent_objects.end();
   });
@@ -236,10 +231,57 @@ void Emulator::build_dictionary() {
     for (Entry& e : od_)
       if (e.key == key(obj::kInterpolationTimePeriod, 2)) e.access = canopen::Access::kRo;
   }
+  for (const ObjectPreset& p : cfg_.presets) {
+    for (Entry& e : od_) {
+      if (e.key != key(p.index, p.sub)) continue;
+      e.value = e.default_value = p.value & e.mask;
+      if (p.read_only) e.access = canopen::Access::kRo;
+    }
+  }
   if (!cfg_.served.empty()) apply_served();  // a drive described by an EDS
   std::sort(od_.begin(), od_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
   od_.shrink_to_fit();  // od_ never changes size after this: Entry pointers stay valid
   rebuild_pdos();
+}
+
+std::vector<std::uint32_t> Emulator::add_mds_objects() {
+  using cia402::MdsObject;
+  const cia402::MdsObjects& m = cfg_.mds_objects;
+  std::vector<std::uint32_t> keys;
+  // Ramps of CSV (MDS): by default no limit beyond the model's own velocity.
+  const auto vmax = static_cast<std::uint32_t>(cfg_.max_velocity);
+  for (std::size_t i = 0; i < cia402::kMdsObjectCount; ++i) {
+    const auto o = static_cast<MdsObject>(i);
+    const cia402::ObjectAddress a = m[o];
+    const std::uint64_t v = o == MdsObject::kRampVelocityPositive || o == MdsObject::kRampVelocityNegative ? vmax : 0;
+    const std::size_t size = cia402::info(o).size;
+    const canopen::DataType t = size == 1 ? canopen::DataType::kUnsigned8
+                                : size == 2 ? canopen::DataType::kUnsigned16
+                                            : canopen::DataType::kUnsigned32;
+    // One of the emulator's own objects at that address becomes the MDS object.
+    std::erase_if(od_, [&](const Entry& e) { return e.key == key(a.index, a.sub); });
+    add(a.index, a.sub, v);
+    Entry& e = od_.back();
+    set_type(e, t);
+    e.access = canopen::Access::kRw;
+    e.pdo = canopen::PdoMappable::kNo;
+    keys.push_back(e.key);
+  }
+  // A record's sub-index 0 (highest sub-index supported), unless the index has one.
+  for (const cia402::ObjectAddress& a : m.at) {
+    if (a.sub == 0 || std::any_of(od_.begin(), od_.end(), [&](const Entry& e) { return e.key == key(a.index, 0); }))
+      continue;
+    std::uint8_t highest = 0;
+    for (const cia402::ObjectAddress& b : m.at)
+      if (b.index == a.index) highest = std::max(highest, b.sub);
+    add(a.index, 0, highest);
+    Entry& e = od_.back();
+    set_type(e, canopen::DataType::kUnsigned8);
+    e.access = canopen::Access::kRo;
+    e.pdo = canopen::PdoMappable::kNo;
+    keys.push_back(e.key);
+  }
+  return keys;
 }
 
 std::vector<Emulator::ObjectDescription> Emulator::dictionary() const {
@@ -295,12 +337,13 @@ void Emulator::resolve_hot() noexcept {
   h.target_velocity = must_find(obj::kTargetVelocity);
   h.profile_accel = must_find(obj::kProfileAcceleration);
   h.profile_decel = must_find(obj::kProfileDeceleration);
-  h.ramp_vpos = must_find(obj::kRampVelocityLimit, obj::kRampVelocityPositiveSub);
-  h.ramp_vneg = must_find(obj::kRampVelocityLimit, obj::kRampVelocityNegativeSub);
-  h.ramp_jerk = must_find(obj::kRampJerkControl);
-  h.slat_config = must_find(obj::kSlatConfiguration);
-  h.slat_set_point = must_find(obj::kSlatSetPoint);
-  h.slat_delay = must_find(obj::kSlatTimeDelay);
+  auto mds = [&](cia402::MdsObject o) { return must_find(cfg_.mds_objects[o].index, cfg_.mds_objects[o].sub); };
+  h.ramp_vpos = mds(cia402::MdsObject::kRampVelocityPositive);
+  h.ramp_vneg = mds(cia402::MdsObject::kRampVelocityNegative);
+  h.ramp_jerk = mds(cia402::MdsObject::kRampJerkControl);
+  h.slat_config = mds(cia402::MdsObject::kSlatConfiguration);
+  h.slat_set_point = mds(cia402::MdsObject::kSlatSetPoint);
+  h.slat_delay = mds(cia402::MdsObject::kSlatTimeDelay);
 }
 
 std::int64_t Emulator::sval(const Entry* e) noexcept {
@@ -475,11 +518,16 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   }
   if (index == obj::kModesOfOperation && !mode_supported(static_cast<std::int8_t>(v))) return SdoAbort::kInvalidValue;
   if (index == obj::kHomingMethod && !homing_method_supported(static_cast<std::int8_t>(v))) return SdoAbort::kInvalidValue;
-  if (index == 0x1019 && cfg_.behaviour.check_sync_length && (v == 1 || v > 240)) return SdoAbort::kInvalidValue;
+  if (index == obj::kSyncCounterOverflow && cfg_.behaviour.check_sync_length) {
+    // CiA 301, as CANopenNode's CO_ODF_1019: only while 0x1006 is 0, and 0 or 2..240.
+    if (get(obj::kCommunicationCyclePeriod) != 0) return SdoAbort::kDeviceState;
+    if (v == 1 || v > 240) return SdoAbort::kInvalidValue;
+  }
   if (index == 0x1029 && sub == 1 && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 1 && v == 0) return SdoAbort::kInvalidValue;
-  if (index == obj::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;
-  if (index == obj::kSlatConfiguration && v > 2) return SdoAbort::kInvalidValue;
+  const std::optional<cia402::MdsObject> mds = cfg_.mds_objects.find(index, sub);
+  if (mds == cia402::MdsObject::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;
+  if (mds == cia402::MdsObject::kSlatConfiguration && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 2) {
     const auto i = static_cast<std::int8_t>(v);
     if (i < -9) return SdoAbort::kValueTooLow;
@@ -499,7 +547,7 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   if (pdo_obj) rebuild_pdos();
   if (index == 0x1017) next_heartbeat_ns_ = now_ns_ + static_cast<std::int64_t>(v) * 1'000'000;
   if (index == 0x1016) consumers_[static_cast<std::size_t>(std::min<std::uint8_t>(sub, 4) - 1)] = Consumer{};
-  if (index == kFaultInjection && v != 0) inject_fault(static_cast<std::uint16_t>(v));
+  if (index == kFaultInjection && sub == 0 && v != 0 && !mds) inject_fault(static_cast<std::uint16_t>(v));
   if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled && !cfg_.refuse_mode_switch &&
       cfg_.behaviour.mode_switch_syncs == 0)
     mode_display_ = static_cast<std::int8_t>(v);
@@ -536,7 +584,8 @@ void Emulator::power_on(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   settled_cw_ = {};
   active_fault_ = pending_fault_ = 0;
   fault_cause_syncs_left_ = 0;
-  rpdo_short_error_ = rpdo_long_error_ = sync_length_error_ = false;
+  rpdo_short_error_ = rpdo_long_error_ = sync_length_error_ = sync_timeout_error_ = false;
+  last_sync_ns_ = -1;
   rpdo_short_mask_ = rpdo_long_mask_ = 0;
   homing_active_ = homing_done_ = homing_error_ = false;
   homing_phase_ = HomingPhase::kIdle;
@@ -564,6 +613,8 @@ void Emulator::handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::Fra
     case 0x81: power_on(now_ns, out); break;
     case 0x82:
       reset_dictionary(true);
+      last_sync_ns_ = -1;  // 0x1006 back to its default: the SYNC watch starts again
+      sync_timeout_error_ = false;
       sdo_.reset();
       sdo_queue_size_ = 0;
       nmt_ = canopen::NmtState::kPreOperational;
@@ -622,6 +673,8 @@ void Emulator::on_frame(const can::TimedFrame& tf, canopen::FrameSink& out) noex
       if (bad) {
         ++counters_.sync_length_errors;  // not processed
       } else {
+        last_sync_ns_ = now_ns_;
+        comm_error(sync_timeout_error_, false, canopen::emcy_code::kCommunication, out);
         handle_sync(now_ns_, out);
       }
     }
@@ -734,6 +787,16 @@ void Emulator::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
       automatic_transitions(false, out);  // 13 now, not at the next SYNC (the master may be gone)
       apply_error_behaviour();
     }
+  }
+  // The SYNC watch (0x1006, EmulatorBehaviour::sync_timeout): 1.5 periods
+  // without a SYNC, once one came (CANopenNode's CO_SYNC_process).
+  const auto period_us = static_cast<std::int64_t>(get(cia402::obj::kCommunicationCyclePeriod));
+  if (cfg_.behaviour.sync_timeout && period_us > 0 && last_sync_ns_ >= 0 && !sync_timeout_error_ &&
+      (nmt_ == canopen::NmtState::kOperational || nmt_ == canopen::NmtState::kPreOperational) &&
+      now_ns - last_sync_ns_ > period_us * 1'500) {
+    ++counters_.sync_timeouts;
+    comm_error(sync_timeout_error_, true, canopen::emcy_code::kCommunication, out);
+    apply_error_behaviour();
   }
   automatic_transitions(false, out);
   sdo_.step(now_ns, out);
@@ -1072,7 +1135,7 @@ bool Emulator::fault_cause_remains() const noexcept {
 
 void Emulator::refresh_error_register() noexcept {
   std::uint8_t r = active_fault_ != 0 ? error_register_for(active_fault_) : 0;
-  bool comm = rpdo_short_error_ || rpdo_long_error_ || sync_length_error_;
+  bool comm = rpdo_short_error_ || rpdo_long_error_ || sync_length_error_ || sync_timeout_error_;
   for (const Consumer& k : consumers_) comm = comm || k.lost;
   if (comm) r |= canopen::kErrGeneric | canopen::kErrCommunication;
   put(hot_.error_register, r);

@@ -70,8 +70,8 @@ struct ServedObject {
 /// with the error register and 0000h when they clear) are the same in both.
 struct EmulatorBehaviour {
   /// The optional objects a drive may lack are absent: 0x1016 (consumer
-  /// heartbeat) and the project's vendor-area MDS objects 0x2010..0x2022
-  /// (SDO abort 0x06020000).
+  /// heartbeat) and the vendor-area MDS objects (EmulatorConfig::mds_objects,
+  /// by default the project's 0x2010..0x2022; SDO abort 0x06020000).
   bool optional_objects_absent = true;
   /// 0x60C2:2 (interpolation time index) is read-only (abort 0x06010002):
   /// the drive only takes periods in milliseconds (index -3).
@@ -89,10 +89,18 @@ struct EmulatorBehaviour {
   bool rpdo_too_long_emcy = true;
   /// The SYNC's length is checked against 0x1019 (0 bytes when 0x1019 = 0,
   /// 1 byte otherwise): a SYNC of the wrong length is not processed and sends
-  /// EMCY 8240h once. 0x1019 writes take only 0 and 2..240 (0x06090030).
+  /// EMCY 8240h once. 0x1019 writes take only 0 and 2..240 (0x06090030), and
+  /// only while 0x1006 is 0 (0x08000022), as CiA 301 and CANopenNode's
+  /// CO_ODF_1019 say.
   bool check_sync_length = true;
+  /// With 0x1006 (communication cycle period) not 0 the drive watches the
+  /// SYNC, as CANopenNode's CO_SYNC_process: once a SYNC came, none for
+  /// 1.5 x 0x1006 (in Pre-operational or Operational) sends EMCY 8100h once
+  /// (error register bit 4) and takes 0x1029:1's reaction (error_behaviour:
+  /// 0 leaves Operational); the next SYNC clears it (EMCY 0000h).
+  bool sync_timeout = true;
   /// 0x1029:1 (error behaviour, communication error) exists and acts on a
-  /// communication error (lost master heartbeat): 0 = Pre-operational
+  /// communication error (lost master heartbeat, SYNC watch): 0 = Pre-operational
   /// (default), 1 = no change, 2 = Stopped.
   bool error_behaviour = true;
   /// After power-on the drive stays in Not ready to switch on (statusword
@@ -124,11 +132,15 @@ struct EmulatorBehaviour {
   [[nodiscard]] static EmulatorBehaviour permissive() noexcept;
 };
 
-/// The objects a drive may lack (EmulatorBehaviour::optional_objects_absent).
-inline constexpr std::array<std::uint16_t, 6> kOptionalObjects = {0x1016, cia402::obj::kRampVelocityLimit,
-                                                                  cia402::obj::kRampJerkControl,
-                                                                  cia402::obj::kSlatConfiguration,
-                                                                  cia402::obj::kSlatSetPoint, cia402::obj::kSlatTimeDelay};
+
+/// A power-on value other than the emulator's own, and optionally read-only
+/// (EmulatorConfig::presets), e.g. a drive whose 0x1006 comes preset.
+struct ObjectPreset {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  std::uint64_t value = 0;  ///< raw bits, in the object's size
+  bool read_only = false;   ///< SDO writes abort 0x06010002
+};
 
 struct EmulatorConfig {
   std::uint8_t node = 2;
@@ -171,6 +183,20 @@ struct EmulatorConfig {
   /// 0x06020000 (object does not exist), as on a real drive without them.
   /// A PDO whose communication object is absent is never valid.
   std::vector<std::uint16_t> absent_objects;
+  /// Where this drive keeps the MDS objects CiA 402 lacks (ramp velocity
+  /// limits, ramp jerk, SLAT): the project's 0x2010..0x2022 by default, or
+  /// other indices (cia402-emu --mds-objects), as a real drive may. Nothing is
+  /// then at the default indices. An address that is also one of the
+  /// emulator's own objects (e.g. 0x2000 fault injection) becomes the MDS
+  /// object; a record's sub-index 0 (highest sub-index) is added when an
+  /// object sits at sub-index 1 or above.
+  cia402::MdsObjects mds_objects{};
+  /// Power-on values (and read-only objects) other than the emulator's own,
+  /// e.g. {0x1006, 0, 1000}: a drive that watches the SYNC from power-on and
+  /// so refuses 0x1019 writes until 0x1006 is 0; {0x1019, 0, 5, true}: a
+  /// drive whose SYNC counter overflow is fixed at 5. Objects it lacks are
+  /// ignored. Applied after EmulatorBehaviour's and before `served`.
+  std::vector<ObjectPreset> presets;
   /// Not empty (cia402-emu --eds): the drive serves exactly these
   /// sub-objects over SDO and PDO mapping, with their access, PDO mapping
   /// flags and defaults. Its own objects not listed abort 0x06020000 /
@@ -200,6 +226,7 @@ struct EmulatorCounters {
   std::uint64_t boot_ups = 0;
   std::uint64_t rpdo_length_errors = 0;
   std::uint64_t sync_length_errors = 0;     ///< SYNCs dropped for their length (0x1019)
+  std::uint64_t sync_timeouts = 0;          ///< SYNC watch (0x1006) timeouts, EMCY 8100h
   std::uint64_t refused_fault_resets = 0;   ///< fault resets refused while the cause remained
   std::uint64_t sdo_replies_dropped = 0;    ///< delayed SDO replies lost to a full queue
 };
@@ -352,12 +379,13 @@ class Emulator final : public canopen::SdoServerBackend {
     // MDS ramps and SLAT (direct_model.cpp)
     Entry* profile_accel;       // 0x6083 RampAcceleration
     Entry* profile_decel;       // 0x6084 RampDeceleration
-    Entry* ramp_vpos;           // 0x2010:1
-    Entry* ramp_vneg;           // 0x2010:2
-    Entry* ramp_jerk;           // 0x2011
-    Entry* slat_config;         // 0x2020
-    Entry* slat_set_point;      // 0x2021
-    Entry* slat_delay;          // 0x2022
+    // EmulatorConfig::mds_objects (by default 0x2010:1/2, 0x2011, 0x2020..0x2022)
+    Entry* ramp_vpos;           // ramp velocity - positive
+    Entry* ramp_vneg;           // ramp velocity - negative
+    Entry* ramp_jerk;           // ramp jerk - control
+    Entry* slat_config;         // SLAT configuration
+    Entry* slat_set_point;      // SLAT set point
+    Entry* slat_delay;          // SLAT time delay
   };
   /// Per mapped PDO entry: the dictionary entry (nullptr if absent); where
   /// it sits in the payload is in the PDO's packing plan.
@@ -370,6 +398,9 @@ class Emulator final : public canopen::SdoServerBackend {
     return (static_cast<std::uint32_t>(index) << 8) | sub;
   }
   void build_dictionary();
+  /// The MDS objects at EmulatorConfig::mds_objects (and their records'
+  /// sub-index 0); returns their keys (optional_objects_absent removes them).
+  std::vector<std::uint32_t> add_mds_objects();
   void add(std::uint16_t index, std::uint8_t sub, std::uint64_t value, const std::string* text = nullptr);
   Entry* find(std::uint16_t index, std::uint8_t sub) noexcept;
   void resolve_hot() noexcept;  // after build_dictionary(): fills hot_
@@ -514,6 +545,8 @@ class Emulator final : public canopen::SdoServerBackend {
   bool rpdo_short_error_ = false;           // EMCY 8210h sent, not yet cleared
   bool rpdo_long_error_ = false;            // EMCY 8220h sent, not yet cleared
   bool sync_length_error_ = false;          // EMCY 8240h sent, not yet cleared
+  bool sync_timeout_error_ = false;         // EMCY 8100h sent (no SYNC for 1.5 x 0x1006), not yet cleared
+  std::int64_t last_sync_ns_ = -1;          // the last SYNC processed (-1: none since power-on / reset)
   std::uint8_t rpdo_short_mask_ = 0;        // bit p: RPDO p + 1's last frame was short
   std::uint8_t rpdo_long_mask_ = 0;         // bit p: RPDO p + 1's last frame was long
   // TPDO event state (types 0, 254, 255).

@@ -166,7 +166,10 @@ void Decoder::apply_write(std::uint8_t node, std::uint16_t index, std::uint8_t s
                           std::uint8_t len) noexcept {
   (void)len;
   if (index == 0x1006 && sub == 0) {
-    sync_period_ns_ = static_cast<std::int64_t>(value) * 1000;
+    // 0 is no period (SYNC watch off): canmotiond writes it to every drive
+    // before 0x1019, and with drive.sync_watch the period after it; the next
+    // node's 0 must not drop the period the previous node got.
+    if (value != 0) sync_period_ns_ = static_cast<std::int64_t>(value) * 1000;
     return;
   }
   const bool comm_r = index >= 0x1400 && index < 0x1400 + kPdosPerDirection;

@@ -183,7 +183,8 @@ class Decoder {
   /// which CiA 402 drives commonly default to synchronous 1 for TPDO1).
   [[nodiscard]] std::uint8_t tpdo_transmission_type(std::uint8_t node, std::uint8_t number) const noexcept;
 
-  /// SYNC period in ns written to 0x1006 (communication cycle period), 0 if none seen.
+  /// SYNC period in ns last written to 0x1006 (communication cycle period)
+  /// other than 0 (0 turns the SYNC watch off), 0 if none seen.
   [[nodiscard]] std::int64_t sync_period_from_trace_ns() const noexcept { return sync_period_ns_; }
 
  private:

@@ -201,6 +201,18 @@ TEST(TraceDecoder, NetworkManagementFrames) {
   EXPECT_EQ(dec.decode(ext).kind, tr::EventKind::kUnknown);
 }
 
+// canmotiond writes 0x1006 = 0 (before 0x1019) and, with drive.sync_watch,
+// the period to each node in turn: a later node's 0 keeps the period.
+TEST(TraceDecoder, CommunicationCyclePeriodZeroIsNoPeriod) {
+  tr::Decoder dec;
+  sdo_write(dec, 2, 0x1006, 0, 0);
+  EXPECT_EQ(dec.sync_period_from_trace_ns(), 0);
+  sdo_write(dec, 2, 0x1006, 0, 4000);
+  EXPECT_EQ(dec.sync_period_from_trace_ns(), 4'000'000);
+  sdo_write(dec, 3, 0x1006, 0, 0);
+  EXPECT_EQ(dec.sync_period_from_trace_ns(), 4'000'000);
+}
+
 TEST(TraceDecoder, FrameBitsWorstCase) {
   EXPECT_EQ(tr::frame_bits_worst_case(can::Frame(0x181, {1, 2, 3, 4, 5, 6, 7, 8})), 135U);
   EXPECT_EQ(tr::frame_bits_worst_case(can::Frame(0x080, {})), 55U);

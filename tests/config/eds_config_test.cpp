@@ -119,15 +119,17 @@ TEST(EdsConfig, BootWritesLeaveOutOptionalObjectsTheEdsLacks) {
   for (const cia402::BootWrite& b : w)
     EXPECT_EQ(c.axes[0].drive.dictionary->has(b.w.index, b.w.sub), canopen::Presence::kPresent)
         << std::hex << b.w.index << ":" << int(b.w.sub);
-  // Without an EDS the same axis writes the unused PDOs 3 and 4 and 0x1016, all optional.
+  // Without an EDS the same axis writes the unused PDOs 3 and 4, 0x1016,
+  // 0x1006 = 0 and 0x1019, all optional.
   Config n;
   ASSERT_NO_THROW(n = load_string(yaml("      heartbeat_ms: 50\n"), kFile));
   const std::vector<cia402::BootWrite> all = boot_writes(n.axes[0], n.buses[0], n.controller.period_s, 0);
   const auto optional = std::count_if(all.begin(), all.end(), [](const cia402::BootWrite& b) { return b.optional && !b.is_read(); });
-  // RPDO 2..4 and TPDO 2..4 (csp uses one each way) and 0x1016:1; the
-  // minimal drive has RPDO2 and TPDO2, so 3, 4 and 0x1016 are left out.
-  EXPECT_EQ(optional, 7);
-  EXPECT_EQ(all.size(), w.size() + 5);
+  // RPDO 2..4 and TPDO 2..4 (csp uses one each way), 0x1016:1, 0x1006 and
+  // 0x1019; the minimal drive has RPDO2 and TPDO2, so 3, 4, 0x1016, 0x1006,
+  // 0x1019 and the read of 0x1019 made only if the drive refuses it are left out.
+  EXPECT_EQ(optional, 9);
+  EXPECT_EQ(all.size(), w.size() + 8);
   // The boot's optional reads (0x6502, 0x6061) stay: the minimal drive has
   // both; so does the read of 0x60C2:2 made only if the drive refuses it.
   const auto optional_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.optional && b.is_read() && !b.ip_fallback; });

@@ -68,7 +68,7 @@ axes:
 struct Loop : test::RuntimeRig {
   std::vector<std::string> trace;
 
-  Loop() : RuntimeRig(load_string(kYaml, "mds.yaml")) {
+  explicit Loop(const char* yaml = kYaml) : RuntimeRig(load_string(yaml, "mds.yaml")) {
     rt.controller->set_trace(true);
     rt.sim->power_on(0);
   }
@@ -319,6 +319,144 @@ TEST(MdsLoop, RefusedModeSwitchIsADriveFaultThatCancelsMds) {
   for (int i = 0; i < 300; ++i) l.cycle();
   EXPECT_EQ(l.emu(0, 2).mode_display(), 9);
   EXPECT_EQ(l.emu(0, 2).velocity(), 10'000.0);
+}
+
+// The MDS objects at the drive's own indices (drive.mds_objects, issue 15
+// item 6): the simulated drives serve them there only (cia402-emu
+// --mds-objects), the master writes exactly those indices and never the
+// project's 0x2010..0x2022, and the ramp limit and SLAT act from there.
+const char* kRelocatedYaml = R"(controller: {period_ms: 1}
+buses:
+  - {name: can0, interface: sim}
+  - {name: can1, interface: sim}
+drives:
+  pdo: csp_csv_cst
+  mds_objects:
+    ramp_velocity_positive: 0x3000:1
+    ramp_velocity_negative: 0x3000:2
+    ramp_jerk_control: 0x3001
+    slat_configuration: 0x4010
+    slat_set_point: 0x4011
+    slat_time_delay: 0x4012
+axes:
+  - name: V
+    type: AXIS_CIP_DRIVE
+    bus: can0
+    node: 2
+    conversion_constant: 1000
+    max_speed: 100
+    direct_control:
+      mode: velocity
+      ramp: {acceleration: 50, deceleration: 100, velocity_positive: 60, velocity_negative: 40, jerk_control: 0}
+  - name: T
+    type: AXIS_CIP_DRIVE
+    bus: can1
+    node: 3
+    conversion_constant: 1000
+    max_speed: 100
+    direct_control:
+      mode: torque
+      max_torque: 1000
+      velocity_command: 8
+      slat: {configuration: 1, set_point: 2, time_delay_ms: 5}
+)";
+
+TEST(MdsLoop, ObjectsAtTheDrivesOwnIndicesRampsAndSlat) {
+  Loop l(kRelocatedYaml);
+  auto& ev = l.emu(0, 2);
+  auto& et = l.emu(1, 3);
+  et.set_load_model(1e6, 0, 0.01);
+  for (int i = 0; i < 50; ++i) l.cycle();
+
+  // Velocity: beyond the relocated RampVelocity - Positive (0x3000:1) the
+  // drive stops at 60 000 counts/s, ramping at 0x6083.
+  l.exec("MDS(V, mv, 80, UnitsPerSec)");
+  ASSERT_TRUE(l.until("mv.DN", 3000)) << "ERR " << l.read("mv.ERR");
+  // Configured: the drives have them where the file says.
+  EXPECT_EQ(ev.read_int(0x3000, 1), 60'000);
+  EXPECT_EQ(ev.read_int(0x3000, 2), 40'000);
+  EXPECT_EQ(et.read_int(0x4010), 1);
+  EXPECT_EQ(et.read_int(0x4011), 2'000);
+  EXPECT_EQ(et.read_int(0x4012), 5);
+  for (int i = 0; i < 1500; ++i) {
+    const double v0 = ev.velocity();
+    l.cycle();
+    ASSERT_LE(ev.velocity() - v0, 50.0 + 1e-9) << "cycle " << i;
+  }
+  EXPECT_EQ(ev.velocity(), 60'000.0);
+
+  // Torque with SLAT 1 from 0x4010..0x4012: speed control after 5 ms beyond 2 000 counts/s.
+  SlatChecker s1{et, 1, 2'000, 5};
+  l.exec("MDS(T, mt, 8, UnitsPerSec)");
+  for (int i = 0; i < 3000 && l.read("mt.DN") == 0.0; ++i) s1.step(l);
+  ASSERT_EQ(l.read("mt.DN"), 1.0) << "ERR " << l.read("mt.ERR");
+  for (int i = 0; i < 500; ++i) s1.step(l);
+  EXPECT_EQ(s1.to_speed, 1);
+  EXPECT_NEAR(et.velocity(), 8'000, 1);
+
+  // Golden bytes: every SDO download of the master into the manufacturer
+  // area (0x2000..0x5FFF), in order, per bus; none to 0x2010..0x2022.
+  std::vector<std::string> vendor;
+  for (const std::string& line : l.trace) {
+    const auto hash = line.find('#');
+    if (hash == std::string::npos || hash < 3 || line.compare(hash - 3, 2, "60") != 0) continue;  // 602#, 603#
+    const std::string d = line.substr(hash + 1);
+    if (d.size() < 8 || d[0] != '2') continue;  // a download request
+    const unsigned long index = std::stoul(d.substr(4, 2) + d.substr(2, 2), nullptr, 16);
+    if (index >= 0x2010 && index <= 0x2022) ADD_FAILURE() << "written at the project's index: " << line;
+    if (index >= 0x2000 && index <= 0x5FFF) vendor.push_back(line.substr(line.rfind(' ', hash) + 1));
+  }
+  const std::vector<std::string> golden = {
+      "602#2300300160EA0000",  // 0x3000:1 = 60 000 (RampVelocity - Positive)
+      "602#23003002409C0000",  // 0x3000:2 = 40 000 (RampVelocity - Negative)
+      "602#2F01300000000000",  // 0x3001 = 0 (RampJerk - Control)
+      "602#2F10400000000000",  // 0x4010 = 0 (SLAT disabled on V)
+      "602#2311400000000000",  // 0x4011 = 0
+      "602#2B12400000000000",  // 0x4012 = 0
+      "603#2F10400001000000",  // 0x4010 = 1 (SLAT Min Speed/Torque)
+      "603#23114000D0070000",  // 0x4011 = 2 000 counts/s
+      "603#2B12400005000000",  // 0x4012 = 5 ms
+  };
+  std::vector<std::string> sorted = vendor;
+  std::stable_sort(sorted.begin(), sorted.end(), [](const std::string& a, const std::string& b) {
+    return a.compare(0, 3, b, 0, 3) < 0;  // by node, keeping each node's order
+  });
+  EXPECT_EQ(sorted, golden);
+  for (int n : {2, 3}) {
+    const auto* d = l.ctl().network(static_cast<std::size_t>(n - 2)).drive(static_cast<std::uint8_t>(n));
+    ASSERT_NE(d, nullptr);
+    EXPECT_FALSE(d->failed()) << d->failure().to_string();
+  }
+}
+
+// The same configuration's master against drives that keep the objects at the
+// project's indices: the boot fails at the first ramp object, naming both keys.
+TEST(MdsLoop, RelocatedObjectsOnADriveWithoutThemFailTheBootNamingTheKeys) {
+  Config c = load_string(kRelocatedYaml, "mds.yaml");
+  Runtime rt = build_runtime(c, true);
+  // Node 2's simulated drive (drive 0 on can0) replaced by one that keeps the
+  // objects at the project's indices.
+  emulator::EmulatorConfig e = emulator_config(c.axes[0]);
+  e.mds_objects = cia402::MdsObjects{};
+  ASSERT_EQ(rt.sim->find_drive(0, 2), &rt.sim->drive(0));
+  rt.sim->disconnect(0);
+  rt.sim->add_drive(0, e);
+  rt.sim->power_on(0);
+  rt::ControllerHost host(*rt.controller);
+  std::int64_t now = 0;
+  const auto* d = rt.controller->network(0).drive(2);
+  for (int i = 0; i < 3000 && !d->failed(); ++i) {
+    rt.sim->begin_cycle(now);
+    rt.controller->cycle(now);
+    rt.sim->end_cycle(now);
+    now += 1'000'000;
+  }
+  ASSERT_TRUE(d->failed());
+  const std::string why = d->failure().to_string();
+  for (const char* part : {"node 2", "write to 0x3000:1", "0x06020000",
+                           "axes[0].direct_control.ramp.velocity_positive (written to 0x3000:1, placed by "
+                           "drives.mds_objects.ramp_velocity_positive)"})
+    EXPECT_NE(why.find(part), std::string::npos) << part << " in: " << why;
 }
 
 }  // namespace

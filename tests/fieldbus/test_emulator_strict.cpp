@@ -548,3 +548,70 @@ TEST(EmulatorStrict, HomingTakesTimePerMethodFamily) {
     EXPECT_EQ(p.emu.position(), 77);
   }
 }
+
+// CiA 301 0x1019 (as CANopenNode's CO_ODF_1019): written only while 0x1006
+// is 0 (0x08000022 otherwise), and only 0 or 2..240 (issue 15 item 5).
+TEST(EmulatorStrict, SyncCounterOverflowWrittenOnlyWhile1006IsZero) {
+  Drive s(Drive::strict());
+  ASSERT_EQ(s.write(0x1006, 0, 1000, 4), 0u);
+  EXPECT_EQ(s.write(0x1019, 0, 5, 1), kDeviceState);
+  EXPECT_EQ(s.emu.read_int(0x1019), 0);
+  ASSERT_EQ(s.write(0x1006, 0, 0, 4), 0u);
+  EXPECT_EQ(s.write(0x1019, 0, 5, 1), 0u);
+  EXPECT_EQ(s.emu.read_int(0x1019), 5);
+  ASSERT_EQ(s.write(0x1006, 0, 1000, 4), 0u);  // 0x1006 itself may change at any time
+  EXPECT_EQ(s.write(0x1019, 0, 0, 1), kDeviceState);
+  // A drive whose 0x1006 is set from power-on (EmulatorConfig::presets).
+  EmulatorConfig c = Drive::strict();
+  c.presets = {emulator::ObjectPreset{0x1006, 0, 2000}};
+  Drive preset(c);
+  EXPECT_EQ(preset.emu.read_int(0x1006), 2000);
+  EXPECT_EQ(preset.write(0x1019, 0, 5, 1), kDeviceState);
+  // A read-only preset.
+  c.presets = {emulator::ObjectPreset{0x1019, 0, 5, true}};
+  Drive fixed(c);
+  EXPECT_EQ(fixed.emu.read_int(0x1019), 5);
+  EXPECT_EQ(fixed.write(0x1019, 0, 5, 1), kReadOnly);
+  Drive p(Drive::permissive());
+  ASSERT_EQ(p.write(0x1006, 0, 1000, 4), 0u);
+  EXPECT_EQ(p.write(0x1019, 0, 5, 1), 0u);
+}
+
+// The MDS objects at other indices (EmulatorConfig::mds_objects, issue 15
+// item 6): served there with their types and checks, nothing at 0x2010..0x2022.
+TEST(EmulatorStrict, MdsObjectsServedWhereConfigured) {
+  EmulatorConfig c = Drive::strict();
+  c.behaviour.optional_objects_absent = false;
+  using cia402::MdsObject;
+  c.mds_objects[MdsObject::kRampVelocityPositive] = {0x3000, 1};
+  c.mds_objects[MdsObject::kRampVelocityNegative] = {0x3000, 2};
+  c.mds_objects[MdsObject::kRampJerkControl] = {0x3001, 0};
+  c.mds_objects[MdsObject::kSlatConfiguration] = {0x2000, 0};  // the emulator's fault injection object becomes it
+  c.mds_objects[MdsObject::kSlatSetPoint] = {0x3011, 0};
+  c.mds_objects[MdsObject::kSlatTimeDelay] = {0x3012, 0};
+  Drive s(c);
+  std::uint32_t v = 0;
+  for (const int i : {0x2010, 0x2011, 0x2020, 0x2021, 0x2022})
+    EXPECT_EQ(s.read(static_cast<std::uint16_t>(i), 0, v), kNoObject) << std::hex << i;
+  ASSERT_EQ(s.read(0x3000, 0, v), 0u);
+  EXPECT_EQ(v, 2u) << "the record's highest sub-index";
+  EXPECT_EQ(s.write(0x3000, 0, 3, 1), kReadOnly);
+  EXPECT_EQ(s.write(0x3000, 1, 60'000, 4), 0u);
+  EXPECT_EQ(s.write(0x3000, 2, 60'000, 2), 0x06070013u) << "UNSIGNED32: 2 bytes are too few";
+  EXPECT_EQ(s.write(0x3001, 0, 101, 1), 0x06090031u) << "jerk control 0..100";
+  EXPECT_EQ(s.write(0x3001, 0, 50, 1), 0u);
+  EXPECT_EQ(s.write(0x2000, 0, 3, 1), kInvalidValue) << "SLAT configuration 0..2";
+  EXPECT_EQ(s.write(0x2000, 0, 2, 1), 0u);
+  EXPECT_EQ(s.write(0x3012, 0, 7, 2), 0u);
+  EXPECT_EQ(s.emu.read_int(0x3000, 1), 60'000);
+  EXPECT_EQ(s.emu.read_int(0x2000), 2);
+  for (int i = 0; i < 3; ++i) s.sync();
+  EXPECT_NE(s.emu.state(), State::kFault) << "no fault injected by the SLAT write";
+  EXPECT_NE(s.emu.state(), State::kFaultReactionActive);
+  EXPECT_EQ(s.emu.counters().emcys, 0u);
+  // Strict (optional objects absent): none of them, nowhere.
+  c.behaviour.optional_objects_absent = true;
+  Drive a(c);
+  for (const int i : {0x3000, 0x3001, 0x3011, 0x3012, 0x2010})
+    EXPECT_EQ(a.read(static_cast<std::uint16_t>(i), 0, v), kNoObject) << std::hex << i;
+}

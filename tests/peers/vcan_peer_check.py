@@ -115,16 +115,20 @@ class Check:
         xs = self.sdo_transfers()
         # Disabling a PDO the drive does not have (it has 2 + 2): 0602 0000h is
         # the drive's right answer, and canmotiond must go on (issue 12 item 2).
-        tolerated = [x for x in xs if x[4] == 0x06020000 and x[2] == 1 and x[3] >> 31
-                     and (0x1400 <= x[1] <= 0x15FF or 0x1800 <= x[1] <= 0x19FF)]
+        # So is 0602 0000h to 0x1006 = 0 and 0x1019 (the SYNC consumer's cycle
+        # period and counter overflow, optional in CiA 301; the peer has
+        # neither and ignores a SYNC counter byte: issue 15 item 5).
+        tolerated = [x for x in xs if x[4] == 0x06020000 and
+                     ((x[2] == 1 and x[3] >> 31 and (0x1400 <= x[1] <= 0x15FF or 0x1800 <= x[1] <= 0x19FF))
+                      or (x[1] == 0x1006 and x[2] == 0 and x[3] == 0) or (x[1] == 0x1019 and x[2] == 0))]
         aborts = [x for x in xs if x[4] and x not in tolerated]
         peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
         t_gone = max(t for t, i, _ in self.t.frames if i in peer_ids)
         unanswered = [x for x in xs if x[4] is None and x[0] < t_gone]   # not those after the peer is gone
         self.item(not aborts, 'SDO configuration without aborts',
                   f'{len(xs)} writes, {len(aborts)} aborted' +
-                  (f' ({len(tolerated)} more: disabling PDOs the drive does not have, ' +
-                   ', '.join(f'0x{x[1]:04X}' for x in tolerated) + ': 0602 0000h)' if tolerated else '') + ''.join(
+                  (f' ({len(tolerated)} more: disabling PDOs the drive does not have, or its absent SYNC '
+                   'objects, ' + ', '.join(f'0x{x[1]:04X}' for x in tolerated) + ': 0602 0000h)' if tolerated else '') + ''.join(
                       f'; 0x{i:04X}:{s:02X} := 0x{v:X}: abort 0x{c:08X} {ABORT_TEXT.get(c, "")}'
                       for _, i, s, v, c in aborts[:6]), around=aborts[0][0] if aborts else None)
         self.item(not unanswered, 'every SDO request answered', f'{len(unanswered)} without a response')

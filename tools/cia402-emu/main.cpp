@@ -49,6 +49,9 @@ constexpr const char* kFooter = R"(Examples:
       inject a following-error fault (EMCY 0x8611) through object 0x2000
   cia402-emu -i vcan0 -n 2 --viscous-friction 0.01 --rated-torque-acceleration 1000000
       CST with a load: torque accelerates against friction (SLAT 0x2020..0x2022)
+  cia402-emu -i vcan0 -n 2 --mds-objects ramp_velocity_positive=0x3000:1,slat_set_point=0x3011
+      MDS objects at the drive's own indices (the others at their defaults, 0x2010:2,
+      0x2011, 0x2020, 0x2022; nothing at 0x2010:1 or 0x2021): as canmotiond's drive.mds_objects
   cia402-emu -i vcan0 -n 2 --refuse-mode-switch
       0x6061 never follows 0x6060: the master's mode-switch timeout fires
   cia402-emu -i vcan0 -n 2 --without-object 0x1016 --without-object 0x1403 --without-object 0x1603
@@ -62,12 +65,14 @@ constexpr const char* kFooter = R"(Examples:
       strict, 2 s of DC bus charging, SDO replies 5 ms late, local control
 
 Profiles (--profile; a flag changes one behaviour of the profile):
-  strict      (default) what a real drive does: 0x1016 and 0x2010..0x2022 absent
+  strict      (default) what a real drive does: 0x1016 and the MDS objects absent
               (--optional-objects-absent), 0x60C2:2 read-only (--ip-index-ro), PDO
               changes only in Pre-operational (--remap-preop-only), CiA 402
               predefined PDO1 = controlword/statusword, type 255
               (--cia402-pdos), over-long RPDO EMCY 8220h (--long-rpdo-emcy),
-              SYNC length checked against 0x1019, EMCY 8240h (--sync-length),
+              SYNC length checked against 0x1019, EMCY 8240h, 0x1019 written
+              only while 0x1006 is 0 (--sync-length), SYNC watched at 1.5 x
+              0x1006 when it is not 0, EMCY 8100h (--sync-timeout),
               0x1029 error behaviour (--error-behaviour), 100 ms in Not ready
               to switch on (--boot-ms), SDO replies a call later
               (--sdo-delay-ms), one transition per SYNC (--one-transition),
@@ -85,6 +90,37 @@ type (0x18xx:2) and moves only on SYNC (0x080), by the period in 0x60C2. Object 
 mapping and fault injection: see fieldbus/README.md.
 
 Exit status: 0 after SIGINT/SIGTERM or --duration, 1 on error.)";
+
+/// --mds-objects KEY=INDEX[:SUB][,KEY=INDEX[:SUB]...] (keys of
+/// cia402::kMdsObjectInfo) applied to `m`; an error message, or empty.
+std::string parse_mds_objects(const std::string& arg, cia402::MdsObjects& m) {
+  std::size_t from = 0;
+  while (from <= arg.size()) {
+    const std::size_t comma = std::min(arg.find(',', from), arg.size());
+    const std::string item = arg.substr(from, comma - from);
+    from = comma + 1;
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos) return "'" + item + "' is not KEY=INDEX:SUB (e.g. slat_set_point=0x3011:0)";
+    const std::string k = item.substr(0, eq);
+    std::size_t i = 0;
+    while (i < cia402::kMdsObjectCount && cia402::kMdsObjectInfo[i].key != k) ++i;
+    if (i == cia402::kMdsObjectCount) {
+      std::string keys;
+      for (const auto& info : cia402::kMdsObjectInfo) keys += (keys.empty() ? "" : ", ") + std::string(info.key);
+      return "unknown MDS object '" + k + "' (one of: " + keys + ")";
+    }
+    const auto a = cia402::parse_object_address(item.substr(eq + 1));
+    if (!a || a->index < 0x2000 || a->index > 0x9FFF)
+      return "'" + item.substr(eq + 1) + "' is not an object INDEX:SUB in 0x2000..0x9FFF (sub-index 0..254)";
+    m.at[i] = *a;
+  }
+  for (std::size_t i = 0; i < cia402::kMdsObjectCount; ++i)
+    for (std::size_t j = i + 1; j < cia402::kMdsObjectCount; ++j)
+      if (m.at[i] == m.at[j])
+        return std::string(cia402::kMdsObjectInfo[i].key) + " and " + std::string(cia402::kMdsObjectInfo[j].key) +
+               " are both at the same object";
+  return {};
+}
 
 /// A whole string as an unsigned number (decimal, 0x hex or 0 octal); nullopt
 /// if it is not one.
@@ -125,7 +161,7 @@ int main(int argc, char** argv) {
   bool refuse_mode = false;
   std::vector<std::string> absent;
   std::string profile = "strict";
-  std::optional<bool> f_optional, f_ip_ro, f_remap, f_pdos, f_long, f_sync, f_errb, f_one, f_modes, f_homing;
+  std::optional<bool> f_optional, f_ip_ro, f_remap, f_pdos, f_long, f_sync, f_sync_to, f_errb, f_one, f_modes, f_homing;
   std::optional<double> boot_ms, sdo_delay_ms;
   std::optional<std::uint32_t> fault_cause_syncs, mode_switch_syncs;
   bool no_remote = false;
@@ -154,6 +190,12 @@ int main(int argc, char** argv) {
   app.add_option("--without-object", absent,
                  "emulate a drive without this object (index, e.g. 0x1016); SDO access aborts with 0x06020000; repeat "
                  "for several");
+  std::vector<std::string> mds_args;
+  app.add_option("--mds-objects", mds_args,
+                 "where this drive keeps the MDS objects CiA 402 lacks, KEY=INDEX:SUB,... with KEY one of "
+                 "ramp_velocity_positive, ramp_velocity_negative, ramp_jerk_control, slat_configuration, "
+                 "slat_set_point, slat_time_delay (default: 0x2010:1, 0x2010:2, 0x2011, 0x2020, 0x2021, 0x2022); "
+                 "repeat or separate with commas");
   std::string eds_file;
   app.add_option("--eds", eds_file,
                  "serve exactly the objects of this EDS or DCF (CiA 306): absent objects abort 0x06020000, PDO "
@@ -166,13 +208,17 @@ int main(int argc, char** argv) {
   auto flag_opt = [&app](const char* name, std::optional<bool>& v, const char* what) {
     app.add_option(name, v, std::string(what) + " (true/false; default: the profile's)");
   };
-  flag_opt("--optional-objects-absent", f_optional, "0x1016 and 0x2010..0x2022 absent (abort 0x06020000)");
+  flag_opt("--optional-objects-absent", f_optional,
+           "0x1016 and the MDS objects (0x2010..0x2022 or --mds-objects) absent (abort 0x06020000)");
   flag_opt("--ip-index-ro", f_ip_ro, "0x60C2:2 read-only (abort 0x06010002)");
   flag_opt("--remap-preop-only", f_remap, "PDO parameters change only in Pre-operational (abort 0x08000022)");
   flag_opt("--cia402-pdos", f_pdos, "CiA 402 predefined PDO1 (controlword / statusword, type 255) at power-on");
   flag_opt("--long-rpdo-emcy", f_long, "an over-long RPDO sends EMCY 8220h");
-  flag_opt("--sync-length", f_sync, "SYNC length checked against 0x1019 (EMCY 8240h)");
-  flag_opt("--error-behaviour", f_errb, "0x1029 exists and acts on a lost master heartbeat");
+  flag_opt("--sync-length", f_sync,
+           "SYNC length checked against 0x1019 (EMCY 8240h); 0x1019 takes 0, 2..240, only while 0x1006 is 0 (0x08000022)");
+  flag_opt("--sync-timeout", f_sync_to,
+           "with 0x1006 not 0, no SYNC for 1.5 x 0x1006 sends EMCY 8100h and takes 0x1029's reaction");
+  flag_opt("--error-behaviour", f_errb, "0x1029 exists and acts on a lost master heartbeat or SYNC");
   flag_opt("--one-transition", f_one, "one commanded transition per SYNC (3 and 4 in two SYNCs)");
   flag_opt("--refuse-unsupported-modes", f_modes, "an RPDO's mode outside 0x6502 is not taken");
   flag_opt("--homing-model", f_homing, "homing moves per method family over several SYNCs");
@@ -212,6 +258,12 @@ int main(int argc, char** argv) {
     }
     absent_objects.push_back(static_cast<std::uint16_t>(*v));
   }
+  cia402::MdsObjects mds_objects;
+  for (const std::string& a : mds_args)
+    if (std::string why = parse_mds_objects(a, mds_objects); !why.empty()) {
+      std::fprintf(stderr, "cia402-emu: --mds-objects: %s\n", why.c_str());
+      return 1;
+    }
   std::optional<eds::Eds> description;
   if (!eds_file.empty()) {
     try {
@@ -232,6 +284,7 @@ int main(int argc, char** argv) {
   apply(behaviour.cia402_default_pdos, f_pdos);
   apply(behaviour.rpdo_too_long_emcy, f_long);
   apply(behaviour.check_sync_length, f_sync);
+  apply(behaviour.sync_timeout, f_sync_to);
   apply(behaviour.error_behaviour, f_errb);
   apply(behaviour.one_transition_per_sync, f_one);
   apply(behaviour.refuse_unsupported_modes, f_modes);
@@ -283,6 +336,7 @@ int main(int argc, char** argv) {
     c.viscous_friction = viscous;
     c.refuse_mode_switch = refuse_mode;
     c.absent_objects = absent_objects;
+    c.mds_objects = mds_objects;
     if (description) c.served = emulator::served_objects(*description, c.node);
     c.behaviour = behaviour;
     c.remote = !no_remote;
