@@ -6,7 +6,8 @@
 /// (motion scripts), STATS, HELP.
 ///
 /// Non-RT. Everything happens in poll(), which the owner calls from its non-RT
-/// housekeeping (once per cycle in --sim, every ~1 ms in real time). poll()
+/// housekeeping (once per cycle: between cycles in --sim, half a period
+/// after the cycle's deadline in real time). poll()
 /// never blocks: sockets are non-blocking, a request that waits for the
 /// planner (an instruction call, a script, a WATCH) is per-client state that
 /// poll() advances, and every per-client buffer is bounded, so a slow, dead or

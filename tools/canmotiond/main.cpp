@@ -403,7 +403,7 @@ std::unique_ptr<rt::CommandServer> open_socket(const Options& o, rt::Controller&
   }
 }
 
-/// The non-RT work of one step (between cycles in --sim, every millisecond
+/// The non-RT work of one step (between cycles in --sim, once per cycle
 /// on the housekeeping thread in real time): outputs, socket, script,
 /// progress, the end of the run and the controlled stop.
 class Housekeeping {
@@ -503,11 +503,15 @@ int run_simulated(config::Runtime& rt, rt::CyclicExecutive& exec, Housekeeping& 
   return 0;
 }
 
-/// Real time: the cycle on the RT thread, housekeeping on this one every
-/// millisecond, systemd readiness and watchdog.
-int run_real_time(const Options& o, config::Runtime& rt, rt::CyclicExecutive& exec, Housekeeping& hk) {
+/// Real time: the cycle on the RT thread, housekeeping on this one once per
+/// cycle (half a period after the deadline), systemd readiness and watchdog.
+int run_real_time(const Options& o, config::Runtime& rt, rt::CyclicExecutive& exec, Housekeeping& hk,
+                  std::chrono::nanoseconds period) {
   rt::Controller& ctl = *rt.controller;
+  // The cycle's grid for the housekeeping thread (an atomic store: RT-safe).
+  std::atomic<std::int64_t> grid_ns{-1};
   exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
+    grid_ns.store(info.deadline.count(), std::memory_order_relaxed);
     const std::int64_t t = info.wake.count();
     if (rt.sim) rt.sim->begin_cycle(t);
     ctl.cycle(t);
@@ -529,8 +533,18 @@ int run_real_time(const Options& o, config::Runtime& rt, rt::CyclicExecutive& ex
     wd = std::make_unique<rt::WatchdogThread>([&exec] { return exec.cycle_count(); }, *iv / 2);
     wd->start();
   }
+  // Housekeeping once per cycle, half a period after the cycle's deadline, so
+  // that its wake-ups never fall together with the RT thread's. (A free
+  // 1 ms sleep drifted through the cycle's grid; where both threads shared a
+  // CPU, its timer and context switch then delayed the RT wake-up.)
+  rt::MonotonicClock mono;
+  const std::int64_t p = period.count();
   for (bool ended = false; !ended;) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const std::int64_t now = mono.now().count();
+    const std::int64_t g = grid_ns.load(std::memory_order_relaxed);
+    std::int64_t next = (g < 0 ? now : g) + p / 2;
+    if (next <= now) next += ((now - next) / p + 1) * p;
+    mono.sleep_until(rt::Nanos{next});
     ended = hk(ctl.cycles());
   }
   rt::SdNotifier::stopping();
@@ -583,7 +597,7 @@ int run(const Options& o) {
              script ? ", script " + o.script : std::string());
   Housekeeping hk(o, host, exec, *out, server.get(), runner.get());
   if (rt.sim) rt.sim->power_on(o.sim ? 0 : clock.now().count());  // boot-up frames at the run's start time
-  if (const int e = o.sim ? run_simulated(rt, exec, hk, period) : run_real_time(o, rt, exec, hk); e != 0) return e;
+  if (const int e = o.sim ? run_simulated(rt, exec, hk, period) : run_real_time(o, rt, exec, hk, period); e != 0) return e;
 
   // The end: the rest of the outputs, the summary, a script that did not finish.
   int status = hk.status();
