@@ -5,9 +5,10 @@
 # controller time: sha256 of the --trace file and of the --csv file, each
 # compared with its line in HASH_FILE (sha256sum format, names demo.trace,
 # demo.csv, mapc.trace, mapc.csv).
-# The hashes were recorded on main 94e8130, before the planner refactor of
-# issue 13 started. A deliberate behaviour change (planner or fieldbus) changes
-# them: the failure message prints both hashes and the command; re-record with
+# The hashes were first recorded on main 94e8130, before the planner refactor
+# of issue 13 started, and held through it; deliberate fieldbus changes since
+# re-recorded them (git log tests/golden/sim.sha256 says which and why). A
+# deliberate behaviour change (planner or fieldbus) changes them: the failure message prints both hashes and the command; re-record with
 #   CANMOTION_GOLDEN_UPDATE=1 sim-golden.sh ...   (or ctest with that variable set)
 # and say in the commit why the output changed.
 set -euo pipefail
