@@ -22,6 +22,13 @@ fail() { echo "vcan-demo-run: $*" >&2; exit 1; }
 
 cfg="$art/demo-vcan.yaml"
 "$here/make-vcan-config.sh" "$examples/demo.yaml" "$period" > "$cfg"
+# The SDO and transition timeouts for the emulated VM (as vcan.demo_coordinated):
+# with the host loaded (two VMs and a build, wake-ups 140 ms late at p99) the
+# emulators answered the boot's first read after more than the demo's 200 ms
+# (seen: "0x1000:0 ... aborted with 0x05040000 ... after 201.1 ms").
+grep -q '^  timeouts: {sdo_ms: 200, boot_ms: 5000, transition_ms: 1000}$' "$cfg" ||
+  fail "demo.yaml's drives.timeouts line changed; update vcan-demo-run.sh"
+sed -i 's/^  timeouts: {sdo_ms: 200, boot_ms: 5000, transition_ms: 1000}$/  timeouts: {sdo_ms: 2000, boot_ms: 5000, transition_ms: 5000}/' "$cfg"
 script="$examples/demo.script"
 
 pids=()
