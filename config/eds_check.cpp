@@ -25,6 +25,63 @@ std::vector<cia402::BootWrite> proxy_writes(const cia402::DriveConfig& d, const 
   const cia402::DriveProxy proxy(d, master);
   return {proxy.boot_writes().begin(), proxy.boot_writes().end()};
 }
+
+/// The boot's write of the master's interpolation time index (0x60C2:2).
+bool is_ip_index_write(const cia402::BootWrite& w) {
+  return w.w.index == cia402::obj::kInterpolationTimePeriod && w.w.sub == 2 && !w.is_read() && !w.ip_fallback;
+}
+
+/// The EDS has 0x60C2:2 and it is writable.
+bool eds_ip_index_writable(const eds::Eds& e) {
+  const eds::SubObject* s = e.find(cia402::obj::kInterpolationTimePeriod, 2);
+  return s != nullptr && eds::writable(s->access);
+}
+
+/// 0x60C2:2 (interpolation time index) when the EDS has it read-only or not
+/// at all, as the boot treats such a drive (cia402/drive_boot.cpp): read-only
+/// (ro/const), the drive takes periods in 10^DefaultValue s only and 0x60C2:1
+/// is written in that unit, so the period must be a whole number 1..255 of
+/// it (refused otherwise, at controller.period_ms); absent, the drive keeps
+/// its own unit and 0x60C2:1 is written with the master's value (a warning).
+/// A writable 0x60C2:2 is checked with the other writes.
+void check_interpolation_index(const Config& cfg, const AxisSettings& a, const std::string& who,
+                               std::vector<Diagnostic>& diags) {
+  const eds::Eds& e = *a.drive.eds_data;
+  const eds::Object* o = e.find(cia402::obj::kInterpolationTimePeriod);
+  if (o == nullptr) return;  // no 0x60C2: its :1 write is refused
+  const eds::SubObject* s = o->find(2);
+  if (s != nullptr && eds::writable(s->access)) return;
+  const std::int64_t cycle_ns = std::llround(cfg.controller.period_s * 1e9);
+  const auto ip = cia402::encode_interpolation_period(cycle_ns);
+  const std::string period = fmt::format("{:g} ms", static_cast<double>(cycle_ns) / 1e6);
+  const std::string key = "controller.period_ms";
+  const Location where = cfg.controller.where.line > 0 ? cfg.controller.where : a.drive.eds_where;
+  if (s == nullptr) {
+    diags.push_back({Severity::kWarning, cfg.path, a.drive.eds_where, a.drive.eds_key,
+                     fmt::format("{}: {}:{}: 0x60C2 has no sub-index 2 (interpolation time index): it is not written, "
+                                 "the drive keeps its own unit and 0x60C2:1 is written as {} (the period {} in units "
+                                 "of 10^{} s)",
+                                 who, e.file, o->line, ip ? ip->value : 0, period, ip ? ip->index : 0)});
+    return;
+  }
+  const std::string what = fmt::format("0x60C2:02 ({})", s->name.empty() ? "Interpolation time index" : s->name);
+  if (!s->default_value || s->size() != 1) {
+    diags.push_back({Severity::kWarning, cfg.path, a.drive.eds_where, a.drive.eds_key,
+                     fmt::format("{}: {}:{}: {} is AccessType={} without a DefaultValue: the boot reads the drive's "
+                                 "unit and fails if the period {} ({}) is not a whole number 1..255 of it",
+                                 who, e.file, s->line, what, eds::access_type_name(s->access), period, key)});
+    return;
+  }
+  const auto idx = static_cast<std::int8_t>(canopen::sign_extend(s->default_value->resolve(a.node, 1), 8));
+  const std::int64_t unit = cia402::interpolation_period_ns(cia402::InterpolationPeriod{1, idx});
+  if (unit > 0 && cycle_ns % unit == 0 && cycle_ns / unit >= 1 && cycle_ns / unit <= 255) return;
+  diags.push_back({Severity::kError, cfg.path, where, key,
+                   fmt::format("{}: {}:{}: {} is AccessType={} at DefaultValue={} (the drive takes periods in units "
+                               "of 10^{} s only) and the cycle period {} is not a whole number 1..255 of that unit: "
+                               "choose a period the drive can take",
+                               who, e.file, s->line, what, eds::access_type_name(s->access), s->default_value->text,
+                               static_cast<int>(idx), period)});
+}
 }  // namespace
 
 std::vector<cia402::BootWrite> boot_writes(const AxisSettings& a, const BusSettings& bus, double period_s,
@@ -44,6 +101,7 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
   const eds::Eds* e = a.drive.eds_data.get();
   for (const cia402::BootWrite& w : proxy_writes(d, bus)) {
     if (w.check == cia402::BootCheck::kSupportedModes) continue;  // with its mode bits below
+    if (is_ip_index_write(w) && e != nullptr && !eds_ip_index_writable(*e)) continue;  // check_interpolation_index()
     eds::Use u;
     u.index = w.w.index;
     u.sub = w.w.sub;
@@ -149,6 +207,7 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
       diags.push_back({Severity::kError, cfg.path, ds.eds_where, x.key.empty() ? ds.eds_key : x.key,
                        // "file:line: message"; the key is the diagnostic's own.
                        fmt::format("{}: {}{}: {}", who, x.file, x.line > 0 ? fmt::format(":{}", x.line) : "", x.message)});
+    check_interpolation_index(cfg, a, who, diags);
     bool said_modes = false;  // 0x6502 may be wanted by several keys: said once
     for (const eds::Use& u : r.skipped) {
       if (u.index == 0x1016)

@@ -50,12 +50,22 @@ void DriveProxy::build_configuration() {
   // or absent: then its index is read and 0x60C2:1 written again in that
   // unit (the two ip_fallback entries, skipped when :2 was written); a period
   // the drive's unit cannot express fails the boot (BootCheck::kInterpolationIndex).
-  writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)},
-                              WriteOrigin::kInterpolationPeriod, 0, false});
-  writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 2, 1, 0}, WriteOrigin::kCheck, 0, true, true,
-                              BootCheck::kInterpolationIndex});
-  writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value}, WriteOrigin::kInterpolationPeriod,
-                              0, false, true});
+  // When the drive's EDS says so already, the write it would refuse is left
+  // out: read-only (ro/const), the fallback runs at once; absent, neither
+  // written nor read (the drive keeps its own unit; config/eds_check warns).
+  const canopen::DeviceDictionary::Entry* ip_index =
+      cfg_.dictionary ? cfg_.dictionary->find(obj::kInterpolationTimePeriod, 2) : nullptr;
+  ip_index_read_only_ = ip_index != nullptr && (ip_index->access == canopen::Access::kRo ||
+                                                ip_index->access == canopen::Access::kConst);
+  if (!absent(SdoWrite{obj::kInterpolationTimePeriod, 2, 1, 0})) {
+    if (!ip_index_read_only_)
+      writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 2, 1, static_cast<std::uint8_t>(ip.index)},
+                                  WriteOrigin::kInterpolationPeriod, 0, false});
+    writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 2, 1, 0}, WriteOrigin::kCheck, 0, true, true,
+                                BootCheck::kInterpolationIndex});
+    writes_.push_back(BootWrite{SdoWrite{obj::kInterpolationTimePeriod, 1, 1, ip.value},
+                                WriteOrigin::kInterpolationPeriod, 0, false, true});
+  }
   // The SYNC consumer (CiA 301): 0x1019 may change only while 0x1006 is 0
   // (abort 0x08000022 otherwise; CANopenNode's CO_ODF_1019 too), so 0x1006 is
   // written 0 first, then 0x1019 = the master's counter overflow value (0: its
@@ -197,7 +207,7 @@ bool DriveProxy::check_read(const BootWrite& bw, std::uint32_t v, std::int64_t n
       const std::size_t at = static_cast<std::size_t>(&bw - writes_.data());
       if (unit > 0 && cfg_.cycle_ns % unit == 0 && cfg_.cycle_ns / unit >= 1 && cfg_.cycle_ns / unit <= 255) {
         writes_[at + 1].w.value = static_cast<std::uint32_t>(cfg_.cycle_ns / unit);
-        notice(at - 1, ip_abort_, idx);
+        notice(at, ip_abort_, idx);  // 0x60C2:2 as the refused write (abort 0: read-only in the EDS, not written)
         return true;
       }
       ok = false;
@@ -344,7 +354,8 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
           ++tolerated_;
           if (bw->origin != WriteOrigin::kUnusedPdo) {
             if (bw->check == BootCheck::kInterpolationIndex) {
-              notice(r.tag - 1, ip_abort_, 0);  // no 0x60C2:2 at all: 0x60C2:1 keeps the master's value
+              // no 0x60C2:2 at all: 0x60C2:1 keeps the master's value
+              notice(r.tag, ip_abort_ != 0 ? ip_abort_ : static_cast<std::uint32_t>(r.abort), 0);
             } else {
               notice(r.tag, static_cast<std::uint32_t>(r.abort));
             }
@@ -390,7 +401,8 @@ void DriveProxy::step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcep
         const BootWrite& bw = writes_[next_write_];
         if (bw.ip_fallback || bw.sync_fallback) {
           if (done_writes_ < next_write_) break;  // 0x60C2:2's (0x1019's) answer decides
-          if (!(bw.ip_fallback ? ip_fallback_ : sync_fallback_)) {
+          // (0x60C2:2 read-only in the drive's EDS: not written, the fallback runs)
+          if (!(bw.ip_fallback ? ip_fallback_ || ip_index_read_only_ : sync_fallback_)) {
             ++next_write_;  // it was written: nothing to fall back on
             ++done_writes_;
             continue;

@@ -53,6 +53,14 @@ int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key)
   }
   return 0;
 }
+
+/// The drive's EDS name of index:sub (`d`: its dictionary, may be null),
+/// else `standard` (CiA 301/402's). Realtime-safe.
+const char* eds_name_or(const canopen::DeviceDictionary* d, std::uint16_t index, std::uint8_t sub,
+                        const char* standard) noexcept {
+  const char* n = d != nullptr ? d->name(index, sub) : nullptr;
+  return n != nullptr ? n : standard;
+}
 }  // namespace
 
 const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept {
@@ -71,8 +79,9 @@ const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) n
   return nullptr;
 }
 
-std::string describe_notice(const canopen::NodeEvent& e) {
-  const std::string_view name = canopen::object_name(e.index, e.sub);
+std::string describe_notice(const canopen::NodeEvent& e, const canopen::DeviceDictionary* dictionary) {
+  const std::string_view name =
+      dictionary != nullptr ? dictionary->name_or_standard(e.index, e.sub) : canopen::object_name(e.index, e.sub);
   const char* fallback = "not written; the drive keeps its own setting";
   char buf[160];
   if (e.index == 0x1016) {
@@ -100,6 +109,11 @@ std::string describe_notice(const canopen::NodeEvent& e) {
     fallback = buf;
   }
   char out[512];
+  if (e.abort == 0) {  // no transfer: the drive's EDS has it read-only (DriveProxy leaves the write out)
+    std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) read-only in the drive's EDS (not written): %s",
+                  e.node, e.index, e.sub, static_cast<int>(name.size()), name.data(), fallback);
+    return out;
+  }
   const char* what = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly) ? "read-only"
                      : canopen::object_absent(static_cast<canopen::SdoAbort>(e.abort)) || e.abort == 0 ? "absent"
                                                                                                        : "refused";
@@ -133,7 +147,8 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                         node, waited_ms, static_cast<double>(timeout_ns) / 1e6);
       break;
     case FailureKind::kSdoAbort: {
-      auto name = canopen::object_name(sdo_index, sdo_sub);
+      auto name = dictionary != nullptr ? dictionary->name_or_standard(sdo_index, sdo_sub)
+                                        : canopen::object_name(sdo_index, sdo_sub);
       if (name.empty()) name = "an object canmotion does not know";
       const auto text = canopen::sdo_abort_text(sdo_abort);
       char why[320] = "";
@@ -200,40 +215,45 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
       const bool k = hint != nullptr && hint[0] != '\0';
       switch (check) {
         case BootCheck::kDeviceType:
-          n = k ? std::snprintf(out.data(), out.size(), "node %u: 0x1000 (Device type) is 0x%08" PRIX32 ", %s expects 0x%08" PRIX32,
-                                node, read_value, hint, expected)
+          n = k ? std::snprintf(out.data(), out.size(), "node %u: 0x1000 (%s) is 0x%08" PRIX32 ", %s expects 0x%08" PRIX32,
+                                node, eds_name_or(dictionary, 0x1000, 0, "Device type"), read_value, hint, expected)
                 : std::snprintf(out.data(), out.size(),
-                                "node %u: 0x1000 (Device type) is 0x%08" PRIX32 ": device profile %" PRIu32
+                                "node %u: 0x1000 (%s) is 0x%08" PRIX32 ": device profile %" PRIu32
                                 ", not 402 (CiA 402 drive); canmotiond drives CiA 402 drives only",
-                                node, read_value, read_value & 0xFFFFu);
+                                node, eds_name_or(dictionary, 0x1000, 0, "Device type"), read_value,
+                                read_value & 0xFFFFu);
           break;
         case BootCheck::kVendorId:
         case BootCheck::kProductCode:
         case BootCheck::kRevision: {
-          const char* what = check == BootCheck::kVendorId ? "1 (Vendor-ID)" : check == BootCheck::kProductCode ? "2 (Product code)" : "3 (Revision number)";
+          const std::uint8_t si = check == BootCheck::kVendorId ? 1 : check == BootCheck::kProductCode ? 2 : 3;
+          const char* what = eds_name_or(dictionary, obj::kIdentity, si,
+                                         si == 1 ? "Vendor-ID" : si == 2 ? "Product code" : "Revision number");
           const char* sub = check == BootCheck::kVendorId ? "vendor_id" : check == BootCheck::kProductCode ? "product_code" : "revision";
           n = std::snprintf(out.data(), out.size(),
-                            "node %u: identity 0x1018:%s is 0x%08" PRIX32 ", the configuration expects 0x%08" PRIX32
+                            "node %u: identity 0x1018:%u (%s) is 0x%08" PRIX32 ", the configuration expects 0x%08" PRIX32
                             " (%s%s%s): another drive than configured is on this node",
-                            node, what, read_value, expected, k ? hint : "drive.identity", ".", sub);
+                            node, si, what, read_value, expected, k ? hint : "drive.identity", ".", sub);
           break;
         }
         case BootCheck::kSupportedModes: {
           const auto mn = mode_name(static_cast<std::int8_t>(expected));
           n = std::snprintf(out.data(), out.size(),
-                            "node %u: the drive does not support mode %d (%.*s): 0x6502 (Supported drive modes) is 0x%08" PRIX32
+                            "node %u: the drive does not support mode %d (%.*s): 0x6502 (%s) is 0x%08" PRIX32
                             "; the mode is needed by %s",
                             node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(mn.size()), mn.data(),
-                            read_value, k ? hint : "the drive's configured mode");
+                            eds_name_or(dictionary, obj::kSupportedDriveModes, 0, "Supported drive modes"), read_value,
+                            k ? hint : "the drive's configured mode");
           break;
         }
         case BootCheck::kModeDisplay: {
           const auto rq = mode_name(static_cast<std::int8_t>(expected));
           const auto sh = mode_name(static_cast<std::int8_t>(read_value));
           n = std::snprintf(out.data(), out.size(),
-                            "node %u: 0x6060 = %d (%.*s) written, but 0x6061 (Modes of operation display) still shows %d (%.*s) "
+                            "node %u: 0x6060 = %d (%.*s) written, but 0x6061 (%s) still shows %d (%.*s) "
                             "after %.1f ms (%s): the drive does not run the mode it accepted",
                             node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(rq.size()), rq.data(),
+                            eds_name_or(dictionary, obj::kModesOfOperationDisplay, 0, "Modes of operation display"),
                             static_cast<int>(static_cast<std::int8_t>(read_value)), static_cast<int>(sh.size()), sh.data(),
                             waited_ms, k ? hint : "mode switch timeout");
           break;
@@ -241,10 +261,10 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
         case BootCheck::kInterpolationIndex: {
           const auto idx = static_cast<int>(static_cast<std::int8_t>(read_value & 0xFFu));
           n = std::snprintf(out.data(), out.size(),
-                            "node %u: 0x60C2:2 (Interpolation time index) is read-only at %d (periods in units of "
+                            "node %u: 0x60C2:2 (%s) is read-only at %d (periods in units of "
                             "10^%d s) and the cycle period %.6g ms (%s) is not a whole number 1..255 of that unit: "
                             "choose a period the drive can take",
-                            node, idx, idx, static_cast<double>(expected) / 1e6, k ? hint : "the cycle period");
+                            node, eds_name_or(dictionary, obj::kInterpolationTimePeriod, 2, "Interpolation time index"), idx, idx, static_cast<double>(expected) / 1e6, k ? hint : "the cycle period");
           break;
         }
         case BootCheck::kSyncCounter: {
@@ -260,10 +280,11 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
             std::snprintf(why, sizeof why, "the drive counts SYNCs up to %" PRIu32 ", the master up to %" PRIu32,
                           read_value, expected);
           n = std::snprintf(out.data(), out.size(),
-                            "node %u: 0x1019:0 (Synchronous counter overflow value) refused the write of %" PRIu32
+                            "node %u: 0x1019:0 (%s) refused the write of %" PRIu32
                             " (SDO abort 0x%08" PRIX32 " %.*s) and holds %" PRIu32 ": %s; set %s: %" PRIu32
                             ", or give the drive's 0x1019 the value %" PRIu32,
-                            node, expected, sdo_abort, static_cast<int>(text.size()), text.data(), read_value, why,
+                            node, eds_name_or(dictionary, obj::kSyncCounterOverflow, 0, "Synchronous counter overflow value"),
+                            expected, sdo_abort, static_cast<int>(text.size()), text.data(), read_value, why,
                             k ? hint : "the master's SYNC counter overflow", read_value, expected);
           break;
         }
@@ -365,6 +386,7 @@ void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, s
   failure_.waited_ns = waited;
   failure_.timeout_ns = timeout;
   failure_.t_ns = now_ns;
+  failure_.dictionary = cfg_.dictionary.get();
 }
 
 bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {

@@ -105,9 +105,13 @@ enum class BootCheck : std::uint8_t {
 /// One sentence for a canopen::NodeEvent::Kind::kObjectAbsent (an optional
 /// boot object the drive lacks or refused as read-only, and the fallback the
 /// proxy took), e.g. "node 2: no 0x1016 (Consumer heartbeat time, SDO abort
-/// 0x06020000): the drive does not watch the master's heartbeat". Uses
-/// snprintf: call it from a non-RT thread.
-[[nodiscard]] std::string describe_notice(const canopen::NodeEvent& e);
+/// 0x06020000): the drive does not watch the master's heartbeat". The
+/// object is named by `dictionary` (the drive's EDS, DriveConfig::dictionary)
+/// when it has a name for it, else by CiA 301/402. An event with abort 0 is
+/// an object the EDS has read-only (not written). Uses snprintf: call it
+/// from a non-RT thread.
+[[nodiscard]] std::string describe_notice(const canopen::NodeEvent& e,
+                                          const canopen::DeviceDictionary* dictionary = nullptr);
 
 /// What the configuration expects of the drive's identity (`drive.identity`);
 /// unset members are not read (0x1018:2/3 are optional in CiA 301).
@@ -204,7 +208,8 @@ struct BootWrite {
   std::uint16_t extra = 0;  ///< kExtra: index in DriveConfig::extra_writes
   bool optional = false;    ///< a drive without the object is fine (abort 0x06020000 / 0x06090011 accepted)
   /// Runs only after the drive refused 0x60C2:2 (the read of its index and
-  /// 0x60C2:1 written again in its unit); skipped otherwise.
+  /// 0x60C2:1 written again in its unit), or at once when the drive's EDS
+  /// has 0x60C2:2 read-only (then not written); skipped otherwise.
   bool ip_fallback = false;
   BootCheck check = BootCheck::kNone;  ///< not kNone: a read (upload) that checks the drive
   /// Runs only after the drive refused 0x1019 other than as absent (the read
@@ -284,10 +289,16 @@ struct Failure {
   BootCheck check = BootCheck::kNone;  ///< kBootCheck: what did not match
   std::uint32_t read_value = 0;        ///< kBootCheck: what the drive has
   std::uint32_t expected = 0;          ///< kBootCheck: what the configuration expects (kSupportedModes: the missing mode)
+  /// The drive's EDS (DriveConfig::dictionary), or nullptr: describe() names
+  /// objects by it where it has a name. Like `hint`, valid while the
+  /// DriveProxy lives.
+  const canopen::DeviceDictionary* dictionary = nullptr;
 
   /// One sentence, e.g. "node 2: transition 4 (Switched on -> Operation
   /// enabled) timed out after 500.0 ms: drive is in Switched on, statusword
-  /// 0x0233, last EMCY 0x8611 (following error)". Writes at most out.size()-1
+  /// 0x0233, last EMCY 0x8611 (following error)". Objects are named by the
+  /// drive's EDS (`dictionary`) where it has a name, else by CiA 301/402.
+  /// Writes at most out.size()-1
   /// characters plus NUL; returns the length. Uses snprintf: call it from a
   /// non-RT thread.
   std::size_t describe(std::span<char> out) const noexcept;
@@ -474,6 +485,7 @@ class DriveProxy {
   std::uint32_t ip_abort_ = 0;  // the abort 0x60C2:2's write got
   bool sync_fallback_ = false;  // 0x1019 refused: the BootWrite::sync_fallback read runs
   std::uint32_t sync_abort_ = 0;  // the abort 0x1019's write got
+  bool ip_index_read_only_ = false;  // the EDS has 0x60C2:2 ro/const: not written, the fallback runs at once
   std::vector<std::uint8_t> noticed_;  // per writes_ entry: its notice was made (said once)
   std::array<canopen::NodeEvent, 16> notices_{};  // bound: at most one per optional boot object, 16 is ample
   std::size_t notice_head_ = 0, notice_count_ = 0;

@@ -1,7 +1,10 @@
 #pragma once
 /// \file
-/// A concise DCF (CiA 306 device configuration file) of what a master
-/// writes to one node at boot, for a commissioning engineer to review:
+/// A DCF (device configuration file in CiA 306's INI text format, an EDS
+/// with the values to configure) of what a master writes to one node at
+/// boot: only the written sub-objects, not the device's whole dictionary.
+/// It is not a "concise DCF" (CiA 302-3, object 0x1F22: a binary list of
+/// index, sub-index, size and data). For a commissioning engineer to review:
 /// [DeviceComissioning] (node-ID, baud rate, name), the [DeviceInfo] of the
 /// node's EDS when there is one, and one section per written sub-object
 /// with its ParameterValue (the last value written: the PDO procedure

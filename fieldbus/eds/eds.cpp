@@ -199,6 +199,37 @@ int on_key(void* user, const char* /*section*/, const char* name, const char* va
   return 1;
 }
 
+/// Syntax errors listed at most (then one more line says there are more):
+/// each costs inih one more pass over the text (syntax_errors()).
+constexpr int kMaxSyntaxErrors = 50;
+
+int ignore_key(void*, const char*, const char*, const char*, int) noexcept { return 1; }
+
+/// Every INI syntax error of `text` after the one inih reported at `first`
+/// (its line), in line order, `first` included. inih goes on after an error
+/// (ini_stop_on_first_error is off: the keys are all collected) but returns
+/// the first error's line only: each further one is found by parsing again
+/// with the lines reported so far blanked (line numbers kept).
+std::vector<int> syntax_errors(std::string text, int first) {
+  std::vector<int> lines;
+  std::size_t from = 0;  // where line `at` starts (errors come in ascending line order)
+  int at = 1;
+  for (int line = first; line > 0;) {
+    lines.push_back(line);
+    if (lines.size() > static_cast<std::size_t>(kMaxSyntaxErrors)) break;  // the caller says there are more
+    for (; at < line && from != std::string::npos; ++at) {
+      from = text.find('\n', from);
+      if (from != std::string::npos) ++from;
+    }
+    if (from == std::string::npos) break;
+    const std::size_t end = std::min(text.find('\n', from), text.size());
+    std::fill(text.begin() + static_cast<std::ptrdiff_t>(from), text.begin() + static_cast<std::ptrdiff_t>(end), ' ');
+    line = ini_parse_string(text.c_str(), ignore_key, nullptr);
+    if (line == -2) throw std::bad_alloc();
+  }
+  return lines;
+}
+
 int probe_key(void* user, const char*, const char* name, const char*, int lineno) noexcept {
   if (name != nullptr) *static_cast<int*>(user) = lineno;
   return 1;
@@ -822,7 +853,15 @@ Eds parse(std::string_view text, std::string file) {
   const std::string z(text);  // inih reads a NUL-terminated string
   const int r = ini_parse_string(z.c_str(), on_key, &c);
   if (c.out_of_memory || r == -2) throw std::bad_alloc();
-  if (r > 0) b.error(r, "not a [section] header or a key=value line");
+  if (r > 0) {
+    const std::vector<int> lines = syntax_errors(z, r);
+    for (std::size_t i = 0; i < lines.size(); ++i)
+      b.error(lines[i], i < static_cast<std::size_t>(kMaxSyntaxErrors)
+                            ? std::string("not a [section] header or a key=value line")
+                            : fmt::format("more lines that are not a [section] header or a key=value line (only the "
+                                          "first {} are listed)",
+                                          kMaxSyntaxErrors));
+  }
   return b.build(c);
 }
 

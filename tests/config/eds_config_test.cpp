@@ -5,8 +5,12 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "config/eds_check.hpp"
@@ -36,6 +40,15 @@ std::string yaml(const std::string& drive_keys, const std::string& defaults = ""
          drive_keys;
 }
 const std::string kFile = kExamples + "/eds-test.yaml";
+
+/// The 1-based line of the first line `l` of `text`.
+int line_of_text(const std::string& text, const std::string& l) {
+  std::istringstream in(text);
+  std::string x;
+  for (int n = 1; std::getline(in, x); ++n)
+    if (x == l) return n;
+  return 0;
+}
 
 /// The line of `[section]` in an example EDS file.
 int line_of(const std::string& file, const std::string& section) {
@@ -136,6 +149,95 @@ TEST(EdsConfig, BootWritesLeaveOutOptionalObjectsTheEdsLacks) {
   EXPECT_EQ(optional_reads, 2);
   const auto fallback_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.ip_fallback && b.is_read(); });
   EXPECT_EQ(fallback_reads, 1);
+}
+
+/// minimal-drive.eds with its [60C2sub2] section replaced by `sub2` ("":
+/// the sub-index left out, SubNumber and sub 0 lowered), written to a
+/// temporary file named after `name`; returns its path.
+std::string minimal_with_ip_index(const std::string& name, const std::string& sub2) {
+  std::ifstream in(kExamples + "/minimal-drive.eds");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string t = ss.str();
+  const std::size_t at = t.find("[60C2sub2]\n");
+  const std::size_t end = t.find("\n\n", at);
+  EXPECT_NE(at, std::string::npos);
+  t.replace(at, end + 2 - at, sub2);
+  if (sub2.empty()) {
+    const std::size_t obj = t.find("[60C2]\n");
+    t.replace(t.find("SubNumber=3", obj), 11, "SubNumber=2");
+    t.replace(t.find("DefaultValue=2", t.find("[60C2sub0]")), 14, "DefaultValue=1");
+  }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / fmt::format("canmotion-{}-{}.eds", name, ::getpid())).string();
+  std::ofstream(path) << t;
+  return path;
+}
+
+std::string ip_index_section(const std::string& access, const std::string& default_value) {
+  return "[60C2sub2]\nParameterName=Zeitraster Exponent\nObjectType=0x7\nDataType=0x0002\nAccessType=" + access +
+         "\nDefaultValue=" + default_value + "\nPDOMapping=0\n\n";
+}
+
+/// The boot's transfers of 0x60C2:2: writes (downloads) and reads.
+std::pair<int, int> ip_index_transfers(const std::vector<cia402::BootWrite>& w) {
+  int writes = 0, reads = 0;
+  for (const cia402::BootWrite& b : w)
+    if (b.w.index == 0x60C2 && b.w.sub == 2) ++(b.is_read() ? reads : writes);
+  return {writes, reads};
+}
+
+// CiA 402 allows a read-only 0x60C2:2: the drive takes periods in one unit
+// (its DefaultValue). 1 ms is 10 x 10^-4 s: accepted, the boot does not
+// write 0x60C2:2 (the drive would refuse it) and reads the index at once.
+TEST(EdsConfig, ReadOnlyIpIndexThatExpressesThePeriodIsAccepted) {
+  const std::string eds = minimal_with_ip_index("ip-ro-4", ip_index_section("ro", "-4"));
+  Config c;
+  ASSERT_NO_THROW(c = load_string(yaml("      eds: " + eds + "\n"), kFile));
+  for (const Diagnostic& w : c.warnings) EXPECT_EQ(w.message.find("0x60C2"), std::string::npos) << w.str();
+  const auto [writes, reads] = ip_index_transfers(boot_writes(c.axes[0], c.buses[0], c.controller.period_s, 0));
+  EXPECT_EQ(writes, 0);
+  EXPECT_EQ(reads, 1);
+  std::filesystem::remove(eds);
+}
+
+// A unit of 10 ms cannot express 1 ms: refused before the bus, naming the
+// object (by the EDS), its file and line, the index, the period and the key.
+TEST(EdsConfig, ReadOnlyIpIndexThatCannotExpressThePeriodIsRefusedAtThePeriod) {
+  const std::string eds = minimal_with_ip_index("ip-ro-2", ip_index_section("ro", "-2"));
+  const std::vector<Diagnostic> d = test::diagnostics_of(yaml("      eds: " + eds + "\n"), kFile);
+  ASSERT_EQ(d.size(), 1u) << ConfigError(d).what();
+  EXPECT_EQ(d[0].key, "controller.period_ms");
+  std::ifstream in(eds);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string want_where = fmt::format("{}:{}:", eds, line_of_text(ss.str(), "[60C2sub2]"));
+  const std::string& m = d[0].message;
+  EXPECT_NE(m.find("axis 'X' (node 2)"), std::string::npos) << m;
+  EXPECT_NE(m.find(want_where + " 0x60C2:02 (Zeitraster Exponent) is AccessType=ro at DefaultValue=-2"), std::string::npos) << m;
+  EXPECT_NE(m.find("units of 10^-2 s"), std::string::npos) << m;
+  EXPECT_NE(m.find("the cycle period 1 ms is not a whole number 1..255"), std::string::npos) << m;
+  // 10 ms is 1 x 10^-2 s: the same drive is accepted.
+  std::string y10 = yaml("      eds: " + eds + "\n");
+  y10.replace(0, y10.find('\n'), "controller: {period_ms: 10}");
+  EXPECT_NO_THROW((void)load_string(y10, kFile));
+  std::filesystem::remove(eds);
+}
+
+// Without 0x60C2:2 the drive keeps its own unit: accepted (a warning says
+// so), and the boot neither writes nor reads it.
+TEST(EdsConfig, AbsentIpIndexIsAcceptedAndNeitherWrittenNorRead) {
+  const std::string eds = minimal_with_ip_index("ip-absent", "");
+  Config c;
+  ASSERT_NO_THROW(c = load_string(yaml("      eds: " + eds + "\n"), kFile));
+  bool warned = false;
+  for (const Diagnostic& w : c.warnings)
+    warned = warned || w.message.find("0x60C2 has no sub-index 2") != std::string::npos;
+  EXPECT_TRUE(warned);
+  const auto [writes, reads] = ip_index_transfers(boot_writes(c.axes[0], c.buses[0], c.controller.period_s, 0));
+  EXPECT_EQ(writes, 0);
+  EXPECT_EQ(reads, 0);
+  std::filesystem::remove(eds);
 }
 
 }  // namespace

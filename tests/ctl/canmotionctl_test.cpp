@@ -155,6 +155,24 @@ TEST(Canmotionctl, InstructionGetSetStatusStats) {
   EXPECT_EQ(raw.out, "OK mam1.DN=1\n");
 }
 
+// The drive failure that `status` shows names the object by the drive's EDS
+// (DriveConfig::dictionary, from drive.eds in canmotiond), where CiA 301
+// would say "Vendor-ID".
+TEST(Canmotionctl, StatusNamesObjectsByTheDrivesEds) {
+  Rig r({}, [](AxisSpec& x, emulator::EmulatorConfig&) {
+    x.drive.identity.has_vendor_id = true;
+    x.drive.identity.vendor_id = 0x1234;  // the emulator's is another
+    x.drive.dictionary = std::make_shared<const canopen::DeviceDictionary>(
+        std::vector<canopen::DeviceDictionary::Entry>{
+            {0x1018, 1, canopen::DataType::kUnsigned32, canopen::Access::kRo, "Hersteller-ID"}},
+        "acme.eds");
+  });
+  ASSERT_TRUE(r.run_until([&] { return r.status().axes[1].phase == cia402::Phase::kFailed; }, 3000));
+  const Result st = ctl(&r, r.dir.path, {"-s", r.sock, "status"});
+  EXPECT_EQ(st.status, 0) << st.err;
+  EXPECT_TRUE(contains(st.out, "X: drive failure: node 2: identity 0x1018:1 (Hersteller-ID) is 0x")) << st.out;
+}
+
 TEST(Canmotionctl, WatchAndRun) {
   Rig r;
   r.boot();

@@ -117,7 +117,11 @@ struct Rig : test::SimController {
   std::unique_ptr<CommandServer> server;
   std::vector<std::string> log;
 
-  explicit Rig(std::function<void(CommandServerOptions&)> tweak = {}) {
+  /// `tweak` changes the server's options, `axis` axis X and its drive's
+  /// emulator (test::SimController).
+  explicit Rig(std::function<void(CommandServerOptions&)> tweak = {},
+               const std::function<void(AxisSpec&, emulator::EmulatorConfig&)>& axis = {})
+      : test::SimController(axis) {
     CommandServerOptions o;
     o.path = sock;
     o.log = [this](const std::string& l) { log.push_back(l); };

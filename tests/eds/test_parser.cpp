@@ -524,6 +524,37 @@ TEST(EdsErrors, ObjectListsMustMatchTheSections) {
                                           line_of(counts, "4=0x2000")));
 }
 
+// Every line inih cannot read is reported, not the first only (in line
+// order, with the file's other errors), and a flood of them is cut short.
+TEST(EdsErrors, EveryIniSyntaxErrorIsReported) {
+  const std::string text = eds_text(
+      "[2000]\nParameterName=x\nObjectType=0x7\nDataType=0x0005\nAccessType=ro\n  continued\nPDOMapping=0\n\n"
+      "[2001\nno equals sign here\n\n[2002]\nParameterName=y\nObjectType=0x7\nDataType=0x0005\nAccessType=ro\n"
+      "PDOMapping=0\nstray words\n",
+      {0x2000, 0x2002});
+  const auto e = errors_of(text);
+  const std::string syntax = "not a [section] header or a key=value line";
+  std::vector<std::string> got;
+  for (const eds::Diagnostic& d : e)
+    if (d.message == syntax) got.push_back(d.to_string());
+  const std::vector<std::string> want = {
+      fmt::format("bad.eds:{}: {}", line_of(text, "  continued"), syntax),
+      fmt::format("bad.eds:{}: {}", line_of(text, "[2001"), syntax),
+      fmt::format("bad.eds:{}: {}", line_of(text, "no equals sign"), syntax),
+      fmt::format("bad.eds:{}: {}", line_of(text, "stray words"), syntax),
+  };
+  EXPECT_EQ(got, want) << error_text(text);
+
+  std::string flood = eds_text("");
+  for (int i = 0; i < 60; ++i) flood += "junk\n";
+  const auto f = errors_of(flood);
+  ASSERT_EQ(f.size(), 51u) << error_text(flood);
+  EXPECT_EQ(f[0].line, line_of(flood, "junk"));
+  EXPECT_EQ(f[49].line, line_of(flood, "junk") + 49);
+  EXPECT_EQ(f[50].message,
+            "more lines that are not a [section] header or a key=value line (only the first 50 are listed)");
+}
+
 TEST(EdsErrors, IniSyntaxAndFileLevelProblems) {
   const std::string text = "ParameterName=before any section\n" +
                            eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\n  continued\n", {0x2000});

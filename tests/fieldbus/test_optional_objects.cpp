@@ -6,9 +6,11 @@
 
 #include <array>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "fieldbus/canopen/device_dictionary.hpp"
 #include "fieldbus/canopen/master.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 #include "fieldbus/cia402/cia402.hpp"
@@ -201,6 +203,113 @@ TEST(OptionalObjects, OptionalExtraWriteSkippedRequiredOneNamesItsKey) {
     const std::string why = rig.drive(kNode).failure().to_string();
     EXPECT_NE(why.find("0x2010:1"), std::string::npos) << why;
     EXPECT_NE(why.find("direct_control.ramp.velocity_positive"), std::string::npos) << why;
+  }
+}
+
+/// The SDO frames of node 2 about 0x60C2 while the rig boots, as "ID#DATA".
+std::vector<std::string> ip_sdo_frames(SimRig& rig) {
+  can::SimBus::Endpoint& spy = rig.bus().add_endpoint("spy");
+  std::vector<std::string> sdo;
+  std::array<can::TimedFrame, 256> buf{};
+  rig.power_on();
+  for (int i = 0; i < 400 && !rig.network().all_operational() && !rig.network().any_failed(); ++i) {
+    rig.step();
+    for (std::size_t k; (k = spy.receive(buf)) > 0;)
+      for (std::size_t j = 0; j < k; ++j) {
+        const can::Frame& f = buf[j].frame;
+        if ((f.id != 0x600u + kNode && f.id != 0x580u + kNode) || f.len != 8 || f.data[1] != 0xC2 || f.data[2] != 0x60)
+          continue;
+        char s[40];
+        std::snprintf(s, sizeof s, "%03X#%02X%02X%02X%02X%02X%02X%02X%02X", f.id, f.data[0], f.data[1], f.data[2],
+                      f.data[3], f.data[4], f.data[5], f.data[6], f.data[7]);
+        sdo.emplace_back(s);
+      }
+  }
+  return sdo;
+}
+
+/// A drive description with these sub-objects (the master asks it only
+/// about 0x60C2:2 and optional objects, and for names).
+std::shared_ptr<const canopen::DeviceDictionary> dictionary(std::vector<canopen::DeviceDictionary::Entry> entries) {
+  return std::make_shared<const canopen::DeviceDictionary>(std::move(entries), "test.eds");
+}
+
+// The drive's EDS has 0x60C2:2 read-only: the master does not make the
+// write the drive would refuse; it reads the index at once and writes
+// 0x60C2:1 in the drive's unit. The notice says why, by the EDS's name.
+TEST(OptionalObjects, EdsReadOnlyIpIndexIsReadNotWritten) {
+  SimRigConfig c = one_drive();
+  c.cycle_ns = 4'000'000;
+  c.drive.dictionary = dictionary({{0x60C2, 1, canopen::DataType::kUnsigned8, canopen::Access::kRw, "Zeitraster Wert"},
+                                   {0x60C2, 2, canopen::DataType::kInteger8, canopen::Access::kRo, "Zeitraster Exponent"}});
+  SimRig rig(c);  // strict: 0x60C2:2 read-only at -3
+  const std::vector<std::string> sdo = ip_sdo_frames(rig);
+  ASSERT_TRUE(rig.network().all_operational()) << rig.drive(kNode).failure().to_string();
+  const std::vector<std::string> golden = {
+      "602#2FC2600104000000",  // download 0x60C2:1 = 4
+      "582#60C2600100000000",  //   confirmed
+      "602#40C2600200000000",  // upload 0x60C2:2 (no download: read-only in the EDS)
+      "582#4FC26002FD000000",  //   -3 (1 byte)
+      "602#2FC2600104000000",  // download 0x60C2:1 = 4 (ms, the drive's unit)
+      "582#60C2600100000000",  //   confirmed
+  };
+  EXPECT_EQ(sdo, golden);
+  const std::vector<canopen::NodeEvent> n = notices(rig);
+  ASSERT_EQ(count(n, obj::kInterpolationTimePeriod, 2), 1u);
+  for (const auto& e : n) {
+    if (e.index != obj::kInterpolationTimePeriod) continue;
+    EXPECT_EQ(e.abort, 0u);
+    EXPECT_EQ(e.detail, -3);
+    const std::string text = cia402::describe_notice(e, c.drive.dictionary.get());
+    EXPECT_NE(text.find("0x60C2:2 (Zeitraster Exponent) read-only in the drive's EDS (not written)"), std::string::npos)
+        << text;
+    EXPECT_NE(text.find("10^-3 s"), std::string::npos) << text;
+    // Without the dictionary: CiA 402's name.
+    EXPECT_NE(cia402::describe_notice(e).find("0x60C2:2 (Interpolation time period: index)"), std::string::npos);
+  }
+}
+
+// The drive's EDS has no 0x60C2:2: neither written nor read (the drive
+// keeps its own unit; the configuration check warned).
+TEST(OptionalObjects, EdsWithoutIpIndexNeitherWritesNorReadsIt) {
+  SimRigConfig c = one_drive();
+  c.cycle_ns = 4'000'000;
+  c.drive.dictionary = dictionary({{0x60C2, 1, canopen::DataType::kUnsigned8, canopen::Access::kRw, ""}});
+  SimRig rig(c);
+  const std::vector<std::string> sdo = ip_sdo_frames(rig);
+  ASSERT_TRUE(rig.network().all_operational()) << rig.drive(kNode).failure().to_string();
+  const std::vector<std::string> golden = {"602#2FC2600104000000", "582#60C2600100000000"};
+  EXPECT_EQ(sdo, golden);
+}
+
+// Failure texts name objects by the drive's EDS where it has a name (what
+// canmotionctl status and canmotiond show), by CiA 301/402 otherwise.
+TEST(OptionalObjects, FailuresNameObjectsByTheDrivesEds) {
+  {
+    SimRigConfig c = one_drive();
+    c.drive.identity.has_vendor_id = true;
+    c.drive.identity.vendor_id = 0x1234;
+    c.drive.dictionary = dictionary({{0x1018, 1, canopen::DataType::kUnsigned32, canopen::Access::kRo, "Hersteller-ID"}});
+    SimRig rig(c);
+    rig.power_on();
+    ASSERT_TRUE(rig.run_until([&] { return rig.network().any_failed(); }, 3000));
+    const std::string why = rig.drive(kNode).failure().to_string();
+    EXPECT_NE(why.find("identity 0x1018:1 (Hersteller-ID) is 0x"), std::string::npos) << why;
+  }
+  {
+    SimRigConfig c = one_drive();
+    c.drive.extra_writes = {SdoWrite{0x2100, 0, 4, 7}};
+    c.drive.hints.extra = {"axes[0].drive.sdo_writes[0]"};
+    c.drive.dictionary = dictionary({{0x2100, 0, canopen::DataType::kUnsigned32, canopen::Access::kRw, "Acme gain"}});
+    SimRig rig(c);
+    rig.power_on();
+    ASSERT_TRUE(rig.run_until([&] { return rig.network().any_failed(); }, 3000));
+    const std::string why = rig.drive(kNode).failure().to_string();
+    EXPECT_NE(why.find("configuration write to 0x2100:0 (Acme gain) aborted with 0x06020000"), std::string::npos) << why;
+    cia402::Failure plain = rig.drive(kNode).failure();
+    plain.dictionary = nullptr;
+    EXPECT_NE(plain.to_string().find("0x2100:0 (an object canmotion does not know)"), std::string::npos)
+        << plain.to_string();
   }
 }
 

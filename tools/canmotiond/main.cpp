@@ -97,6 +97,15 @@ int write_dcfs(const config::Config& cfg, const std::string& dir) {
   return 0;
 }
 
+/// The EDS dictionary of the drive at `node` on bus `bus` (its axis's
+/// drive.eds), or nullptr: notices name its objects by it.
+const canopen::DeviceDictionary* dictionary_of(const rt::Controller& c, std::size_t bus, std::uint8_t node) {
+  for (const rt::AxisSpec& a : c.spec().axes)
+    if (a.config.type == motion::AxisType::CipDrive && a.bus == static_cast<int>(bus) && a.drive.node == node)
+      return a.drive.dictionary.get();
+  return nullptr;
+}
+
 /// Writes the trace and CSV files and prints events; drained from the
 /// controller's rings on a non-RT thread (or inline in --sim).
 class Outputs {
@@ -150,7 +159,8 @@ class Outputs {
       } else if (e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kHeartbeatLost) {
         fmt::print(stderr, "canmotiond: bus {} node {}: heartbeat lost\n", cfg_.buses[e.bus].name, e.node.node);
       } else if (!quiet && e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kObjectAbsent) {
-        fmt::print(stderr, "canmotiond: bus {} {}\n", cfg_.buses[e.bus].name, cia402::describe_notice(e.node));
+        fmt::print(stderr, "canmotiond: bus {} {}\n", cfg_.buses[e.bus].name,
+                   cia402::describe_notice(e.node, dictionary_of(c, e.bus, e.node.node)));
       } else if (e.kind == rt::Event::Kind::kBusState) {
         fmt::print(stderr, "canmotiond: bus {}: state {}\n", cfg_.buses[e.bus].name, static_cast<int>(e.bus_state));
         // On this (housekeeping) thread, never the cycle: rtnetlink, and a
@@ -633,11 +643,13 @@ int main(int argc, char** argv) {
                                            "script ends, or on SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--script", o.script, "motion script to run (see README: Motion scripts)")->check(CLI::ExistingFile);
-  app.add_option("--trace", o.trace, "write every frame on every bus to FILE in candump -L format");
-  app.add_option("--csv", o.csv, "write one row per axis per cycle to FILE");
+  app.add_option("--trace", o.trace, "write every frame on every bus to FILE in candump -L format")->type_name("FILE");
+  app.add_option("--csv", o.csv, "write one row per axis per cycle to FILE")->type_name("FILE");
   app.add_flag("--stats", o.stats, "print cycle statistics once a second and at the end");
-  app.add_option("--socket", o.socket, "serve canmotionctl on this UNIX socket (mode 0660; see tools/canmotionctl/README.md)");
-  app.add_option("--socket-group", o.socket_group, "group owning the --socket file and allowed to use it (default: the daemon's group)");
+  app.add_option("--socket", o.socket, "serve canmotionctl on this UNIX socket (mode 0660; see tools/canmotionctl/README.md)")
+      ->type_name("PATH");
+  app.add_option("--socket-group", o.socket_group, "group owning the --socket file and allowed to use it (default: the daemon's group)")
+      ->type_name("GROUP");
   app.add_option("--sim-rate", o.sim_rate,
                  "with --sim: run at most this many times real time (0 = as fast as possible; default 0, or 1 "
                  "with --socket so that canmotionctl users see motion at its real speed)")
@@ -648,7 +660,8 @@ int main(int argc, char** argv) {
                "opens no bus or socket");
   app.add_option("--write-dcf", o.write_dcf,
                  "write DIR/<axis>.dcf per CANopen axis: the SDO writes of its boot configuration (PDOs, 0x60C2, "
-                 "heartbeats, sdo_writes) as a CiA 306 DCF for review, then exit; opens no bus");
+                 "heartbeats, sdo_writes) as a text DCF (CiA 306 INI format) for review, then exit; opens no bus")
+      ->type_name("DIR");
   app.footer(
       "Examples:\n"
       "  canmotiond --config config/examples/demo.yaml --sim --script config/examples/demo.script\n"
