@@ -624,6 +624,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
 // Called once per drive per cycle from step() only: inlined there.
 [[gnu::always_inline]] inline void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
   state_ = decode_state(fb_.statusword);
+  if (state_ != State::kOperationEnabled) leaving_enabled_ = false;  // it acted (or faulted)
   const bool faulted = state_ == State::kFault || state_ == State::kFaultReactionActive;
   if (faulted && !reset_requested_) {
     // (a fault reset that timed out keeps that failure: it says why the drive is still in Fault)
@@ -640,10 +641,15 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   if (state_ != State::kOperationEnabled) follow_actual();
   // A quick stop with 0x605A = 0..4 completes in Switch on disabled (12).
   if (wanted_ == State::kQuickStopActive && state_ == State::kSwitchOnDisabled) wanted_ = State::kSwitchOnDisabled;
-  if (state_ == wanted_) {
+  // Told to leave Operation enabled, and not shown out of it yet: an
+  // enable() meanwhile is not "reached" on a report that may predate that
+  // command; the command goes on until the drive shows it acted (or its
+  // transition times out), then the enable climbs from where it is.
+  const State target = leaving_enabled() && wanted_ == State::kOperationEnabled ? leave_.expect : wanted_;
+  if (state_ == target) {
     in_flight_ = false;
     reset_requested_ = false;
-    switch (wanted_) {
+    switch (target) {
       case State::kOperationEnabled:
         cw_ = cia402::controlword(Command::kEnableOperation);
         if (homing_step_ == HomingStep::kWaitMode && mode_ == Mode::kHoming && !mode_switch_pending_ &&
@@ -662,13 +668,17 @@ bool DriveProxy::set_mode(Mode m) noexcept {
     }
     return;
   }
-  const auto plan = next_step(state_, wanted_);
+  const auto plan = next_step(state_, target);
+  if (plan && state_ == State::kOperationEnabled && plan->expect != State::kOperationEnabled) {
+    leaving_enabled_ = true;  // 5, 8, 9 or 11 goes out now
+    leave_ = *plan;
+  }
   if (!plan) {
     // Only the drive can move on (not ready, fault reaction) or the wanted
     // state cannot be reached from here: time it like a transition.
     if (!in_flight_ || flight_from_ != state_) {
       in_flight_ = true;
-      flight_ = PlanStep{Command::kDisableVoltage, kNoTransition, wanted_};
+      flight_ = PlanStep{Command::kDisableVoltage, kNoTransition, target};
       flight_from_ = state_;
       flight_since_ns_ = now_ns;
       flight_cycles_ = 0;
@@ -688,9 +698,10 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   if (waited > cfg_.transition_timeout_ns) {
     fail(FailureKind::kTransitionTimeout, now_ns, waited, cfg_.transition_timeout_ns);
     failure_.transition = flight_.transition;
-    failure_.wanted = wanted_;
+    failure_.wanted = target;
     wanted_ = state_;  // stop pushing; enable()/disable() try again
     in_flight_ = false;
+    leaving_enabled_ = false;
     reset_requested_ = false;
     return;
   }
@@ -749,6 +760,7 @@ void DriveProxy::step(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   }
   if (phase_ != Phase::kOperational) {
     sw_read_out_ = sw_read_done_ = false;  // the boot owns the SDO client (a run-time read's result is dropped there)
+    leaving_enabled_ = false;              // a (re)booted drive's first TPDO starts afresh
     // Several boot phases may complete in one cycle (boot-up seen ->
     // configuring queues its first writes at once).
     for (int i = 0; i < 3 && phase_ != Phase::kOperational && phase_ != Phase::kFailed; ++i) {

@@ -411,10 +411,21 @@ class DriveProxy {
   [[nodiscard]] Phase phase() const noexcept { return phase_; }
   [[nodiscard]] State state() const noexcept { return state_; }
   [[nodiscard]] State wanted() const noexcept { return wanted_; }
-  /// True in Operation enabled with the targets taken from the setters.
-  [[nodiscard]] bool enabled() const noexcept { return phase_ == Phase::kOperational && state_ == State::kOperationEnabled; }
+  /// True in Operation enabled with the targets taken from the setters (not
+  /// while leaving_enabled()).
+  [[nodiscard]] bool enabled() const noexcept {
+    return phase_ == Phase::kOperational && state_ == State::kOperationEnabled && !leaving_enabled();
+  }
   /// True while no transition is in progress (the state is the wanted one).
-  [[nodiscard]] bool settled() const noexcept { return state_ == wanted_; }
+  [[nodiscard]] bool settled() const noexcept { return state_ == wanted_ && !leaving_enabled(); }
+  /// The proxy told the drive to leave Operation enabled (transition 5, 8,
+  /// 9 or 11) and no TPDO has shown it out of there yet: its Operation
+  /// enabled may predate that controlword (a drive shows a transition a TPDO
+  /// or more later: it samples at the SYNC before it acts, acts in its own
+  /// cycle, or ramps down first). Until a TPDO shows another state, it is
+  /// not taken as enabled, and a new enable() waits for it (then 2, 3, 4).
+  /// Realtime-safe.
+  [[nodiscard]] bool leaving_enabled() const noexcept { return leaving_enabled_ && state_ == State::kOperationEnabled; }
   [[nodiscard]] const Feedback& feedback() const noexcept { return fb_; }
   [[nodiscard]] Mode mode() const noexcept { return mode_; }
   [[nodiscard]] std::int32_t target_position() const noexcept { return target_position_; }
@@ -514,6 +525,8 @@ class DriveProxy {
   void end_homing(HomingResult r) noexcept;
   // The transition in progress.
   bool in_flight_ = false;
+  bool leaving_enabled_ = false;       // leaving_enabled(): a command out of Operation enabled went out
+  PlanStep leave_{Command::kDisableVoltage, kNoTransition, State::kUnknown};  // that command
   PlanStep flight_{Command::kShutdown, kNoTransition, State::kUnknown};
   State flight_from_ = State::kUnknown;
   std::int64_t flight_since_ns_ = 0;

@@ -1185,18 +1185,23 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
   ++counters_.syncs;
   const bool operational = nmt_ == canopen::NmtState::kOperational;
   // Synchronous RPDOs received since the last SYNC take effect now.
+  bool cw_written = false;
   if (operational) {
-    bool cw_written = false;
     for (unsigned pending = rpdo_pending_; pending != 0; pending &= pending - 1) {  // ascending
       const auto p = static_cast<std::size_t>(std::countr_zero(pending));
       // The latched frame was at least rpdo_[p].size_bytes long (checked in on_frame).
       cw_written = apply_rpdo(p, rpdo_latch_[p]) || cw_written;
     }
     rpdo_pending_ = 0;
-    // Strict: the controlword is evaluated at every SYNC, so that 4 follows 3.
-    if (cw_written || cfg_.behaviour.one_transition_per_sync) evaluate_controlword(out);
-    update_mode_display();
   }
+  // The drive application runs in every NMT state that processes SYNC (CiA
+  // 301: the NMT state gates communication, here the RPDOs above, not the
+  // CiA 402 device): strict, the controlword is evaluated at every SYNC, so
+  // that 4 follows 3 also for a controlword written over SDO in
+  // pre-operational; and 0x6061 follows 0x6060 there too (found by
+  // tests/peers/conformance.py against cia402-emu, vcan.peer.conformance_emu).
+  if (cw_written || cfg_.behaviour.one_transition_per_sync) evaluate_controlword(out);
+  update_mode_display();
   if (cfg_.fail_after_syncs != 0 && counters_.syncs == cfg_.fail_after_syncs) pending_fault_ = cfg_.fail_emcy_code;
   // Motor: advances by the interpolation period 0x60C2, only here.
   const cia402::InterpolationPeriod ip{static_cast<std::uint8_t>(val(hot_.ip_value)),

@@ -238,7 +238,10 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   }
   ax.prev_counts = d.position;
   ax.have_prev = d.tpdo_count > 0;
-  f.drive = drive_state_of(p.state(), operational);
+  // Operation enabled that may predate a command out of it (the drive has not
+  // shown the transition yet, DriveProxy::leaving_enabled) is not Enabled:
+  // an MSO then waits for the drive to leave it and be enabled again.
+  f.drive = drive_state_of(p.state(), operational && !p.leaving_enabled());
   using FK = cia402::FailureKind;
   const FK kind = p.failure().kind;
   // A refused mode switch (0x6061 never showed the mode, drive.timeouts.mode_switch_ms)

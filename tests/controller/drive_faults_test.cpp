@@ -372,6 +372,67 @@ TEST_P(NmtStateWhileRunning, FaultsTheAxisAtTheHeartbeatAndMasrRestartsTheNode) 
 
 INSTANTIATE_TEST_SUITE_P(DriveFaults, NmtStateWhileRunning, ::testing::Values(std::uint8_t{0x80}, std::uint8_t{0x02}));
 
+// A drive that left NMT operational keeps its CiA 402 state: here Operation
+// enabled (no fault: another tool's NMT enter pre-operational). After MASR
+// its first TPDOs still show Operation enabled while canmotiond, the axis
+// being servo off, sends Disable voltage. A drive does not always show a
+// commanded transition in the next TPDO: tests/peers/cia402_peer.py samples
+// its TPDO at the SYNC before it acts on that SYNC's controlword, a drive
+// may act in its own slower cycle, or leave Operation enabled only after a
+// ramp (0x605B/0x605C). Here the RPDOs reach the drive 2.5 cycles late: it
+// shows each controlword's effect 3 TPDOs later. An MSO issued right after
+// MASR's DN must not end DN on a report from before the Disable voltage:
+// the drive then takes it (transition 9) and sits in Switch on disabled
+// while MSO said DN; the axis switched itself off at the next TPDO and the
+// MAM ended with ERR 5, servo off (found by vcan.peer.nmt_preop, where the
+// Python peer lagged several cycles in the VM). The enable waits until the
+// drive has shown that it left Operation enabled, then goes 2, 3, 4.
+TEST(DriveFaults, MsoAfterMasrWaitsUntilTheStillEnabledDriveWasDisabled) {
+  FaultRig r;
+  r.check_allocations = false;  // the SimBus's delayed-frame queue allocates (test infrastructure, not the cycle)
+  auto& tool = r.world.bus(0).add_endpoint("tool");
+  r.enable_and_jog();
+  can::Frame nmt;
+  nmt.id = 0x000;
+  nmt.len = 2;
+  nmt.data[0] = 0x80;  // enter pre-operational
+  nmt.data[1] = kNode;
+  ASSERT_EQ(tool.send(nmt), can::SendResult::kOk);
+  ASSERT_TRUE(r.run_until([&] { return module_fault(r.read("X.AxisFault")); }, 1000));
+  ASSERT_EQ(r.world.drive(0).state(), cia402::State::kOperationEnabled);
+  can::SimFault late;
+  late.cob_id = 0x200u + kNode;
+  late.action = can::SimFault::Action::kDelay;
+  late.count = 0;  // every RPDO1 from now on
+  late.delay_ns = 2 * kPeriod + kPeriod / 2;
+  r.world.bus(0).add_fault(late);
+  const std::size_t cw_before = r.cw.size();
+  r.exec("MASR(X, rst)");
+  ASSERT_TRUE(r.run_until([&] { return r.read("rst.DN") != 0.0 || r.read("rst.ER") != 0.0; }, 5000));
+  ASSERT_EQ(r.read("rst.DN"), 1.0) << "MASR ERR " << r.read("rst.ERR") << "; " << r.axis().failure.to_string();
+  r.exec("MSO(X, mso2)");
+  ASSERT_TRUE(r.run_until([&] { return r.read("mso2.DN") != 0.0 || r.read("mso2.ER") != 0.0; }, 3000));
+  ASSERT_EQ(r.read("mso2.DN"), 1.0) << "MSO ERR " << r.read("mso2.ERR") << " EXERR " << r.read("mso2.EXERR");
+  // The drive took the Disable voltage and was enabled again (9, then 2, 3, 4).
+  bool disabled = false;
+  for (std::size_t i = cw_before; i < r.cw.size(); ++i) disabled = disabled || r.cw[i].second == 0x0000;
+  EXPECT_TRUE(disabled) << "no Disable voltage sent after MASR";
+  r.cycles(20);
+  EXPECT_EQ(r.world.drive(0).state(), cia402::State::kOperationEnabled);
+  EXPECT_EQ(r.read("X.DriveEnableStatus"), 1.0) << "the axis switched itself off after MSO's DN";
+  const double target = r.read("X.ActualPosition") + 5.0;
+  char mam[256];
+  std::snprintf(mam, sizeof mam,
+                "MAM(X, mam2, Absolute, %.6f, 20, UnitsPerSec, 200, UnitsPerSec2, 200, UnitsPerSec2, Trapezoidal, "
+                "100, 100, %%ofTime, Disabled, Programmed, 0, None, 0, 0)",
+                target);
+  r.exec(mam);
+  ASSERT_TRUE(r.run_until([&] { return r.read("mam2.PC") != 0.0 || r.read("mam2.ER") != 0.0; }, 5000));
+  ASSERT_EQ(r.read("mam2.PC"), 1.0) << "MAM ERR " << r.read("mam2.ERR");
+  r.cycles(50);
+  EXPECT_NEAR(r.read("X.ActualPosition"), target, 0.01);
+}
+
 // ---------------------------------------------------------------------------
 // The master's heartbeat no longer reaches a strict drive that watches it
 // (0x1016): the drive faults (EMCY 0x8130) and, per its 0x1029:1 error

@@ -398,6 +398,29 @@ TEST(EmulatorStrict, TransitionsThreeAndFourInTwoSyncs) {
   EXPECT_EQ(p.emu.state(), State::kOperationEnabled) << "permissive: 3 and 4 in one call";
 }
 
+// The CiA 402 application does not depend on the NMT state (CiA 301: NMT
+// gates communication objects): in pre-operational a controlword written over
+// SDO goes on from 3 to 4 at the next SYNC, and 0x6061 follows 0x6060. Found
+// by tests/peers/conformance.py against cia402-emu (vcan.peer.conformance_emu):
+// the strict drive stopped in Switched on and kept showing the old mode.
+TEST(EmulatorStrict, ApplicationRunsInPreOperational) {
+  Drive s(Drive::strict());
+  s.boot();
+  ASSERT_EQ(s.emu.nmt_state(), canopen::NmtState::kPreOperational);
+  ASSERT_TRUE(s.command(0x0006, State::kReadyToSwitchOn));
+  s.write(0x6040, 0, 0x000F, 2);
+  EXPECT_EQ(s.emu.state(), State::kSwitchedOn) << "3 only";
+  s.sync();
+  EXPECT_EQ(s.emu.state(), State::kOperationEnabled) << "4 at the next SYNC, in pre-operational";
+  ASSERT_TRUE(s.command(0x0000, State::kSwitchOnDisabled));
+  ASSERT_EQ(s.write(0x6060, 0, 0, 1), 0u);
+  for (int i = 0; i < 3; ++i) s.sync();
+  EXPECT_EQ(s.emu.mode_display(), 0) << "0x6061 follows 0x6060 = 0 in pre-operational";
+  ASSERT_EQ(s.write(0x6060, 0, 8, 1), 0u);
+  for (int i = 0; i < 3; ++i) s.sync();
+  EXPECT_EQ(s.emu.mode_display(), 8);
+}
+
 TEST(EmulatorStrict, FaultResetRefusedWhileTheCauseRemains) {
   Drive s(Drive::strict());
   s.boot();

@@ -683,6 +683,12 @@ class Drive:
         self._now = now
         return self._boot(now)
 
+    def power_on(self, now: float) -> list:
+        """Power on again after a power-off: every default (as at
+        construction; the position is kept), then the boot-up."""
+        self._power_on()
+        return self.start(now)
+
     def _boot(self, now: float) -> list:
         self.nmt = PREOPERATIONAL
         self.booted = True
@@ -1064,6 +1070,9 @@ COMMANDS_HELP = """Control commands (one per line on --control FIFO or stdin):
                         without its process dying); `resume` undoes it
   nmt preop|stop|op     a local NMT transition (as on a communication error)
   reset                 power cycle: NMT reset node (boot-up sent)
+  power off|on          power off: no frames in or out, no timers (the
+                        drive has no supply); power on: every default, the
+                        boot-up, pre-operational (see --powered-off)
   status                print the CiA 402 and NMT state
   quit                  exit (status 0)
 Signals: SIGUSR1 = `fault`, SIGUSR2 = `reset`, SIGINT/SIGTERM = exit 0."""
@@ -1072,15 +1081,16 @@ Signals: SIGUSR1 = `fault`, SIGUSR2 = `reset`, SIGINT/SIGTERM = exit 0."""
 class Runner:
     """Moves frames between a python-can bus and a Drive."""
 
-    def __init__(self, drive: Drive, bus, clock=time.monotonic, out=sys.stdout):
+    def __init__(self, drive: Drive, bus, clock=time.monotonic, out=sys.stdout, powered=True):
         self.drive, self.bus, self.clock, self.out = drive, bus, clock, out
         self.silent = False
+        self.powered = powered            # False: no supply, nothing in or out until `power on`
         self.stop = False
         self.sent = 0
 
     def send(self, frames):
         import can   # here, not at the top: the trace checks import this module without python-can
-        if self.silent:
+        if self.silent or not self.powered:
             return
         for can_id, data in frames:
             msg = can.Message(arbitration_id=can_id, data=data, is_extended_id=False)
@@ -1095,10 +1105,21 @@ class Runner:
                     time.sleep(0.001)
 
     def start(self, now=None):
+        if not self.powered:
+            self.drive.log('powered off: no frames in or out until `power on`')
+            return
         self.send(self.drive.start(self.clock() if now is None else now))
 
+    def tick(self, now: float):
+        if self.powered:
+            self.send(self.drive.tick(now))
+
+    def next_deadline(self):
+        """The drive's next timer; None while powered off (no timers run)."""
+        return self.drive.next_deadline() if self.powered else None
+
     def handle(self, msg, now: float):
-        if self.silent or msg.is_error_frame or msg.is_remote_frame or msg.is_extended_id:
+        if self.silent or not self.powered or msg.is_error_frame or msg.is_remote_frame or msg.is_extended_id:
             return
         self.send(self.drive.on_frame(msg.arbitration_id, bytes(msg.data), now))
 
@@ -1110,7 +1131,7 @@ class Runner:
             if msg is None:
                 break
             self.handle(msg, self.clock() if now is None else now)
-        self.send(self.drive.tick(self.clock() if now is None else now))
+        self.tick(self.clock() if now is None else now)
 
     def command(self, line: str):
         words = line.split()
@@ -1133,6 +1154,14 @@ class Runner:
                 d.local_nmt({'preop': PREOPERATIONAL, 'stop': STOPPED, 'op': OPERATIONAL}[words[1]])
             elif words[0] == 'reset':
                 self.send(d.on_frame(NMT_ID, bytes([NMT_RESET_NODE, d.node]), now))
+            elif words[0] == 'power' and len(words) == 2 and words[1] in ('on', 'off'):
+                if words[1] == 'off':
+                    self.powered = False
+                    d.log('power off: no frames in or out')
+                elif not self.powered:
+                    self.powered = True
+                    d.log('power on')
+                    self.send(d.power_on(now))
             elif words[0] == 'status':
                 print(f'cia402_peer node {d.node}: {d.summary()}', file=self.out, flush=True)
             elif words[0] == 'quit':
@@ -1141,7 +1170,7 @@ class Runner:
                 raise ValueError('unknown command')
         except (ValueError, IndexError) as e:
             print(f"cia402_peer: control: '{line.strip()}': {e} (commands: fault, clear, silence, resume, "
-                  f"nmt, reset, status, quit)", file=sys.stderr, flush=True)
+                  f"nmt, reset, power, status, quit)", file=sys.stderr, flush=True)
 
     def run(self, control_fd=None, duration=None):
         """Serve until quit, a signal (self.stop) or `duration` seconds."""
@@ -1156,7 +1185,7 @@ class Runner:
             now = self.clock()
             if t_end is not None and now >= t_end:
                 break
-            deadline = self.drive.next_deadline()
+            deadline = self.next_deadline()
             wait = 0.1 if deadline is None else max(0.0, min(0.1, deadline - now))
             if t_end is not None:
                 wait = min(wait, max(0.0, t_end - now))
@@ -1193,7 +1222,7 @@ class Runner:
                     self.command(line.decode(errors='replace'))
                 if not chunk and control_fd == 0:
                     control_fd = None     # stdin closed
-            self.send(self.drive.tick(self.clock()))
+            self.tick(self.clock())
 
 
 def open_control(path: str):
@@ -1234,6 +1263,9 @@ Exit status: 0 after quit, SIGINT/SIGTERM or --duration; 1 on errors (bus, argum
                     help='EMCY code of `fault` and SIGUSR1 (default 0xFF00)')
     ap.add_argument('--sdo-timeout-ms', type=int, default=1000, help='segmented transfer timeout (default 1000)')
     ap.add_argument('--control', metavar='PATH', help="control channel: a FIFO path, or '-' for stdin")
+    ap.add_argument('--powered-off', action='store_true',
+                    help='start without power: silent (no boot-up, nothing answered) until the control command '
+                         '`power on` (a drive switched on after the master)')
     ap.add_argument('--duration', type=float, help='exit after this many seconds')
     ap.add_argument('-v', '--verbose', action='store_true', help='print NMT, CiA 402, PDO, SDO-abort and EMCY events')
     a = ap.parse_args(argv)
@@ -1266,7 +1298,7 @@ def main(argv=None) -> int:
         return 1
     drive = Drive(a.node, a.rpdos, a.tpdos, a.position, a.heartbeat_ms, a.consumer_heartbeat, a.fault_code,
                   a.sdo_timeout_ms / 1000.0, log)
-    runner = Runner(drive, bus)
+    runner = Runner(drive, bus, powered=not a.powered_off)
 
     def on_stop(signum, frame):
         runner.stop = True
@@ -1278,7 +1310,7 @@ def main(argv=None) -> int:
     control = open_control(a.control) if a.control else None
     print(f'cia402_peer: node {a.node} on {a.interface}: {a.rpdos} RPDO, {a.tpdos} TPDO, position {a.position}, '
           f"0x1016 {'with %d entries' % a.consumer_heartbeat if a.consumer_heartbeat else 'absent'}"
-          f"{', control ' + a.control if a.control else ''}", flush=True)
+          f"{', control ' + a.control if a.control else ''}{', powered off' if a.powered_off else ''}", flush=True)
     try:
         runner.run(control, a.duration)
     finally:

@@ -91,7 +91,7 @@ class VirtualLink(Link):
 
     def step(self, t_end):
         """Advance to the peer's next timer, or to t_end."""
-        deadline = self.drive.next_deadline()
+        deadline = self.runner.next_deadline()
         if deadline is not None and deadline <= self.t and deadline == getattr(self, '_stuck', None):
             raise AssertionError(f'peer timer at {deadline} does not fire at {self.t}')
         self._stuck = deadline if deadline is not None and deadline <= self.t else None

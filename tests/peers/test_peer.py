@@ -532,6 +532,31 @@ class ControlAndCli(PeerCase):
         self.link.runner.command('reset')
         self.assertEqual(self.frames(HB)[-1][2], b'\x00')
 
+    def test_power_off_and_on(self):
+        # Power off: nothing in or out, no heartbeat, SDO unanswered, NMT
+        # ignored; power on: the boot-up (one byte 00h), pre-operational,
+        # every default again (0x1017 back to --heartbeat-ms), position kept.
+        self.make(heartbeat_ms=10, position=777)
+        self.sdo.write(0x1017, 0, 20, '<H')
+        self.nmt(0x01)
+        self.link.runner.command('power off')
+        self.frames(HB)
+        self.link.advance(0.1)
+        self.nmt(0x81)
+        self.link.send(0x600 + NODE, struct.pack('<BHB4x', 0x40, 0x1000, 0))
+        self.link.advance(0.05)
+        self.assertEqual(self.frames(HB), [])
+        self.assertEqual(self.frames(0x580 + NODE), [])
+        self.link.runner.command('power on')
+        self.assertEqual([f[2] for f in self.frames(HB)], [b'\x00'])
+        self.assertEqual(self.drive.nmt, peer.PREOPERATIONAL)
+        self.assertEqual(self.sdo.read(0x1017, 0, '<H'), 10)
+        self.assertEqual(self.sdo.read(0x6064, 0, '<i'), 777)
+        self.link.advance(0.1)
+        self.assertEqual({f[2] for f in self.frames(HB)}, {b'\x7f'})
+        self.link.runner.command('power on')          # already on: nothing
+        self.assertEqual(self.frames(HB), [])
+
     def test_bad_command(self):
         import contextlib
         import io
@@ -550,7 +575,8 @@ class ControlAndCli(PeerCase):
     def test_help(self):
         r = self.run_cli('--help')
         self.assertEqual(r.returncode, 0)
-        for word in ('--control', '--position', '--consumer-heartbeat', 'fault [CODE] [hold]', 'Exit status'):
+        for word in ('--control', '--position', '--consumer-heartbeat', '--powered-off', 'fault [CODE] [hold]',
+                     'power off|on', 'Exit status'):
             self.assertIn(word, r.stdout)
 
     def test_bad_arguments(self):
@@ -559,6 +585,15 @@ class ControlAndCli(PeerCase):
         self.assertIn('--node 0: a node-ID is 1..127', r.stderr)
         r = self.run_cli('-i', 'vcan0', '-n', '5', '--rpdos', '9')
         self.assertEqual(r.returncode, 2)
+
+    def test_powered_off_run(self):
+        # --powered-off: the program runs, but the drive sends nothing (no boot-up) until `power on`.
+        r = self.run_cli('-i', 'peer-cli-test-off', '--bus-type', 'virtual', '-n', '5', '--heartbeat-ms', '10',
+                         '--powered-off', '--duration', '0.2', '-v')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn('powered off: no frames in or out', r.stdout)
+        self.assertIn(', powered off', r.stdout)
+        self.assertNotIn('boot-up, NMT pre-operational', r.stdout)   # never booted (the summary says NMT boot-up)
 
     def test_virtual_bus_run(self):
         # The whole program on python-can's virtual bus: boot-up, then exit at --duration.

@@ -3,14 +3,19 @@
 # $CANMOTION_TRACE): canmotiond against the independent peer as separate
 # processes.
 #   vcan-peer-run.sh SCENARIO CANMOTIOND [PEER_OPTION...]
-# SCENARIO is boot_enable_move, fault_recovery or vanish (scenarios/*.script).
+# SCENARIO is boot_enable_move, fault_recovery, vanish, nmt_preop or
+# boot_late (scenarios/*.script).
 # 1. the peer powers up (/usr/bin/python3 cia402_peer.py -i vcan0 -n 5
 #    --position 123456 --heartbeat-ms 100 --control FIFO -v PEER_OPTION...),
 #    then canmotiond
 #    --config vcan.yaml --script scenarios/SCENARIO.script --csv, real time;
+#    boot_late: the peer process starts first but --powered-off (silent);
 # 2. fault_recovery: after canmotiond printed the `X.JogStatus` line, the
-#    peer gets `fault 0xFF00` on its control FIFO; vanish: the peer is
+#    peer gets `fault 0xFF00` on its control FIFO; nmt_preop: `nmt preop`
+#    there (it leaves NMT operational by itself); vanish: the peer is
 #    killed with SIGKILL at that point (the kill time is logged);
+#    boot_late: 0.5 s after canmotiond's first `X.Statusword` line the peer
+#    gets `power on` (boot-up, pre-operational);
 # 3. canmotiond's exit status goes to canmotiond.status (vcan_peer_check.py
 #    fails on anything but 0, after its analysis of the trace); then the
 #    peer is stopped (SIGTERM: it prints its summary); run-vcan-test lets
@@ -45,16 +50,23 @@ trap cleanup EXIT
 # than canmotiond waits for a boot-up. It sends a heartbeat (0x1017 = 100 ms
 # until canmotiond writes its own), so canmotiond finds it in
 # pre-operational and configures it without waiting for a boot-up.
+# boot_late: the process starts first too (for that minute), but without
+# power: nothing in or out until `power on`, after canmotiond is running.
+ready='boot-up, NMT pre-operational'
+if [[ $scenario == boot_late ]]; then
+  peer_opts=(--powered-off "${peer_opts[@]}")
+  ready='powered off: no frames in or out'
+fi
 /usr/bin/python3 "$here/cia402_peer.py" -i vcan0 -n 5 --position 123456 --heartbeat-ms 100 --control "$ctl" -v \
   "${peer_opts[@]}" \
   > "$art/peer.log" 2>&1 &
 ppid_=$!
 for ((i = 0; i < 2400; i++)); do
-  grep -q 'boot-up, NMT pre-operational' "$art/peer.log" && break
+  grep -q "$ready" "$art/peer.log" && break
   kill -0 "$ppid_" 2>/dev/null || break
   sleep 0.1
 done
-grep -q 'boot-up, NMT pre-operational' "$art/peer.log" || { cat "$art/peer.log" >&2; fail "the peer did not start"; }
+grep -q "$ready" "$art/peer.log" || { cat "$art/peer.log" >&2; fail "the peer did not start"; }
 event "peer started (pid $ppid_)"
 timeout -s INT -k 30 120 stdbuf -oL "$daemon" --config "$art/vcan.yaml" --script "$script" --csv "$art/canmotiond.csv" \
   > "$ctl_dir/canmotiond.log" 2>&1 &
@@ -62,16 +74,31 @@ dpid=$!
 event "canmotiond started (pid $dpid)"
 echo "vcan-peer-run: $scenario: the peer (node 5, position 123456${peer_opts[*]:+, ${peer_opts[*]}}), then canmotiond"
 
-if [[ $scenario == fault_recovery || $scenario == vanish ]]; then
+wait_line() {  # wait_line REGEX: canmotiond printed it (true), or it exited / 1200 polls (false)
   for ((i = 0; i < 1200; i++)); do
-    grep -q 'X.JogStatus=' "$ctl_dir/canmotiond.log" && break
+    grep -q "$1" "$ctl_dir/canmotiond.log" && return 0
     kill -0 "$dpid" 2>/dev/null || break
     sleep 0.05
   done
-  if grep -q 'X.JogStatus=' "$ctl_dir/canmotiond.log"; then
+  grep -q "$1" "$ctl_dir/canmotiond.log"
+}
+if [[ $scenario == boot_late ]]; then
+  if wait_line 'X.Statusword='; then
+    sleep 0.5                      # canmotiond runs (SYNC, its waits for the node) before the drive has power
+    echo 'power on' > "$ctl"
+    event "peer: power on"
+  else
+    event "no 'X.Statusword=' line from canmotiond (it exited, or 1200 polls): the peer stays off"
+  fi
+fi
+if [[ $scenario == fault_recovery || $scenario == vanish || $scenario == nmt_preop ]]; then
+  if wait_line 'X.JogStatus='; then
     if [[ $scenario == fault_recovery ]]; then
       echo 'fault 0xFF00' > "$ctl"
       event "peer: fault 0xFF00 injected"
+    elif [[ $scenario == nmt_preop ]]; then
+      echo 'nmt preop' > "$ctl"
+      event "peer: nmt preop"
     else
       kill -KILL "$ppid_"
       event "peer killed (SIGKILL)"

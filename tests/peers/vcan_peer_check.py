@@ -99,6 +99,14 @@ class Check:
             out.append((t, index, sub, value, result))
         return out
 
+    @staticmethod
+    def unused_pdo(x):
+        """A write the peer may refuse with 0602 0000h, its right answer:
+        disabling a PDO it does not have (it has 2 + 2), 0x1006 = 0 or 0x1019
+        (optional objects it lacks)."""
+        return x[4] == 0x06020000 and ((x[2] == 1 and x[3] >> 31 and (0x1400 <= x[1] <= 0x15FF or 0x1800 <= x[1] <= 0x19FF))
+                                       or (x[1] == 0x1006 and x[2] == 0 and x[3] == 0) or (x[1] == 0x1019 and x[2] == 0))
+
     def printed(self, tag):
         return re.findall(rf'\b{re.escape(tag)}=(\S+)', self.log)
 
@@ -118,9 +126,7 @@ class Check:
         # So is 0602 0000h to 0x1006 = 0 and 0x1019 (the SYNC consumer's cycle
         # period and counter overflow, optional in CiA 301; the peer has
         # neither and ignores a SYNC counter byte: issue 15 item 5).
-        tolerated = [x for x in xs if x[4] == 0x06020000 and
-                     ((x[2] == 1 and x[3] >> 31 and (0x1400 <= x[1] <= 0x15FF or 0x1800 <= x[1] <= 0x19FF))
-                      or (x[1] == 0x1006 and x[2] == 0 and x[3] == 0) or (x[1] == 0x1019 and x[2] == 0))]
+        tolerated = [x for x in xs if self.unused_pdo(x)]
         aborts = [x for x in xs if x[4] and x not in tolerated]
         peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
         t_gone = max(t for t, i, _ in self.t.frames if i in peer_ids)
@@ -260,6 +266,119 @@ class Check:
         got = self.printed('X.AxisFault')
         self.item(got[:2] == ['1', '0'], 'X.AxisFault 1 after the EMCY, 0 after MAFR + MSO', f'{got}')
 
+    def live_boot(self):
+        """boot_late: canmotiond was running before the peer had power; the
+        peer's first frame is its boot-up, seen live (not adopted from a
+        heartbeat), and canmotiond sent no SDO to it before."""
+        peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
+        peer = [f for f in self.t.frames if f[1] in peer_ids]
+        first = peer[0] if peer else None
+        before = [f for f in self.t.frames if first is None or f[0] < first[0]]
+        n_sync = sum(1 for f in before if f[1] == self.SYNC)
+        nmt = [f'000#{f[2].hex().upper()}' for f in before if f[1] == 0x000]
+        on = re.search(r'^(\d+\.\d+) peer: power on', self.read('events.log'), re.M)
+        ok = first is not None and first[1] == self.HB and first[2] == b'\x00' and n_sync > 0 and bool(on)
+        self.item(ok, 'live boot-up', (f"the peer's first frame 0x{first[1]:03X}#{first[2].hex().upper()}" if first
+                                        else 'no frame from the peer') +
+                  f', after {len(before)} frames of canmotiond ({n_sync} SYNC; NMT {", ".join(nmt) or "none"})' +
+                  (f'; power on at {on.group(1)}, boot-up {1e3 * (first[0] - float(on.group(1))):.1f} ms later'
+                   if on and first else '; no power-on event'), around=first[0] if first else None)
+        early = [f for f in before if f[1] == self.SDO_REQ]
+        self.item(not early, 'no SDO to the node before its boot-up', f'{len(early)} SDO request(s) before it')
+        boots = re.findall(r'boot-up, NMT pre-operational', self.peer_log)
+        print(f'vcan-peer-check: info: the peer booted {len(boots)} time(s) (NMT reset node by canmotiond counts too)')
+
+    def nmt_preop(self, t_start):
+        """nmt_preop: the peer left NMT operational by itself while jogging;
+        the axis faults at its next heartbeat (7Fh), canmotiond reads its
+        statusword over SDO; MASR configures and starts it again without
+        NMT reset node; MSO re-enables it without a jump; a 10 mm MAM."""
+        ev = re.search(r'^(\d+\.\d+) peer: nmt preop', self.read('events.log'), re.M)
+        hb = self.t.of(self.HB, t_start)
+        k = next((i for i, f in enumerate(hb) if f[2] == b'\x05'), None)
+        t_hb = next((f[0] for f in hb[k:] if f[2] == b'\x7f'), None) if k is not None else None
+        left = 'NMT operational -> pre-operational' in self.peer_log
+        if not self.item(bool(ev) and left and t_hb is not None, 'peer left NMT operational',
+                         (f'`nmt preop` at {ev.group(1)}; ' if ev else 'no `nmt preop` event; ') +
+                         (f'its heartbeat 7Fh at +{1e3 * (t_hb - float(ev.group(1))):.1f} ms' if t_hb and ev
+                          else 'no heartbeat 7Fh after 05h') + ('' if left else '; not in peer.log')):
+            return
+        starts = [f[0] for f in self.t.of(0x000, t_hb) if f[2] in (bytes([1, self.a.node]), b'\x01\x00')]
+        t_start2 = starts[0] if starts else None
+        late_tpdo = self.tpdos(t_hb, t_start2)
+        self.item(not late_tpdo, 'no TPDO1 while pre-operational', f'{len(late_tpdo)} TPDO1 between the 7Fh heartbeat '
+                  'and the next NMT start')
+        # The reaction, counted in SYNCs on the bus (the VM misses deadlines):
+        # the statusword read over SDO and the servo off (controlword bit 3 clear).
+        reads = [f for f in self.t.of(self.SDO_REQ, t_hb) if f[2][:4] == bytes([0x40, 0x41, 0x60, 0x00])]
+        t_read = reads[0][0] if reads else None
+        rsp = next((f for f in self.t.of(self.SDO_RSP, t_read) if f[2][1:4] == bytes([0x41, 0x60, 0x00])), None) \
+            if t_read else None
+        n_read = len(self.t.of(self.SYNC, t_hb, t_read)) if t_read else None
+        sw = struct.unpack_from('<H', rsp[2], 4)[0] if rsp and rsp[2][0] >> 5 == 2 else None
+        self.item(t_read is not None and n_read <= 3 and sw is not None, 'statusword read over SDO at the heartbeat',
+                  (f'0x6041 read {n_read} SYNC(s) after the 7Fh heartbeat ({1e3 * (t_read - t_hb):.1f} ms in the VM), '
+                   + (f'answer 0x{sw:04X} ({state_of(sw)})' if sw is not None else 'no answer')) if t_read
+                  else 'no SDO read of 0x6041 after the 7Fh heartbeat', around=t_read or t_hb)
+        rp = self.rpdos(t_hb, t_start2)
+        off = next((t for t, cw, _ in rp if not cw & 0x08), None)
+        print(f'vcan-peer-check: info: {len(rp)} RPDO1 sent while the node was pre-operational' +
+              (f'; servo off (bit 3 = 0) {len(self.t.of(self.SYNC, t_hb, off))} SYNC(s) after the 7Fh heartbeat'
+               if off else ''))
+        # Said at the heartbeat, and again with the state read over SDO (the
+        # scenario waits 0.5 s before MASR, which would drop a pending read).
+        msgs = re.findall(r'node \d+: left NMT operational: its heartbeat shows pre-operational[^\n]*', self.log)
+        want = f'the drive is in {state_of(sw)}' if sw is not None else None
+        read = [m_ for m_ in msgs if 'read over SDO' in m_]
+        self.item(bool(read) and want is not None and want.lower() in read[0].lower(),
+                  "canmotiond: 'left NMT operational', with the statusword read",
+                  f'{len(msgs)} message(s); ' + (read[0] if read else (msgs[-1] if msgs else 'none')))
+        fault, module, jog = self.printed('X.AxisFault'), self.printed('X.ModuleFault'), self.printed('X.JogStatus')
+        self.item(fault[:1] not in ([], ['0']) and module[:1] == ['1'] and jog[-1:] == ['0'],
+                  'axis faulted (ModuleFault), jog stopped', f'AxisFault {fault}, ModuleFault {module}, JogStatus {jog}')
+        # Recovery: MASR runs the configuration and NMT start again, without
+        # NMT reset node (the drive keeps its position and its state).
+        resets = [f for f in self.t.of(0x000, t_hb) if f[2][0] in (0x81, 0x82)]
+        boots = [f for f in self.t.of(self.HB, t_hb) if f[2] == b'\x00']
+        self.item(not resets and not boots, 'no NMT reset, no boot-up', f'{len(resets)} NMT reset(s), '
+                  f'{len(boots)} boot-up(s) after the 7Fh heartbeat')
+        if not self.item(t_start2 is not None, 'NMT start again (MASR)',
+                         f'{1e3 * (t_start2 - t_hb):.1f} ms after the 7Fh heartbeat' if t_start2 else 'none'):
+            return
+        xs = [x for x in self.sdo_transfers() if t_hb < x[0] < t_start2]
+        written = {(i, s): v for _, i, s, v, c in xs if c == 0}
+        aborts = [x for x in xs if x[4] and not self.unused_pdo(x)]
+        self.item(written.get((0x6060, 0)) == 8 and not aborts, 'configured again before the NMT start',
+                  f'{len(xs)} SDO writes, 0x6060 = {written.get((0x6060, 0))}, {len(aborts)} aborted')
+        self.item(self.printed('masr1.DN')[:1] == ['1'], 'MASR DN', f'{self.printed("masr1.DN")}')
+        # Re-enable: the drive was left in Operation enabled by its NMT
+        # change; the axis is servo off, so canmotiond takes it out of
+        # Operation enabled, and MSO enables it again, at the position it holds.
+        states = []
+        for t, sw_, p in self.tpdos(t_start2):
+            st = state_of(sw_)
+            if not states or states[-1][1] != st:
+                states.append((t, st, p))
+        names = [s_ for _, s_, _ in states]
+        oe = [i for i, n in enumerate(names) if n == 'operation enabled']
+        re_en = next((i for i in oe if i > 0), None)
+        self.item(re_en is not None, 'disabled, then re-enabled by MSO', ' -> '.join(names[:8]) or 'no TPDO1')
+        if re_en is None:
+            return
+        t_oe = states[re_en][0]
+        p0 = states[0][2]
+        held_t = {p for _, _, p in self.rpdos(t_start2, t_oe + 0.2)}
+        held_p = {p for _, _, p in self.tpdos(t_start2, t_oe + 0.2)}
+        enables = re.findall(r'operation enabled at position (-?\d+), first set-point (-?\d+)', self.peer_log)
+        self.item(held_t <= {p0} and held_p == {p0} and len(enables) >= 2 and enables[-1][0] == enables[-1][1],
+                  're-enable without a jump', f'position {p0} at the NMT start; RPDO1 targets {sorted(held_t)[:6]}, '
+                  f'TPDO1 positions {sorted(held_p)[:6]} until 200 ms after Operation enabled; peer: {enables[-1:]}',
+                  around=t_oe)
+        tp = self.tpdos()
+        self.item(tp[-1][2] == p0 + 10000, 'MAM after the recovery arrives exactly',
+                  f'last TPDO1 position {tp[-1][2]} (want {p0} + 10000)')
+        self.item(fault[-1:] == ['0'], 'X.AxisFault 0 after MASR + MSO', f'{fault}')
+
     def vanish(self, t_start):
         peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
         killed = re.search(r'^(\d+\.\d+) peer killed', self.read('events.log'), re.M)
@@ -300,7 +419,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0],
                                  epilog='Environment: CANMOTION_TRACE, CANMOTION_ARTIFACTS, CANMOTION_BUILD_DIR '
                                         '(run-vcan-test); PEER_SYNC_MEAN_MAX (1.5), PEER_VANISH_SLACK_MS (100).')
-    ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish'))
+    ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish', 'nmt_preop', 'boot_late'))
     ap.add_argument('--period-ms', type=float, default=10.0)
     ap.add_argument('--node', type=int, default=5)
     ap.add_argument('--start', type=int, default=123456, help='the peer\'s --position')
@@ -308,10 +427,12 @@ def main():
     c = Check(a)
     print(f'vcan-peer-check: {a.scenario}: {len(c.t.frames)} frames in {c.trace_path}')
     c.status()
+    if a.scenario == 'boot_late':
+        c.live_boot()
     t_start = c.boot()
     if t_start is not None:
-        oe = c.enable(t_start, 0.4 if a.scenario == 'boot_enable_move' else 0.0)
-        if a.scenario == 'boot_enable_move':
+        oe = c.enable(t_start, 0.4 if a.scenario in ('boot_enable_move', 'boot_late') else 0.0)
+        if a.scenario in ('boot_enable_move', 'boot_late'):
             got, want = c.printed('X.ActualPosition'), f'{a.start / 1000:g}'
             c.item(got[:1] == [want], 'X.ActualPosition after MSO', f'{got[:1]} (want {want})')
             c.sync_period(t_start)
@@ -319,6 +440,8 @@ def main():
                 c.move(a.start, 20000)
         elif a.scenario == 'fault_recovery':
             c.fault_recovery(t_start)
+        elif a.scenario == 'nmt_preop':
+            c.nmt_preop(t_start)
         else:
             c.vanish(t_start)
     print(f"vcan-peer-check: {a.scenario}: {'FAIL (' + ', '.join(c.failed) + ')' if c.failed else 'PASS'}")
