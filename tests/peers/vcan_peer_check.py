@@ -100,7 +100,7 @@ class Check:
         return out
 
     @staticmethod
-    def unused_pdo(x):
+    def tolerated_abort(x):
         """A write the peer may refuse with 0602 0000h, its right answer:
         disabling a PDO it does not have (it has 2 + 2), 0x1006 = 0 or 0x1019
         (optional objects it lacks)."""
@@ -126,7 +126,7 @@ class Check:
         # So is 0602 0000h to 0x1006 = 0 and 0x1019 (the SYNC consumer's cycle
         # period and counter overflow, optional in CiA 301; the peer has
         # neither and ignores a SYNC counter byte: issue 15 item 5).
-        tolerated = [x for x in xs if self.unused_pdo(x)]
+        tolerated = [x for x in xs if self.tolerated_abort(x)]
         aborts = [x for x in xs if x[4] and x not in tolerated]
         peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
         t_gone = max(t for t, i, _ in self.t.frames if i in peer_ids)
@@ -347,7 +347,7 @@ class Check:
             return
         xs = [x for x in self.sdo_transfers() if t_hb < x[0] < t_start2]
         written = {(i, s): v for _, i, s, v, c in xs if c == 0}
-        aborts = [x for x in xs if x[4] and not self.unused_pdo(x)]
+        aborts = [x for x in xs if x[4] and not self.tolerated_abort(x)]
         self.item(written.get((0x6060, 0)) == 8 and not aborts, 'configured again before the NMT start',
                   f'{len(xs)} SDO writes, 0x6060 = {written.get((0x6060, 0))}, {len(aborts)} aborted')
         self.item(self.printed('masr1.DN')[:1] == ['1'], 'MASR DN', f'{self.printed("masr1.DN")}')
