@@ -137,17 +137,13 @@ TEST(OptionalObjects, PeriodTheDrivesUnitCannotExpressFailsNamingObjectValueAndP
   EXPECT_NE(why.find("controller.period_ms"), std::string::npos) << why;
 }
 
-/// The SDO frames of the 0x60C2 fallback, byte for byte (CiA 301 expedited
-/// transfers): download :2 = -3... refused, upload :2, download :1 in ms.
-TEST(OptionalObjects, IpFallbackGoldenSdoBytes) {
-  SimRigConfig c = one_drive();
-  c.cycle_ns = 4'000'000;  // 4 ms: 4 x 10^-3 s, 0x60C2:2 written as -3 and refused read-only
-  SimRig rig(c);
+/// The SDO frames of node 2 about 0x60C2 while the rig boots, as "ID#DATA".
+std::vector<std::string> ip_sdo_frames(SimRig& rig) {
   can::SimBus::Endpoint& spy = rig.bus().add_endpoint("spy");
   std::vector<std::string> sdo;
   std::array<can::TimedFrame, 256> buf{};
   rig.power_on();
-  for (int i = 0; i < 400 && !rig.network().all_operational(); ++i) {
+  for (int i = 0; i < 400 && !rig.network().all_operational() && !rig.network().any_failed(); ++i) {
     rig.step();
     for (std::size_t k; (k = spy.receive(buf)) > 0;)
       for (std::size_t j = 0; j < k; ++j) {
@@ -160,6 +156,16 @@ TEST(OptionalObjects, IpFallbackGoldenSdoBytes) {
         sdo.emplace_back(s);
       }
   }
+  return sdo;
+}
+
+/// The SDO frames of the 0x60C2 fallback, byte for byte (CiA 301 expedited
+/// transfers): download :2 = -3... refused, upload :2, download :1 in ms.
+TEST(OptionalObjects, IpFallbackGoldenSdoBytes) {
+  SimRigConfig c = one_drive();
+  c.cycle_ns = 4'000'000;  // 4 ms: 4 x 10^-3 s, 0x60C2:2 written as -3 and refused read-only
+  SimRig rig(c);
+  const std::vector<std::string> sdo = ip_sdo_frames(rig);
   ASSERT_TRUE(rig.network().all_operational()) << rig.drive(kNode).failure().to_string();
   const std::vector<std::string> golden = {
       "602#2FC2600104000000",  // download 0x60C2:1 = 4
@@ -204,28 +210,6 @@ TEST(OptionalObjects, OptionalExtraWriteSkippedRequiredOneNamesItsKey) {
     EXPECT_NE(why.find("0x2010:1"), std::string::npos) << why;
     EXPECT_NE(why.find("direct_control.ramp.velocity_positive"), std::string::npos) << why;
   }
-}
-
-/// The SDO frames of node 2 about 0x60C2 while the rig boots, as "ID#DATA".
-std::vector<std::string> ip_sdo_frames(SimRig& rig) {
-  can::SimBus::Endpoint& spy = rig.bus().add_endpoint("spy");
-  std::vector<std::string> sdo;
-  std::array<can::TimedFrame, 256> buf{};
-  rig.power_on();
-  for (int i = 0; i < 400 && !rig.network().all_operational() && !rig.network().any_failed(); ++i) {
-    rig.step();
-    for (std::size_t k; (k = spy.receive(buf)) > 0;)
-      for (std::size_t j = 0; j < k; ++j) {
-        const can::Frame& f = buf[j].frame;
-        if ((f.id != 0x600u + kNode && f.id != 0x580u + kNode) || f.len != 8 || f.data[1] != 0xC2 || f.data[2] != 0x60)
-          continue;
-        char s[40];
-        std::snprintf(s, sizeof s, "%03X#%02X%02X%02X%02X%02X%02X%02X%02X", f.id, f.data[0], f.data[1], f.data[2],
-                      f.data[3], f.data[4], f.data[5], f.data[6], f.data[7]);
-        sdo.emplace_back(s);
-      }
-  }
-  return sdo;
 }
 
 /// A drive description with these sub-objects (the master asks it only

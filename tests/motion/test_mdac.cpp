@@ -35,6 +35,19 @@ std::string md_mam(const std::string& ax, const std::string& c, double dist, dou
          "," + lock + ",0,0);";
 }
 
+/// For `cycles` cycles, the axis moves between lo and hi per cycle (no jump,
+/// no stop).
+void expect_steps_between(Rig& r, const char* ax, int cycles, double lo, double hi) {
+  double prev = r.axis(ax).command_position;
+  for (int i = 0; i < cycles; ++i) {
+    r.step();
+    const double p = r.axis(ax).command_position;
+    EXPECT_GE(p - prev, lo - 1e-9) << ax << " cycle " << i;
+    EXPECT_LE(p - prev, hi + 1e-9) << ax << " cycle " << i;
+    prev = p;
+  }
+}
+
 }  // namespace
 
 TEST(Mdac, LinkBitsAndMasterDrivenMoveFollowsMasterTravel) {
@@ -225,14 +238,7 @@ TEST(Mdac, McdOnAMasterDrivenMoveReplansPerMasterUnitWithoutAJump) {
   EXPECT_TRUE(r.tag("c1").dn());
   // 0.5 -> 1.0 u/mu at 10 u/mu^2: 0.05 mu = 5 ms of master travel; no jump:
   // the slave moves at most what 1.0 u/mu of the master's 0.01 u per cycle gives
-  double prev = r.axis("Z").command_position;
-  for (int i = 0; i < 100; ++i) {
-    r.step();
-    const double p = r.axis("Z").command_position;
-    EXPECT_GE(p - prev, 0.005 - 1e-9) << "cycle " << i;
-    EXPECT_LE(p - prev, 0.010 + 1e-9) << "cycle " << i;
-    prev = p;
-  }
+  expect_steps_between(r, "Z", 100, 0.005, 0.010);
   EXPECT_NEAR(r.axis("Z").command_velocity, 10.0, 1e-6);  // 1.0 u/mu x 10 u/s
   EXPECT_TRUE(r.tag("m").ip());
   // time-driven units on the master-driven move: a mode change, refused; the
@@ -270,14 +276,7 @@ TEST(Mdac, McdOnAMasterDrivenJogReplansPerMasterUnitWithoutAJump) {
       << r.tag("c1").err;
   EXPECT_TRUE(r.tag("c1").dn());
   // 0.5 -> 1.0 u/mu at 10 u/mu^2 over the master's 0.01 u per cycle: no jump
-  double prev = r.axis("Z").command_position;
-  for (int i = 0; i < 100; ++i) {
-    r.step();
-    const double p = r.axis("Z").command_position;
-    EXPECT_GE(p - prev, 0.005 - 1e-9) << "cycle " << i;
-    EXPECT_LE(p - prev, 0.010 + 1e-9) << "cycle " << i;
-    prev = p;
-  }
+  expect_steps_between(r, "Z", 100, 0.005, 0.010);
   EXPECT_NEAR(r.axis("Z").command_velocity, 10.0, 1e-6);  // 1.0 u/mu x 10 u/s
   EXPECT_TRUE(r.tag("j").ip());
   ASSERT_EQ(r.exec("MCD(Z, c2, jog, yes, 3, no, 0, no, 0, no, 0, no, 0, unitspersec, unitspersec2, unitspersec2, "
