@@ -1,6 +1,7 @@
 // CommandServer on a Controller with an emulated drive, cycle by cycle on a
 // virtual clock; clients are plain UNIX sockets in the test thread.
 #include <grp.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -460,8 +461,12 @@ std::string connect_as(Rig& r, uid_t uid, gid_t gid) {
       if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
         result = std::string("connect: ") + std::strerror(errno);
       } else {
+        // send(MSG_NOSIGNAL), as canmotionctl: the server may refuse and
+        // close before this request is written (seen under ASan in CI), and a
+        // plain write(2) would then kill the child with SIGPIPE before it
+        // reads the refusal, which is already in its socket.
         const std::string req = "GET Controller.Cycle\n";
-        (void)!::write(fd, req.data(), req.size());
+        (void)!::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
         char ch;
         while (::read(fd, &ch, 1) == 1 && ch != '\n') result += ch;
       }
