@@ -502,18 +502,14 @@ class Loader {
   void exception_actions(const YAML::Node& n, const std::string& path, motion::AxisConfig& a) {
     using K = motion::ExceptionKind;
     using A = motion::ExceptionAction;
-    static const std::vector<std::pair<std::string_view, K>> kinds = {
-        {"position_error", K::PositionError},       {"drive_fault", K::DriveFault},
-        {"node_lost", K::NodeLost},                 {"soft_overtravel_positive", K::SoftOvertravelPos},
-        {"soft_overtravel_negative", K::SoftOvertravelNeg}, {"bus_off", K::BusOff}};
     std::vector<std::string_view> keys;
-    for (const auto& k : kinds) keys.push_back(k.first);
+    for (unsigned k = 0; k < static_cast<unsigned>(K::Count); ++k) keys.push_back(motion::exception_key(static_cast<K>(k)));
     if (!check_map(n, path, keys)) return;
-    const std::vector<std::pair<std::string_view, A>> actions = {
-        {"Ignore", A::Ignore},           {"Alarm", A::Alarm},         {"Fault Status Only", A::FaultStatusOnly},
-        {"Stop Planner", A::StopPlanner}, {"Stop Drive", A::StopDrive}, {"Shutdown", A::Shutdown}};
-    for (const auto& [name, kind] : kinds)
-      enumeration(n, path, name, a.exception_actions[static_cast<std::size_t>(kind)], actions);
+    std::vector<std::pair<std::string_view, A>> actions;
+    for (A act : {A::Ignore, A::Alarm, A::FaultStatusOnly, A::StopPlanner, A::StopDrive, A::Shutdown})
+      actions.emplace_back(motion::exception_action_name(act), act);
+    for (unsigned k = 0; k < static_cast<unsigned>(K::Count); ++k)
+      enumeration(n, path, keys[k], a.exception_actions[k], actions);
   }
 
   AxisSettings axis(const YAML::Node& n, const std::string& path, const DriveSettings& defaults) {

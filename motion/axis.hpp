@@ -88,6 +88,10 @@ struct AxisTag {
   std::uint32_t motion_alarm_status = 0;  ///< MotionAlarmStatus
   std::uint32_t exception_faults = 0;     ///< bit per ExceptionKind currently latched as fault
   std::uint32_t exception_alarms = 0;     ///< bit per ExceptionKind currently alarming
+  /// Not a Logix attribute (for the log): per ExceptionKind, the value that
+  /// latched it as a fault, in the cycle it latched: PositionError |command -
+  /// actual|, SoftOvertravelPos/Neg the command position; the others 0.
+  std::array<double, static_cast<std::size_t>(ExceptionKind::Count)> exception_fault_values{};
   double command_position = 0.0;    ///< user units (unwound for rotary)
   double command_velocity = 0.0;    ///< user units/s
   double command_acceleration = 0.0;

@@ -84,6 +84,11 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   a.tag.exception_alarms = alarms;
   const std::uint32_t fresh = faults & ~a.tag.exception_faults;
   a.tag.exception_faults |= faults;
+  // the values that latched them, before the action below moves the command
+  if (fresh & bit(ExceptionKind::PositionError))
+    a.tag.exception_fault_values[static_cast<std::size_t>(ExceptionKind::PositionError)] = std::fabs(a.cmd.p - a.fb_pos);
+  for (ExceptionKind k : {ExceptionKind::SoftOvertravelPos, ExceptionKind::SoftOvertravelNeg})
+    if (fresh & bit(k)) a.tag.exception_fault_values[static_cast<std::size_t>(k)] = user_command(a);
   // the most severe action of the new faults wins
   ExceptionAction worst = ExceptionAction::Ignore;
   for (unsigned k = 0; fresh != 0 && k < static_cast<unsigned>(ExceptionKind::Count); ++k)

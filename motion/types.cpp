@@ -73,4 +73,29 @@ std::string_view err_name(Err e) noexcept {
   return "Unknown Error";
 }
 
+std::string_view exception_key(ExceptionKind k) noexcept {
+  switch (k) {
+    case ExceptionKind::PositionError: return "position_error";
+    case ExceptionKind::DriveFault: return "drive_fault";
+    case ExceptionKind::NodeLost: return "node_lost";
+    case ExceptionKind::SoftOvertravelPos: return "soft_overtravel_positive";
+    case ExceptionKind::SoftOvertravelNeg: return "soft_overtravel_negative";
+    case ExceptionKind::BusOff: return "bus_off";
+    case ExceptionKind::Count: break;
+  }
+  return "?";
+}
+
+std::string_view exception_action_name(ExceptionAction a) noexcept {
+  switch (a) {
+    case ExceptionAction::Ignore: return "Ignore";
+    case ExceptionAction::Alarm: return "Alarm";
+    case ExceptionAction::FaultStatusOnly: return "Fault Status Only";
+    case ExceptionAction::StopPlanner: return "Stop Planner";
+    case ExceptionAction::StopDrive: return "Stop Drive";
+    case ExceptionAction::Shutdown: return "Shutdown";
+  }
+  return "?";
+}
+
 }  // namespace canmotion::motion

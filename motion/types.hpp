@@ -253,6 +253,13 @@ enum class ExceptionKind : std::uint8_t {
   Count = 6,
 };
 
+/// The key of an exception under an axis's `exception_actions:` in the
+/// configuration (position_error, drive_fault, ...): one table for the loader
+/// and the messages.
+std::string_view exception_key(ExceptionKind k) noexcept;
+/// The Logix text of an exception action ("Stop Drive", "Fault Status Only", ...).
+std::string_view exception_action_name(ExceptionAction a) noexcept;
+
 /// The most severe of two actions.
 constexpr ExceptionAction most_severe(ExceptionAction a, ExceptionAction b) noexcept {
   return static_cast<std::uint8_t>(a) >= static_cast<std::uint8_t>(b) ? a : b;

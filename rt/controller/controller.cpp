@@ -485,6 +485,23 @@ void Controller::publish(std::int64_t now_ns) noexcept {
     const motion::AxisTag& tag = planner_.axis(static_cast<motion::AxisId>(a));
     const double err = std::abs(tag.position_error);
     if (err > max_err_[a]) max_err_[a] = err;
+    // Each exception the axis latched as a fault this cycle, once (MAFR/MASR
+    // clear them; a fault latched again is reported again).
+    AxisRt& ax = axes_[a];
+    if (const std::uint32_t fresh = tag.exception_faults & ~ax.exception_faults; fresh != 0) {
+      for (std::size_t k = 0; k < tag.exception_fault_values.size(); ++k) {
+        if (!(fresh & (1u << k))) continue;
+        Event e;
+        e.kind = Event::Kind::kAxisFault;
+        e.axis = static_cast<std::int16_t>(a);
+        e.bus = ax.bus >= 0 ? static_cast<std::uint8_t>(ax.bus) : std::uint8_t{0};
+        e.value = k;
+        e.detail = tag.exception_fault_values[k];
+        e.cycle = cycle_index_;
+        emit(e);
+      }
+    }
+    ax.exception_faults = tag.exception_faults;
     if (tele) {
       const Sample smp{cycle_index_,       static_cast<std::uint16_t>(a), tag.command_position,
                        tag.actual_position, tag.command_velocity,      tag.actual_velocity,

@@ -184,6 +184,9 @@ struct Event {
                    ///< `value` = the class bits (SocketCAN CAN_ERR_*); at most once a second per
                    ///< bus unless the classes change
     kBusRecovered, ///< the bus left bus-off: every node of the bus is re-booted (NMT reset node, configuration)
+    kAxisFault,    ///< an axis latched an exception as a fault (its rising edge in AxisTag::exception_faults):
+                   ///< `value` = the motion::ExceptionKind, `detail` = the position error (PositionError) or
+                   ///< the command position (soft overtravel) in the axis's units; see describe_axis_fault()
   };
   Kind kind = Kind::kNode;
   std::uint8_t bus = 0;
@@ -192,6 +195,7 @@ struct Event {
   cia402::Failure failure{};
   can::BusState bus_state = can::BusState::kErrorActive;
   std::uint64_t value = 0;
+  double detail = 0.0;
   std::uint64_t cycle = 0;
 };
 
@@ -363,6 +367,7 @@ class Controller {
     bool failure_reported = false;
     std::uint32_t failure_rev = 0;  ///< DriveProxy::failure_revision() when the failure was last reported
     bool homing_out = false;  ///< the planner's homing_start as last handed to the proxy (its edges start/cancel)
+    std::uint32_t exception_faults = 0;  ///< AxisTag::exception_faults last cycle (kAxisFault on its rising edges)
   };
   class RecordingSink;
   /// A command in the ring with its sequence number (submit()).
@@ -448,5 +453,11 @@ class Controller {
 
 /// Map a CiA 402 state to the planner's view of the drive. Realtime-safe.
 [[nodiscard]] motion::DriveState drive_state_of(cia402::State s, bool operational) noexcept;
+
+/// The text of a kAxisFault event for a log (not RT): what the axis latched,
+/// the measured value against the configuration key that bounds it, the
+/// action taken and its key, and what clears it; `index` is the axis's place
+/// in the configuration's `axes:` list (the key path `axes[index]`).
+[[nodiscard]] std::string describe_axis_fault(const Event& e, const AxisSpec& axis, std::size_t index);
 
 }  // namespace canmotion::rt

@@ -43,6 +43,17 @@ out=$("$bin" --config "$work/nobus.yaml" --sim --script "$work/nobus.script" -q 
 [[ $rc == 0 ]] || fail "no-bus configuration exit $rc: $out"
 grep -q 'V.CommandVelocity=10$' <<<"$out" || fail "no-bus run: $out"
 
-# 6. --help works and names the options.
+# 6. An axis fault is logged with its value, key, action and what clears it;
+# the script goes on (a soft overtravel on a virtual axis: Stop Planner).
+printf 'controller: {period_ms: 1}\naxes:\n  - {name: V, type: AXIS_VIRTUAL, units: mm, soft_limits: {enabled: true, positive: 5, negative: -5}}\n' > "$work/soft.yaml"
+printf 'MSO(V, mso1);\nMAJ(V, maj1, 0, 10, unitspersec, 100, unitspersec2, 100, unitspersec2, trapezoidal, 100, 100, %%oftime, disabled, programmed, 0, none);\nWAIT 1;\nPRINT V.AxisFault, V.JogStatus;\n' > "$work/soft.script"
+out=$("$bin" --config "$work/soft.yaml" --sim --script "$work/soft.script" -q 2>&1); rc=$?
+[[ $rc == 0 ]] || fail "soft overtravel run exit $rc: $out"
+grep -qE '^canmotiond: axis V: command position 5\.0[0-9]* mm beyond the positive soft limit 5 mm \(axes\[0\]\.soft_limits\.positive\): Stop Planner \(axes\[0\]\.exception_actions\.soft_overtravel_positive\): motion stopped, the servo stays on; MAFR clears it$' <<<"$out" ||
+  fail "soft overtravel message: $out"
+[[ $(grep -c 'soft limit' <<<"$out") == 1 ]] || fail "soft overtravel reported more than once: $out"
+grep -q 'V.AxisFault=16 V.JogStatus=0$' <<<"$out" || fail "soft overtravel tags: $out"
+
+# 7. --help works and names the options.
 "$bin" --help | grep -q -- '--script' || fail "--help"
-echo "daemon-test: statistics tags, exit statuses 0/1/2 and messages as documented"
+echo "daemon-test: statistics tags, exit statuses 0/1/2, axis fault messages as documented"

@@ -859,5 +859,96 @@ TEST(DriveFaults, MsoIssuedBeforeAMissedBootUpCompletes) {
   EXPECT_EQ(r.read("X.DriveEnableStatus"), 1.0);
 }
 
+// An axis that latches an exception as a fault reports it once, as an event
+// with the value that latched it (canmotiond logs describe_axis_fault(): the
+// value against its configuration key, the action and what clears it): a
+// drive that stops following (its TPDOs lost while jogging at 10 mm/s) trips
+// position_error_tolerance 1 mm. After MAFR it is reported again when it
+// latches again, never in between.
+TEST(DriveFaults, PositionErrorFaultIsReportedOnceWithItsValueAndKeys) {
+  FaultRig r([](AxisSpec& x, emulator::EmulatorConfig&) {
+    x.config.position_error_tolerance = 1.0;
+    std::snprintf(x.config.units_name, sizeof x.config.units_name, "mm");
+  });
+  std::vector<Event> faults;
+  r.each_cycle = [&] {
+    Event e;
+    while (r.ctl->pop_event(e))
+      if (e.kind == Event::Kind::kAxisFault) faults.push_back(e);
+  };
+  const std::string tail =
+      " mm beyond its tolerance 1 mm (axes[0].position_error_tolerance): Stop Drive "
+      "(axes[0].exception_actions.position_error): motion stopped, servo off (drive disabled); MAFR clears it, then MSO";
+  for (int round = 0; round < 2; ++round) {
+    r.enable_and_jog();
+    ASSERT_TRUE(faults.empty()) << "reported before it latched: " << describe_axis_fault(faults[0], r.ctl->axis_spec(0), 0);
+    r.world.bus(0).add_fault({0x180u + kNode, can::SimFault::Action::kDrop, 0, 0});  // TPDO1: the feedback stops
+    ASSERT_TRUE(r.run_until([&] { return physical_fault(r.read("X.AxisFault")); }, 500));
+    r.world.bus(0).clear_faults();
+    r.cycles(100);  // still latched: no second report
+    ASSERT_EQ(faults.size(), 1u);
+    const Event& e = faults[0];
+    EXPECT_EQ(e.axis, 0);
+    EXPECT_EQ(e.value, static_cast<std::uint64_t>(motion::ExceptionKind::PositionError));
+    // 10 mm/s = 0.01 mm per cycle: it latches in the first cycle past 1 mm
+    EXPECT_GT(e.detail, 1.0);
+    EXPECT_LE(e.detail, 1.0 + 0.02 + 1e-9);
+    const std::string text = describe_axis_fault(e, r.ctl->axis_spec(0), 0);
+    std::printf("round %d: %s\n", round + 1, text.c_str());
+    EXPECT_EQ(text.rfind("position error 1.0", 0), 0u) << text;
+    EXPECT_NE(text.rfind("position error 1 mm", 0), 0u) << "a value past the tolerance reads as the tolerance: " << text;
+    EXPECT_NE(text.find(tail), std::string::npos) << text;
+    EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+    faults.clear();
+    r.exec("MAFR(X, mafr)");
+    ASSERT_TRUE(r.wait("mafr.DN", 1000)) << "MAFR ERR " << r.read("mafr.ERR");
+    r.cycles(50);
+    EXPECT_TRUE(faults.empty()) << "the reset reported a fault";
+  }
+}
+
+// The other texts, from a configuration (no cycle needed): each names the
+// keys to look at and what clears the fault.
+TEST(DriveFaults, AxisFaultTexts) {
+  AxisSpec a;
+  a.config.soft_limits_enabled = true;
+  a.config.soft_limit_pos = 500;
+  a.config.soft_limit_neg = -20;
+  std::snprintf(a.config.units_name, sizeof a.config.units_name, "deg");
+  a.config.exception_actions[static_cast<std::size_t>(motion::ExceptionKind::SoftOvertravelNeg)] =
+      motion::ExceptionAction::FaultStatusOnly;
+  Event e;
+  e.kind = Event::Kind::kAxisFault;
+  e.value = static_cast<std::uint64_t>(motion::ExceptionKind::SoftOvertravelNeg);
+  e.detail = -20.25;
+  EXPECT_EQ(describe_axis_fault(e, a, 3),
+            "command position -20.25 deg beyond the negative soft limit -20 deg (axes[3].soft_limits.negative): Fault "
+            "Status Only (axes[3].exception_actions.soft_overtravel_negative): the fault is shown, motion goes on; MAFR "
+            "clears it");
+  e.value = static_cast<std::uint64_t>(motion::ExceptionKind::SoftOvertravelPos);
+  e.detail = 500.125;
+  EXPECT_EQ(describe_axis_fault(e, a, 0),
+            "command position 500.125 deg beyond the positive soft limit 500 deg (axes[0].soft_limits.positive): Stop "
+            "Planner (axes[0].exception_actions.soft_overtravel_positive): motion stopped, the servo stays on; MAFR "
+            "clears it");
+  e.detail = 500.0000000000001;  // just past: shown with the digits that make it so
+  EXPECT_EQ(describe_axis_fault(e, a, 0).rfind("command position 500.0000000000001 deg beyond the positive soft limit 500 "
+                                               "deg (axes[0].soft_limits.positive)",
+                                               0),
+            0u)
+      << describe_axis_fault(e, a, 0);
+  e.value = static_cast<std::uint64_t>(motion::ExceptionKind::NodeLost);
+  EXPECT_EQ(describe_axis_fault(e, a, 1),
+            "node lost (heartbeat lost, or the node left NMT operational): Shutdown "
+            "(axes[1].exception_actions.node_lost): motion stopped, servo off, the axis in Shutdown; MASR clears it, "
+            "then MSO");
+  e.value = static_cast<std::uint64_t>(motion::ExceptionKind::DriveFault);
+  EXPECT_EQ(describe_axis_fault(e, a, 1),
+            "drive fault (its cause is logged for the drive): Stop Drive (axes[1].exception_actions.drive_fault): motion "
+            "stopped, servo off (drive disabled); MAFR clears it, then MSO");
+  e.value = static_cast<std::uint64_t>(motion::ExceptionKind::BusOff);
+  EXPECT_EQ(describe_axis_fault(e, a, 2).rfind("its bus is off: Shutdown (axes[2].exception_actions.bus_off)", 0), 0u);
+}
+
 }  // namespace
 }  // namespace canmotion::rt
