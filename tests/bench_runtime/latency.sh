@@ -27,6 +27,9 @@
 #                  (default: not written, i.e. the daemon's default 0; -1 =
 #                  do not hold the PM QoS request, to see what it is worth;
 #                  leave unset for builds that predate the key)
+#   LATENCY_CPU    pin both to this CPU: controller.cpu in the configuration
+#                  (canmotiond's RT thread) and cyclictest -a (default: neither
+#                  pinned, as in the acceptance case)
 #   LATENCY_OUT    folder for the raw outputs (default: a temporary folder)
 # Run as root (or with CAP_SYS_NICE + CAP_IPC_LOCK and write access to
 # /dev/cpu_dma_latency). Prints one line per run and a summary with the
@@ -42,8 +45,14 @@ load_cmd="${LATENCY_LOAD:-hackbench -g 2 -f 4 -l 1000000000}"
 out="${LATENCY_OUT:-$(mktemp -d)}"
 mkdir -p "$out"
 "$here/gen-config.sh" 16 1 8 "$out/bench16"
+pin=()
+if [[ -n ${LATENCY_CPU:-} ]]; then
+  sed -i "s/^  cpu: -1$/  cpu: $LATENCY_CPU/" "$out/bench16.yaml"
+  grep -q "^  cpu: $LATENCY_CPU$" "$out/bench16.yaml" || { echo "latency: could not set controller.cpu" >&2; exit 1; }
+  pin=(-a "$LATENCY_CPU")
+fi
 if [[ -n ${LATENCY_DMA:-} ]]; then
-  sed -i "s/^  cpu: -1$/  cpu: -1\n  cpu_dma_latency_us: $LATENCY_DMA/" "$out/bench16.yaml"
+  sed -i "s/^  cpu: \(-\?[0-9]\+\)$/  cpu: \1\n  cpu_dma_latency_us: $LATENCY_DMA/" "$out/bench16.yaml"
 fi
 # --duration in controller seconds; the controlled stop adds a few cycles.
 secs=$(awk -v l="$loops" 'BEGIN { printf "%.3f", l / 1000 }')
@@ -63,6 +72,7 @@ echo "# $(date -u +%FT%TZ) $(uname -r), $(nproc) CPUs, load $(cut -d' ' -f1-3 /p
 echo "# daemon: $cmd"
 echo "# cases: $cases; $repeats runs each of $loops cycles; load command: $load_cmd"
 [[ -n ${LATENCY_DMA:-} ]] && echo "# controller.cpu_dma_latency_us: $LATENCY_DMA"
+[[ -n ${LATENCY_CPU:-} ]] && echo "# pinned to CPU $LATENCY_CPU (controller.cpu, cyclictest -a)"
 : >"$out/results.txt"
 for c in $cases; do
   case $c in
@@ -81,7 +91,7 @@ for c in $cases; do
     rev=()
     # One after the other: alternate which program runs first.
     [[ $mode == sequential && $((r % 2)) == 0 ]] && rev=(-r)
-    "$repo/tools/rt-latency/compare-cyclictest.sh" -m "$mode" "${rev[@]}" -i 1000 -p 80 -l "$loops" \
+    "$repo/tools/rt-latency/compare-cyclictest.sh" -m "$mode" "${rev[@]}" "${pin[@]}" -i 1000 -p 80 -l "$loops" \
       -o "$out/$c-run$r" -x "$cmd" >"$out/$c-run$r.txt" 2>&1 || { cat "$out/$c-run$r.txt" >&2; exit 1; }
     stop_load
     res=$(grep '^RESULT ' "$out/$c-run$r.txt")

@@ -21,6 +21,9 @@ Options:
   -m MODE        parallel (both at once, same load; default) or sequential
                  (one after the other: cyclictest first)
   -r             sequential: run the measured program first, then cyclictest
+  -a CPU         pin cyclictest's thread to CPU (cyclictest -a CPU); pin the
+                 measured program's RT thread to the same CPU yourself (for
+                 canmotiond: controller.cpu), rt-latency is given -a CPU
   -b PATH        rt-latency binary (default: build*/tools/rt-latency/rt-latency)
   -x 'COMMAND'   measure COMMAND instead of rt-latency: any program that prints
                  canmotion's statistics summary (rt::format_summary), e.g.
@@ -46,11 +49,11 @@ The last line is machine-readable:
 USAGE
 }
 
-interval=1000 prio=80 loops=20000 mode=parallel bin="" outdir="" cmd="" reverse=0
-while getopts "i:p:l:m:b:o:x:rh" opt; do
+interval=1000 prio=80 loops=20000 mode=parallel bin="" outdir="" cmd="" reverse=0 cpu=""
+while getopts "i:p:l:m:b:o:x:a:rh" opt; do
   case $opt in
     i) interval=$OPTARG ;; p) prio=$OPTARG ;; l) loops=$OPTARG ;; m) mode=$OPTARG ;; r) reverse=1 ;;
-    b) bin=$OPTARG ;; o) outdir=$OPTARG ;; x) cmd=$OPTARG ;; h) usage; exit 0 ;; *) usage >&2; exit 1 ;;
+    b) bin=$OPTARG ;; o) outdir=$OPTARG ;; x) cmd=$OPTARG ;; a) cpu=$OPTARG ;; h) usage; exit 0 ;; *) usage >&2; exit 1 ;;
   esac
 done
 here=$(cd "$(dirname "$0")" && pwd)
@@ -67,11 +70,13 @@ mkdir -p "$outdir"
 
 histmax=$(( interval * 20 ))  # cyclictest histogram range in us; beyond it counts as overflow
 ct_cmd=(cyclictest -m -p "$prio" -i "$interval" -l "$loops" -q -h "$histmax")
+[[ -n $cpu ]] && ct_cmd+=(-a "$cpu")
 if [[ -n $cmd ]]; then
   read -r -a rl_cmd <<<"$cmd"
   name=$(basename "${rl_cmd[0]}")
 else
   rl_cmd=("$bin" -q -p "$prio" -i "$interval" -l "$loops" --histogram "$outdir/rt-latency.hist")
+  [[ -n $cpu ]] && rl_cmd+=(-a "$cpu")
   name=rt-latency
 fi
 load1() { cut -d' ' -f1 /proc/loadavg; }
