@@ -59,4 +59,13 @@ std::int64_t Histogram::percentile(double q) const noexcept {
   return std::clamp(upper, min(), std::max(min(), max()));
 }
 
+std::string histogram_text(const Histogram& h) {
+  std::string t = "# lower_ns upper_ns count\n";
+  for (std::size_t i = 0; i < Histogram::kBuckets; ++i)
+    if (const std::uint64_t n = h.bucket_count(i))
+      t += std::to_string(Histogram::bucket_lower(i)) + ' ' + std::to_string(Histogram::bucket_upper(i)) + ' ' +
+           std::to_string(n) + '\n';
+  return t;
+}
+
 }  // namespace canmotion::rt

@@ -8,6 +8,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 namespace canmotion::rt {
 
@@ -82,5 +83,10 @@ class Histogram {
 };
 
 static_assert(Histogram::bucket_of((1ULL << 63) - 1) == Histogram::kBuckets - 1);
+
+/// The non-empty buckets as text, one "lower_ns upper_ns count" line each
+/// after a "# lower_ns upper_ns count" header (rt-latency and canmotiond
+/// --histogram; tools/rt-latency/compare-cyclictest.sh pools them). Not RT.
+std::string histogram_text(const Histogram& h);
 
 }  // namespace canmotion::rt

@@ -58,6 +58,11 @@ fi
 secs=$(awk -v l="$loops" 'BEGIN { printf "%.3f", l / 1000 }')
 cmd="$daemon --config $out/bench16.yaml --script $out/bench16.script --duration $secs --stats --quiet"
 
+# canmotiond --histogram (builds since 2026-11-28): the summary also pools
+# every run's histograms per case (see below).
+has_hist=false
+"$daemon" --help 2>/dev/null | grep -q -- '--histogram' && has_hist=true
+
 load_pid=""
 stop_load() {
   if [[ -n $load_pid ]]; then
@@ -91,8 +96,10 @@ for c in $cases; do
     rev=()
     # One after the other: alternate which program runs first.
     [[ $mode == sequential && $((r % 2)) == 0 ]] && rev=(-r)
+    run_cmd=$cmd
+    $has_hist && run_cmd+=" --histogram $out/$c-run$r/canmotiond.hist"
     "$repo/tools/rt-latency/compare-cyclictest.sh" -m "$mode" "${rev[@]}" "${pin[@]}" -i 1000 -p 80 -l "$loops" \
-      -o "$out/$c-run$r" -x "$cmd" >"$out/$c-run$r.txt" 2>&1 || { cat "$out/$c-run$r.txt" >&2; exit 1; }
+      -o "$out/$c-run$r" -x "$run_cmd" >"$out/$c-run$r.txt" 2>&1 || { cat "$out/$c-run$r.txt" >&2; exit 1; }
     stop_load
     res=$(grep '^RESULT ' "$out/$c-run$r.txt")
     echo "case=$c run=$r ${res#RESULT }" | tee -a "$out/results.txt"
@@ -116,4 +123,29 @@ for c in $cases; do
           printf "%-9s %5d %16s %16s %16s %9.2f %9.2f %13s\n", c, n, med(cp50, n) "/" med(cp99, n), med(mp50, n) "/" med(mp99, n),
                  med(cp999, n) "/" med(mp999, n), med(r50, n), med(r99, n), lo "-" hi }' "$out/results.txt"
 done
+if $has_hist; then
+  echo
+  echo "# pooled: every run's samples of a case together (cyclictest's 1 us histogram, canmotiond's --histogram"
+  echo "# buckets truncated to whole us like cyclictest's), so minutes of drift in the machine weigh on both alike"
+  printf '%-9s %8s %22s %22s %9s %9s %11s\n' case samples "ct p50/p99/p99.9 us" "cm p50/p99/p99.9 us" "p50 ratio" "p99 ratio" "p99.9 ratio"
+  for c in $cases; do
+    ls "$out/$c"-run*/canmotiond.hist >/dev/null 2>&1 || continue
+    # cyclictest: "us count" lines and its overflows (above -h, counted at the top);
+    # canmotiond: "lower_ns upper_ns count", counted at the whole us of the bucket's middle.
+    awk '
+      function pct(h, n, q,   rank, s, us) { rank = int(q * n); if (rank < q * n) rank++; if (rank < 1) rank = 1
+                                             s = 0; for (us = 0; us <= top; us++) { s += h[us]; if (s >= rank) return us } return top }
+      FNR == 1 { ct = FILENAME ~ /cyclictest.txt$/ }
+      ct && /^[0-9]+ [0-9]+$/ { c[$1 + 0] += $2; nc += $2; if ($1 + 0 > top) top = $1 + 0; next }
+      ct && /# Histogram Overflows:/ { ov += $4 + 0; next }
+      !ct && /^[0-9]+ [0-9]+ [0-9]+$/ { us = int(($1 + $2) / 2000); m[us] += $3; nm += $3; if (us > top) top = us }
+      END { top++; c[top] += ov; nc += ov
+            if (!nc || !nm) exit
+            c50 = pct(c, nc, 0.5); c99 = pct(c, nc, 0.99); c999 = pct(c, nc, 0.999)
+            m50 = pct(m, nm, 0.5); m99 = pct(m, nm, 0.99); m999 = pct(m, nm, 0.999)
+            printf "%-9s %8d %22s %22s %9.2f %9.2f %11.2f\n", C, nm, c50 "/" c99 "/" c999, m50 "/" m99 "/" m999,
+                   c50 ? m50 / c50 : 0, c99 ? m99 / c99 : 0, c999 ? m999 / c999 : 0 }' C="$c" \
+      "$out/$c"-run*/cyclictest.txt "$out/$c"-run*/canmotiond.hist
+  done
+fi
 echo "# raw outputs kept in $out"

@@ -54,6 +54,12 @@ grep -qE '^canmotiond: axis V: command position 5\.0[0-9]* mm beyond the positiv
 [[ $(grep -c 'soft limit' <<<"$out") == 1 ]] || fail "soft overtravel reported more than once: $out"
 grep -q 'V.AxisFault=16 V.JogStatus=0$' <<<"$out" || fail "soft overtravel tags: $out"
 
-# 7. --help works and names the options.
+# 7. --histogram is for real time: refused with --sim (exit 2, nothing run).
+out=$("$bin" --config "$ex/demo.yaml" --sim --duration 1 --histogram "$work/h.txt" 2>&1); rc=$?
+[[ $rc == 2 ]] || fail "--sim --histogram exit $rc, want 2: $out"
+grep -q -- '--sim excludes --histogram' <<<"$out" || fail "--sim --histogram message: $out"
+[[ ! -e "$work/h.txt" ]] || fail "--sim --histogram wrote a file"
+
+# 8. --help works and names the options.
 "$bin" --help | grep -q -- '--script' || fail "--help"
 echo "daemon-test: statistics tags, exit statuses 0/1/2, axis fault messages as documented"

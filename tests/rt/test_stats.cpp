@@ -51,6 +51,18 @@ TEST(RtHistogram, EmptyAndNegative) {
 // Property: for random latency-like data, every percentile lies within one
 // bucket (<= 1/64 relative) ABOVE the exact order statistic, never below,
 // and min/max/mean are exact.
+// The text of --histogram (rt-latency, canmotiond): the non-empty buckets,
+// "lower_ns upper_ns count", in order, after one header line.
+TEST(RtHistogram, TextListsTheNonEmptyBuckets) {
+  Histogram h;
+  EXPECT_EQ(histogram_text(h), "# lower_ns upper_ns count\n");
+  h.record(5);
+  h.record(5);
+  h.record(40'000);  // 2^15 <= v < 2^16: buckets 512 ns wide
+  h.record(40'100);
+  EXPECT_EQ(histogram_text(h), "# lower_ns upper_ns count\n5 5 2\n39936 40447 2\n");
+}
+
 TEST(RtHistogram, PercentilesMatchExactOrderStatistics) {
   const std::uint64_t seed = test_seed(20261121);
   const std::uint64_t rounds = test_count(50);

@@ -7,7 +7,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -57,6 +59,7 @@ struct Options {
   double sim_rate = -1;  // --sim-rate; < 0 = default (1 with --socket, else 0 = flat out)
   bool check_args = false;  // --check-args: parse and validate, then exit (tests/docs)
   std::string write_dcf;    // --write-dcf DIR: one DCF per node of the boot writes, then exit
+  std::string histogram;    // --histogram FILE: the wake-up latency histogram at the end (real time)
 };
 
 /// --write-dcf: DIR/<axis>.dcf per CIP axis, the SDO writes of its boot
@@ -623,6 +626,15 @@ int run(const Options& o) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - hk.wall0()).count();
   if (!o.quiet || o.stats) print_summary(o, rt, host, exec.statistics().snapshot(), wall, !o.sim);
   if (o.stats) fmt::print("{}\n", rt::format_summary(exec.statistics().snapshot()));
+  if (!o.histogram.empty()) {
+    const std::string text = rt::histogram_text(exec.statistics().latency());
+    std::FILE* f = std::fopen(o.histogram.c_str(), "w");
+    const bool ok = f != nullptr && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if ((f != nullptr && std::fclose(f) != 0) || !ok) {
+      fmt::print(stderr, "canmotiond: --histogram {}: cannot write it ({})\n", o.histogram, std::strerror(errno));
+      status = 1;
+    }
+  }
   if (runner && runner->status() == rt::script::Runner::Status::kRunning && status == 0) {
     fmt::print(stderr, "canmotiond: the run ended before the script did (statement {} of {})\n",
                runner->position() + 1, script->statements.size());
@@ -640,9 +652,9 @@ int main(int argc, char** argv) {
       "drives CiA 402 servo drives over CANopen (SocketCAN), or simulated drives with --sim.",
       "canmotiond"};
   app.add_option("-c,--config", o.config, "configuration file (YAML)")->required()->check(CLI::ExistingFile);
-  app.add_flag("--sim", o.sim,
-               "simulate every bus in process with an emulated CiA 402 drive per AXIS_CIP_DRIVE node; virtual "
-               "time, as fast as possible, deterministic");
+  CLI::Option* sim = app.add_flag("--sim", o.sim,
+                                  "simulate every bus in process with an emulated CiA 402 drive per AXIS_CIP_DRIVE "
+                                  "node; virtual time, as fast as possible, deterministic");
   app.add_option("--duration", o.duration, "stop after this many seconds of controller time (default: when the "
                                            "script ends, or on SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
@@ -650,6 +662,11 @@ int main(int argc, char** argv) {
   app.add_option("--trace", o.trace, "write every frame on every bus to FILE in candump -L format")->type_name("FILE");
   app.add_option("--csv", o.csv, "write one row per axis per cycle to FILE")->type_name("FILE");
   app.add_flag("--stats", o.stats, "print cycle statistics once a second and at the end");
+  app.add_option("--histogram", o.histogram,
+                 "real time: write the cycle's wake-up latency histogram to FILE at the end (one \"lower_ns "
+                 "upper_ns count\" line per non-empty bucket, as rt-latency --histogram)")
+      ->type_name("FILE")
+      ->excludes(sim);
   app.add_option("--socket", o.socket, "serve canmotionctl on this UNIX socket (mode 0660; see tools/canmotionctl/README.md)")
       ->type_name("PATH");
   app.add_option("--socket-group", o.socket_group, "group owning the --socket file and allowed to use it (default: the daemon's group)")

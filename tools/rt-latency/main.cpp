@@ -162,13 +162,7 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "rt-latency: cannot write {}\n", histogram_file);
       return 1;
     }
-    const Histogram& h = exec.statistics().latency();
-    out << "# lower_ns upper_ns count\n";
-    for (std::size_t i = 0; i < Histogram::kBuckets; ++i) {
-      if (const auto n = h.bucket_count(i)) {
-        out << Histogram::bucket_lower(i) << ' ' << Histogram::bucket_upper(i) << ' ' << n << '\n';
-      }
-    }
+    out << histogram_text(exec.statistics().latency());
   }
   return 0;
 }
