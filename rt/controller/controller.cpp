@@ -494,7 +494,6 @@ void Controller::publish(std::int64_t now_ns) noexcept {
         Event e;
         e.kind = Event::Kind::kAxisFault;
         e.axis = static_cast<std::int16_t>(a);
-        e.bus = ax.bus >= 0 ? static_cast<std::uint8_t>(ax.bus) : std::uint8_t{0};
         e.value = k;
         e.detail = tag.exception_fault_values[k];
         e.cycle = cycle_index_;

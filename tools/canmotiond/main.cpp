@@ -7,9 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -627,11 +625,11 @@ int run(const Options& o) {
   if (!o.quiet || o.stats) print_summary(o, rt, host, exec.statistics().snapshot(), wall, !o.sim);
   if (o.stats) fmt::print("{}\n", rt::format_summary(exec.statistics().snapshot()));
   if (!o.histogram.empty()) {
-    const std::string text = rt::histogram_text(exec.statistics().latency());
-    std::FILE* f = std::fopen(o.histogram.c_str(), "w");
-    const bool ok = f != nullptr && std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if ((f != nullptr && std::fclose(f) != 0) || !ok) {
-      fmt::print(stderr, "canmotiond: --histogram {}: cannot write it ({})\n", o.histogram, std::strerror(errno));
+    std::ofstream f(o.histogram);
+    f << rt::histogram_text(exec.statistics().latency());
+    f.close();
+    if (!f) {
+      fmt::print(stderr, "canmotiond: --histogram: cannot write {}\n", o.histogram);
       status = 1;
     }
   }
