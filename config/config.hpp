@@ -84,7 +84,19 @@ struct DriveTimeouts {
   std::uint32_t transition_ms = 1000;  ///< one CiA 402 state transition
   std::uint32_t mode_switch_ms = 500;  ///< 0x6061 following a 0x6060 change
   std::uint32_t homing_ms = 60'000;    ///< MAH on the drive (mode 6): start to homing completed; 0 = no limit
+  /// The longest an instruction waits on the drive (MSO, MSF, MDS's enable,
+  /// MAFR/MASR/MGSR's fault reset) before ERR 12; 0 = drive_wait_limit_s()'s default.
+  std::uint32_t wait_ms = 0;
 };
+
+/// The planner's wait limit for instructions that wait on a drive
+/// (motion::AxisConfig::drive_wait_limit), in seconds: `wait_ms`, or when 0
+/// the longest a drive may take with these timeouts to boot (the boot-up,
+/// again after NMT reset node, the configuration to the first TPDO: 3 x
+/// boot_ms), to show its mode (mode_switch_ms) and to make the enable's
+/// transitions (at most 4: one out of Operation enabled, 2, 3, 4:
+/// 4 x transition_ms). With the defaults 19.5 s.
+[[nodiscard]] double drive_wait_limit_s(const DriveTimeouts& t) noexcept;
 
 /// One extra SDO download done at boot, after canmotion's own configuration.
 struct SdoWrite {

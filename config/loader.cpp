@@ -283,12 +283,14 @@ class Loader {
   }
 
   void timeouts(const YAML::Node& n, const std::string& path, DriveTimeouts& t) {
-    if (!check_map(n, path, {"sdo_ms", "boot_ms", "transition_ms", "mode_switch_ms", "homing_ms"})) return;
+    if (!check_map(n, path, {"sdo_ms", "boot_ms", "transition_ms", "mode_switch_ms", "homing_ms", "wait_ms"})) return;
     scalar(n, path, "sdo_ms", t.sdo_ms, 1u, 60'000u, "ms");
     scalar(n, path, "boot_ms", t.boot_ms, 10u, 600'000u, "ms");
     scalar(n, path, "transition_ms", t.transition_ms, 1u, 60'000u, "ms");
     scalar(n, path, "mode_switch_ms", t.mode_switch_ms, 1u, 60'000u, "ms");
     scalar(n, path, "homing_ms", t.homing_ms, 0u, 3'600'000u, "ms (0 = no limit)");
+    scalar(n, path, "wait_ms", t.wait_ms, 0u, 3'600'000u,
+           "ms (0 = 3 x boot_ms + mode_switch_ms + 4 x transition_ms)");
   }
 
   void drive(const YAML::Node& n, const std::string& path, DriveSettings& d) {

@@ -106,6 +106,11 @@ std::vector<cia402::SdoWrite> direct_control_writes(const AxisSettings& a) {
   return w;
 }
 
+double drive_wait_limit_s(const DriveTimeouts& t) noexcept {
+  if (t.wait_ms > 0) return static_cast<double>(t.wait_ms) / 1e3;
+  return (3.0 * t.boot_ms + t.mode_switch_ms + 4.0 * t.transition_ms) / 1e3;
+}
+
 cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s, std::size_t axis_index) {
   cia402::DriveConfig d;
   const std::string axis = fmt::format("axes[{}]", axis_index);
@@ -280,6 +285,7 @@ Runtime build_runtime(const Config& cfg, bool force_sim) {
       while (bi < cfg.buses.size() && cfg.buses[bi].name != a.bus) ++bi;
       as.bus = static_cast<int>(bi);
       as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s, spec.axes.size());
+      as.config.drive_wait_limit = drive_wait_limit_s(a.drive.timeouts);
       if (force_sim || cfg.buses[bi].is_sim()) {
         // The simulated bus index equals the bus index: every simulated bus was added in order.
         std::size_t sim_index = 0;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "motion/signatures.hpp"
 #include "motion/types.hpp"
 
 namespace canmotion::motion {
@@ -65,6 +66,12 @@ struct AxisConfig {
   /// torque command is set live; both direct status bits are set.
   bool direct_slat = false;
   std::uint8_t group = 0;          ///< motion group index (< kMaxGroups)
+  /// CIP drives: the longest an instruction waits on the drive (MSO, MSF,
+  /// MDS's enable, the fault reset of MAFR/MASR/MGSR), in seconds from its
+  /// start, whatever happens to the drive meanwhile (a boot, a reset, a
+  /// reboot, a lost node): then it ends with ERR 12, EXERR 16. The runtime
+  /// sets it from the drive's timeouts (drive.timeouts.wait_ms). > 0.
+  double drive_wait_limit = 5.0;
   /// Exception action per ExceptionKind. Defaults: position error and drive
   /// fault stop the drive, lost node and bus-off shut down, soft overtravel stops the planner.
   std::array<ExceptionAction, static_cast<std::size_t>(ExceptionKind::Count)> exception_actions{
@@ -75,6 +82,26 @@ struct AxisConfig {
   constexpr ExceptionAction action(ExceptionKind k) const noexcept {
     return exception_actions[static_cast<std::size_t>(k)];
   }
+};
+
+/// Why an instruction that waited on the drive ended with an error (for the log).
+enum class DriveWaitCause : std::uint8_t {
+  Limit,              ///< AxisConfig::drive_wait_limit passed (the drive never got there)
+  LinkFailed,         ///< the drive's boot failed (no answer, a refused configuration)
+  TransitionTimeout,  ///< the runtime's transition timeout expired (the drive did not make a state transition)
+  DriveFault,         ///< the drive went to Fault
+  AxisFaulted,        ///< the axis latched a fault or went to Shutdown meanwhile (its exception action)
+};
+
+/// The last instruction that waited on an axis's drive and ended with an
+/// error (not a Logix attribute: what the runtime logs).
+struct DriveWaitEnd {
+  Instr instr = Instr::MSO;
+  std::uint16_t control = 0xFFFF;  ///< its control tag (ControlId)
+  DriveWaitCause cause = DriveWaitCause::Limit;
+  std::int16_t err = 0;
+  std::int8_t exerr = 0;
+  std::uint64_t waited_cycles = 0;  ///< from its start to its end
 };
 
 /// The axis tag: what a Logix program reads from an AXIS_* tag.
@@ -92,6 +119,10 @@ struct AxisTag {
   /// latched it as a fault, in the cycle it latched: PositionError |command -
   /// actual|, SoftOvertravelPos/Neg the command position; the others 0.
   std::array<double, static_cast<std::size_t>(ExceptionKind::Count)> exception_fault_values{};
+  /// Not Logix attributes (for the log): instructions that waited on this
+  /// axis's drive and ended with an error, and the last of them.
+  std::uint32_t drive_wait_errors = 0;
+  DriveWaitEnd last_drive_wait{};
   double command_position = 0.0;    ///< user units (unwound for rotary)
   double command_velocity = 0.0;    ///< user units/s
   double command_acceleration = 0.0;

@@ -14,21 +14,36 @@
 #include "motion/instr/time_cam.hpp"
 
 namespace canmotion::motion {
-namespace {
-/// MSO/MSF/MDS/fault resets on a CIP drive: how long the planner waits for the drive
-/// (seconds) before ERR 12 (Servo Message Failure, EXERR 16 device in wrong state).
-constexpr double kDriveTimeout = 5.0;
-}  // namespace
-
 Core::Core(double cycle_period) noexcept : T(cycle_period > 0 ? cycle_period : 0.001) {}
 
-std::uint64_t Core::drive_deadline() const noexcept { return cycle + static_cast<std::uint64_t>(kDriveTimeout / T); }
+std::uint64_t Core::drive_deadline(const AxisRt& a) const noexcept {
+  return cycle + static_cast<std::uint64_t>(a.cfg.drive_wait_limit / T);
+}
+
+std::optional<DriveWaitCause> Core::enable_failed(const AxisRt& a, bool fault_waits_for_reset) const noexcept {
+  // A latched fault (Stop Drive) or Shutdown: the drive is not enabled again
+  // before MAFR / MASR (ERR 20 / 7 had it come first).
+  if (a.servo.faulted || a.servo.shutdown) return DriveWaitCause::AxisFaulted;
+  if (a.fb.drive == DriveState::Fault && !(fault_waits_for_reset && a.servo.reset.valid())) return DriveWaitCause::DriveFault;
+  if (link_failed(a.fb.link)) return DriveWaitCause::LinkFailed;
+  if (a.fb.transition_timeout) return DriveWaitCause::TransitionTimeout;
+  if (cycle >= a.hs.deadline) return DriveWaitCause::Limit;
+  return std::nullopt;
+}
+
+void Core::end_drive_wait(AxisRt& a, ControlTag* t, ControlId id, Instr instr, DriveWaitCause cause, std::uint64_t since,
+                          Err e, std::int8_t exerr) noexcept {
+  if (t == nullptr) return;  // a newer execution owns the tag: not this wait's error
+  t->reject(e, exerr);
+  ++a.tag.drive_wait_errors;
+  a.tag.last_drive_wait = DriveWaitEnd{instr, id, cause, static_cast<std::int16_t>(e), exerr, cycle - since};
+}
 
 bool Core::configure_axis(AxisId id, const AxisConfig& cfg) noexcept {
   if (id >= kMaxAxes) return false;
   if (!(cfg.conversion_constant > 0) || (cfg.rotary && !(cfg.unwind > 0)) || cfg.max_speed < 0 ||
       cfg.max_accel < 0 || cfg.max_decel < 0 || cfg.max_accel_jerk < 0 || cfg.max_decel_jerk < 0 ||
-      cfg.position_error_tolerance < 0 || cfg.group >= kMaxGroups)
+      cfg.position_error_tolerance < 0 || !(cfg.drive_wait_limit > 0) || cfg.group >= kMaxGroups)
     return false;
   AxisRt& a = axes[id];
   a = AxisRt{};

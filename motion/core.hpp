@@ -15,6 +15,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 #include "motion/axis.hpp"
@@ -49,6 +50,8 @@ struct ServoState {
   /// waits, the drive fault and lost node conditions are not latched again.
   OwnerRef reset{};
   std::uint64_t reset_deadline = 0;
+  std::uint64_t reset_since = 0;   ///< cycle the waiting fault reset started
+  Instr reset_instr = Instr::MAFR; ///< the instruction that waits (MAFR, MASR, MGSR)
 };
 
 /// Instructions waiting for the drive (AXIS_CIP_DRIVE): the MSO/MSF enable
@@ -56,6 +59,7 @@ struct ServoState {
 struct Handshakes {
   OwnerRef mso{}, msf{};       ///< MSO waiting for Operation Enabled, MSF for its end
   std::uint64_t deadline = 0;  ///< cycle at which MSO/MSF/MDS stop waiting (ERR 12)
+  std::uint64_t since = 0;     ///< cycle the waiting MSO/MSF/MDS started
   OwnerRef mah{};              ///< MAH homing on the drive
   bool homing = false;         ///< drive homing (mode 6) in progress
   bool homing_started = false; ///< the homing request was sent
@@ -215,9 +219,19 @@ struct Core {
       if (auto* p = std::get_if<ProfileGen>(&a.gen[std::countr_zero(m)]); p && p->scurve) return true;
     return false;
   }
-  /// The cycle at which a handshake with the drive (MSO, MSF, MDS, a fault
-  /// reset) times out.
-  std::uint64_t drive_deadline() const noexcept;
+  /// The cycle at which a handshake with `a`'s drive (MSO, MSF, MDS, a
+  /// fault reset) started now times out (AxisConfig::drive_wait_limit).
+  std::uint64_t drive_deadline(const AxisRt& a) const noexcept;
+  /// Why an enable handshake (MSO, MDS) waiting on `a`'s drive fails now, if
+  /// it does: the axis faulted (Stop Drive) or shut down meanwhile, the drive in Fault (unless `fault_waits_for_reset` and a fault
+  /// reset waits for it), a failed link, a transition timeout, the deadline
+  /// Handshakes::deadline.
+  std::optional<DriveWaitCause> enable_failed(const AxisRt& a, bool fault_waits_for_reset) const noexcept;
+  /// End an instruction that waited on `a`'s drive with an error: `t` (may
+  /// be null: a stale tag) rejected with `e`/`exerr`, and the end recorded
+  /// in the axis tag for the log (AxisTag::last_drive_wait).
+  void end_drive_wait(AxisRt& a, ControlTag* t, ControlId id, Instr instr, DriveWaitCause cause, std::uint64_t since,
+                      Err e = Err::ServoMessageFailure, std::int8_t exerr = 16) noexcept;
   AxisId id_of(const AxisRt& a) const noexcept { return static_cast<AxisId>(&a - axes.data()); }
 
  private:

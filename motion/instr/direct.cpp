@@ -54,7 +54,8 @@ Err start(Ctx& x, const MdsParams& p) noexcept {
   } else {  // enable the drive first: STATE 0 request, 1 waiting [seed 002]
     a.servo.enable_req = true;
     a.direct.waiting = true;
-    a.hs.deadline = x.c.drive_deadline();
+    a.hs.since = x.c.cycle;
+    a.hs.deadline = x.c.drive_deadline(a);
     x.tag.state = 0;
   }
   return Err::None;
@@ -88,12 +89,12 @@ void feedback(Core& c, AxisRt& a) noexcept {
       a.servo.on = true;
       a.direct.waiting = false;
       if (t) { t->state = 1; t->set(flag::DN, true); }
-    } else if (a.fb.drive == DriveState::Fault || link_failed(a.fb.link) || a.fb.transition_timeout ||
-               c.cycle >= a.hs.deadline) {
+    } else if (const auto cause = c.enable_failed(a, false); cause) {
+      const OwnerRef mds = a.direct.mds;
       a.direct.waiting = false;
       end(c, a, false);
       a.servo.enable_req = false;
-      if (t) t->reject(Err::ServoMessageFailure, 16);
+      c.end_drive_wait(a, t, mds.id, Instr::MDS, *cause, a.hs.since);
     } else if (t) {
       t->state = 1;
     }

@@ -40,7 +40,8 @@ Err start(Ctx& x, const MsoParams& p) noexcept {
   }
   // CIP: DN when the drive reports Operation Enabled (STATE 0 request, 1 waiting).
   a.hs.mso = x.self;
-  a.hs.deadline = x.c.drive_deadline();
+  a.hs.since = x.c.cycle;
+  a.hs.deadline = x.c.drive_deadline(a);
   x.tag.state = 0;
   return Err::None;
 }
@@ -60,7 +61,8 @@ Err start(Ctx& x, const MsfParams& p) noexcept {
     x.tag.set(flag::DN, true);
   } else {
     a.hs.msf = x.self;
-    a.hs.deadline = x.c.drive_deadline();
+    a.hs.since = x.c.cycle;
+    a.hs.deadline = x.c.drive_deadline(a);
   }
   return Err::None;
 }
@@ -87,7 +89,7 @@ Err start(Ctx& x, const MafrParams& p) noexcept {
   if (a.cfg.inhibited) return Err::AxisIsInhibited;
   // CIP: the drive's fault reset goes out this cycle; DN once the drive has
   // left Fault (and is connected again after a lost node or a reboot).
-  if (servo::reset_faults(x.c, a, x.self)) x.tag.set(flag::DN, true);
+  if (servo::reset_faults(x.c, a, x.self, x.r.instr)) x.tag.set(flag::DN, true);
   return Err::None;
 }
 
@@ -98,13 +100,13 @@ bool drive_clear(const AxisFeedback& f) noexcept {
   return f.link == DriveLink::Up && f.drive != DriveState::Fault && !f.drive_fault && !f.node_lost;
 }
 
-void end_reset(Core& c, AxisRt& a, bool ok) noexcept {
+void end_reset(Core& c, AxisRt& a, bool ok, DriveWaitCause cause = DriveWaitCause::Limit) noexcept {
   const OwnerRef owner = a.servo.reset;
   a.servo.reset = {};
   ControlTag* t = c.tag(owner);
   if (!t) return;
   if (!ok) {
-    t->reject(Err::ServoMessageFailure, 16);  // device in wrong state
+    c.end_drive_wait(a, t, owner.id, a.servo.reset_instr, cause, a.servo.reset_since);  // ERR 12, device in wrong state
     for (std::size_t i = 0; i < c.axis_count; ++i)  // MGSR: the other axes stop waiting
       if (c.axes[i].servo.reset == owner) c.axes[i].servo.reset = {};
     return;
@@ -115,7 +117,7 @@ void end_reset(Core& c, AxisRt& a, bool ok) noexcept {
 }
 }  // namespace
 
-bool reset_faults(Core& c, AxisRt& a, OwnerRef owner) noexcept {
+bool reset_faults(Core& c, AxisRt& a, OwnerRef owner, Instr instr) noexcept {
   a.servo.faulted = false;
   a.tag.exception_faults = 0;
   a.tag.motion_fault_status = 0;
@@ -127,7 +129,9 @@ bool reset_faults(Core& c, AxisRt& a, OwnerRef owner) noexcept {
   if (a.servo.reset.valid() && a.servo.reset.id != owner.id)
     if (ControlTag* old = c.tag(a.servo.reset)) old->reject(Err::ServoMessageFailure, 16);
   a.servo.reset = owner;
-  a.servo.reset_deadline = c.drive_deadline();
+  a.servo.reset_instr = instr;
+  a.servo.reset_since = c.cycle;
+  a.servo.reset_deadline = c.drive_deadline(a);
   return false;
 }
 
@@ -138,8 +142,12 @@ void reset_feedback(Core& c, AxisRt& a) noexcept {
     a.servo.reset = {};
   } else if (drive_clear(a.fb)) {
     end_reset(c, a, true);
-  } else if (link_failed(a.fb.link) || a.fb.transition_timeout || c.cycle >= a.servo.reset_deadline) {
-    end_reset(c, a, false);
+  } else if (link_failed(a.fb.link)) {
+    end_reset(c, a, false, DriveWaitCause::LinkFailed);
+  } else if (a.fb.transition_timeout) {
+    end_reset(c, a, false, DriveWaitCause::TransitionTimeout);
+  } else if (c.cycle >= a.servo.reset_deadline) {
+    end_reset(c, a, false, DriveWaitCause::Limit);
   }
 }
 
@@ -155,10 +163,9 @@ void feedback(Core& c, AxisRt& a) noexcept {
       t->state = 1;
       t->set(flag::DN, true);
       a.hs.mso = {};
-    } else if ((a.fb.drive == DriveState::Fault && !a.servo.reset.valid()) || link_failed(a.fb.link) ||
-               a.fb.transition_timeout || c.cycle >= a.hs.deadline) {
+    } else if (const auto cause = c.enable_failed(a, true); cause) {
       // (a drive still in Fault while a fault reset waits for it: wait too)
-      t->reject(Err::ServoMessageFailure, 16);
+      c.end_drive_wait(a, t, a.hs.mso.id, Instr::MSO, *cause, a.hs.since);
       a.servo.enable_req = false;
       a.hs.mso = {};
     } else {
@@ -173,7 +180,7 @@ void feedback(Core& c, AxisRt& a) noexcept {
       t->set(flag::DN, true);
       a.hs.msf = {};
     } else if (c.cycle >= a.hs.deadline) {
-      t->reject(Err::ServoMessageFailure, 16);
+      c.end_drive_wait(a, t, a.hs.msf.id, Instr::MSF, DriveWaitCause::Limit, a.hs.since);
       a.hs.msf = {};
     }
   }

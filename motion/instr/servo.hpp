@@ -42,18 +42,20 @@ Err start(Ctx& x, const MafrParams& p) noexcept;
 
 namespace servo {
 /// Clear the latched faults and pulse a drive fault reset (MAFR, MASR, MGSR
-/// executed as `owner`). Returns whether the reset is done; not when a CIP
-/// drive still has to leave Fault or reconnect: then `owner` waits in
-/// ServoState::reset (a different execution waiting there gets ERR 12).
-bool reset_faults(Core& c, AxisRt& a, OwnerRef owner) noexcept;
+/// executed as `owner`, an `instr`). Returns whether the reset is done; not
+/// when a CIP drive still has to leave Fault or reconnect: then `owner`
+/// waits in ServoState::reset (a different execution waiting there gets ERR
+/// 12), at most AxisConfig::drive_wait_limit.
+bool reset_faults(Core& c, AxisRt& a, OwnerRef owner, Instr instr) noexcept;
 /// A waiting fault reset, each cycle after the pulse went out (CIP axes,
 /// after the feedback was read): DN when the drive left Fault and is
 /// connected (MGSR: with the group's last axis); ERR 12 EXERR 16 when the
-/// link failed, on a transition timeout or after the drive timeout.
+/// link failed, on a transition timeout or after AxisConfig::drive_wait_limit.
 void reset_feedback(Core& c, AxisRt& a) noexcept;
 /// The MSO / MSF handshakes, each cycle while one waits (CIP axes, after the
 /// feedback was read): DN on Operation Enabled (MSO) or when the drive left
-/// it (MSF); ERR 12 EXERR 16 on a fault or after the drive timeout.
+/// it (MSF); ERR 12 EXERR 16 on a fault, a failed link, a transition timeout
+/// or after AxisConfig::drive_wait_limit (Core::end_drive_wait records it).
 void feedback(Core& c, AxisRt& a) noexcept;
 }  // namespace servo
 

@@ -157,7 +157,7 @@ Err start(Ctx& x, const MgsrParams& p) noexcept {
   bool waiting = false;
   for_group(x.c, p.group, [&](AxisRt& a) noexcept {
     a.servo.shutdown = false;
-    if (!servo::reset_faults(x.c, a, x.self)) waiting = true;
+    if (!servo::reset_faults(x.c, a, x.self, x.r.instr)) waiting = true;
   });
   if (!waiting) x.tag.set(flag::DN, true);
   return Err::None;

@@ -1,5 +1,7 @@
 // describe_axis_fault(): the log text of an axis exception latched as a
-// fault (Event::Kind::kAxisFault). Not RT: canmotiond's housekeeping thread.
+// fault (Event::Kind::kAxisFault); describe_drive_wait(): of an instruction
+// that waited on the drive and ended with an error (Event::Kind::kDriveWait).
+// Not RT: canmotiond's housekeeping thread.
 #include <fmt/format.h>
 
 #include <cstdlib>
@@ -69,6 +71,40 @@ std::string describe_axis_fault(const Event& e, const AxisSpec& axis, std::size_
   const motion::ExceptionAction act = c.action(kind);
   return fmt::format("{}: {} ({}.exception_actions.{}): {}", what, motion::exception_action_name(act), key,
                      motion::exception_key(kind), effect(act));
+}
+
+std::string describe_drive_wait(const Event& e, const AxisSpec& axis, std::size_t index, std::string_view control,
+                                double period_s) {
+  using C = motion::DriveWaitCause;
+  const std::string key = fmt::format("axes[{}].drive.timeouts", index);
+  const motion::DriveWaitEnd& w = e.wait;
+  std::string why;
+  switch (w.cause) {
+    case C::Limit:
+      why = fmt::format("the drive did not get there within the wait limit {:.6g} s ({}.wait_ms; 0 or unset: "
+                        "3 x boot_ms + mode_switch_ms + 4 x transition_ms)",
+                        axis.config.drive_wait_limit, key);
+      break;
+    case C::LinkFailed: why = "the drive's boot failed"; break;
+    case C::TransitionTimeout:
+      why = fmt::format("the drive did not make a state transition within {:.6g} ms ({}.transition_ms)",
+                        static_cast<double>(axis.drive.transition_timeout_ns) / 1e6, key);
+      break;
+    case C::DriveFault: why = "the drive went to Fault"; break;
+    case C::AxisFaulted:
+      why = "the axis latched a fault or went to Shutdown meanwhile (its exception action; MAFR or MASR, then MSO)";
+      break;
+  }
+  std::string drive;
+  if (axis.config.type == motion::AxisType::CipDrive) {
+    const auto phase = cia402::phase_name(e.drive.phase);
+    const auto state = cia402::state_name(e.drive.state);
+    drive = fmt::format("; drive node {}: {}, {} (statusword 0x{:04X})", e.drive.node, phase, state, e.drive.statusword);
+    if (e.failure.kind != cia402::FailureKind::kNone) drive += "; " + e.failure.to_string();
+  }
+  const std::string_view name = motion::signature(w.instr).name;
+  return fmt::format("{}{}{} ended with ERR {} EXERR {} after {:.3f} s: {}{}", name, control.empty() ? "" : " ", control,
+                     w.err, w.exerr, static_cast<double>(w.waited_cycles) * period_s, why, drive);
 }
 
 }  // namespace canmotion::rt

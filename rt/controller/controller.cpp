@@ -501,6 +501,21 @@ void Controller::publish(std::int64_t now_ns) noexcept {
       }
     }
     ax.exception_faults = tag.exception_faults;
+    // An instruction that waited on the drive and ended with an error: once each.
+    if (tag.drive_wait_errors != ax.drive_wait_errors) {
+      ax.drive_wait_errors = tag.drive_wait_errors;
+      Event e;
+      e.kind = Event::Kind::kDriveWait;
+      e.axis = static_cast<std::int16_t>(a);
+      e.bus = static_cast<std::uint8_t>(ax.bus < 0 ? 0 : ax.bus);
+      e.wait = tag.last_drive_wait;
+      e.cycle = cycle_index_;
+      if (const cia402::DriveProxy* p = ax.proxy) {
+        e.drive = Event::DriveView{p->phase(), p->state(), p->feedback().statusword, p->node()};
+        e.failure = p->failure();
+      }
+      emit(e);
+    }
     if (tele) {
       const Sample smp{cycle_index_,       static_cast<std::uint16_t>(a), tag.command_position,
                        tag.actual_position, tag.command_velocity,      tag.actual_velocity,

@@ -187,6 +187,9 @@ struct Event {
     kAxisFault,    ///< an axis latched an exception as a fault (its rising edge in AxisTag::exception_faults):
                    ///< `value` = the motion::ExceptionKind, `detail` = the position error (PositionError) or
                    ///< the command position (soft overtravel) in the axis's units; see describe_axis_fault()
+    kDriveWait,    ///< an instruction that waited on an axis's drive (MSO, MSF, MDS, MAFR, MASR, MGSR) ended
+                   ///< with an error: `wait` says which and why, `drive` and `failure` what the drive
+                   ///< was doing then; see describe_drive_wait()
   };
   Kind kind = Kind::kNode;
   std::uint8_t bus = 0;
@@ -197,6 +200,15 @@ struct Event {
   std::uint64_t value = 0;
   double detail = 0.0;
   std::uint64_t cycle = 0;
+  motion::DriveWaitEnd wait{};  ///< kDriveWait
+  /// kDriveWait on a CIP axis: the drive proxy's phase, CiA 402 state and
+  /// statusword in that cycle.
+  struct DriveView {
+    cia402::Phase phase = cia402::Phase::kWaitBoot;
+    cia402::State state = cia402::State::kUnknown;
+    std::uint16_t statusword = 0;
+    std::uint8_t node = 0;
+  } drive{};
 };
 
 /// One frame on one bus, for the candump trace.
@@ -368,6 +380,7 @@ class Controller {
     std::uint32_t failure_rev = 0;  ///< DriveProxy::failure_revision() when the failure was last reported
     bool homing_out = false;  ///< the planner's homing_start as last handed to the proxy (its edges start/cancel)
     std::uint32_t exception_faults = 0;  ///< AxisTag::exception_faults last cycle (kAxisFault on its rising edges)
+    std::uint32_t drive_wait_errors = 0; ///< AxisTag::drive_wait_errors last cycle (kDriveWait when it grows)
   };
   class RecordingSink;
   /// A command in the ring with its sequence number (submit()).
@@ -459,5 +472,13 @@ class Controller {
 /// action taken and its key, and what clears it; `index` is the axis's place
 /// in the configuration's `axes:` list (the key path `axes[index]`).
 [[nodiscard]] std::string describe_axis_fault(const Event& e, const AxisSpec& axis, std::size_t index);
+/// The log text of an Event::Kind::kDriveWait on axis `axis` (its index in
+/// the configuration, for the keys named) whose control tag is called
+/// `control` (empty: not known), e.g. "MSO mso1 ended with ERR 12 EXERR 16
+/// after 19.500 s: the drive did not get there within its wait limit ...;
+/// drive node 2: waiting for boot-up after NMT reset node, ...". Not
+/// realtime (fmt).
+[[nodiscard]] std::string describe_drive_wait(const Event& e, const AxisSpec& axis, std::size_t index,
+                                              std::string_view control, double period_s);
 
 }  // namespace canmotion::rt

@@ -327,6 +327,26 @@ Runner::Status Runner::fail(const Statement& s, const std::string& message) {
   return status_;
 }
 
+std::optional<std::string> Runner::errored(const Condition& c) {
+  // WAIT UNTIL t.DN / t.PC (as written, not negated or compared) on a
+  // control tag whose .ER is set: the instruction ended with an error, its
+  // DN or PC never comes. Fail now with its ERR, not at the timeout (or never).
+  if (c.op != Condition::Op::kTrue) return std::nullopt;
+  const auto dot = c.tag.rfind('.');
+  if (dot == std::string::npos) return std::nullopt;
+  std::string member = c.tag.substr(dot + 1);
+  for (char& ch : member) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  if (member != "DN" && member != "PC") return std::nullopt;
+  const std::string base = c.tag.substr(0, dot);
+  std::string e;
+  const auto er = host_.read(base + ".ER", &e);
+  if (!er || *er == 0.0) return std::nullopt;
+  const auto err = host_.read(base + ".ERR", &e);
+  const auto exerr = host_.read(base + ".EXERR", &e);
+  return fmt::format("WAIT UNTIL {}: {}.ER is set (ERR {} EXERR {}): the instruction ended with an error, {} never comes",
+                     c.str(), base, format_value(err.value_or(-1)), format_value(exerr.value_or(0)), c.tag);
+}
+
 Runner::Status Runner::step(double now_s) {
   if (status_ != Status::kRunning) return status_;
   if (pending_call_) {
@@ -374,6 +394,7 @@ Runner::Status Runner::step(double now_s) {
         const auto v = host_.read(s.cond.tag, &e);
         if (!v) return fail(s, e);
         if (!s.cond.holds(*v)) {
+          if (auto why = errored(s.cond)) return fail(s, *why);
           if (s.seconds > 0 && now_s - wait_start_ + 5e-10 >= s.seconds)
             return fail(s, fmt::format("WAIT UNTIL {} timed out after {} s ({} = {})", s.cond.str(),
                                        format_value(s.seconds), s.cond.tag, format_value(*v)));

@@ -122,6 +122,8 @@ class Runner {
 
  private:
   Status fail(const Statement& s, const std::string& message);
+  /// The reason a WAIT UNTIL on `c` can never hold: its control tag ended with ER (see script.cpp).
+  std::optional<std::string> errored(const Condition& c);
   const Script& script_;
   ScriptHost& host_;
   std::function<void(const std::string&)> out_;

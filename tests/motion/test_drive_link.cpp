@@ -258,4 +258,49 @@ TEST(DriveLinkFailed, PendingMsoEndsOnATransitionTimeout) {
   EXPECT_FALSE(r.out[0].enable);
 }
 
+// The wait on the drive is bounded by the axis's own drive_wait_limit (the
+// runtime's drive.timeouts.wait_ms), and each wait that ends with an error
+// is recorded for the log with its instruction, tag and cause (issue 26).
+TEST(DriveWait, MsoWaitsItsAxisLimitAndTheEndIsRecorded) {
+  Rig r;
+  AxisConfig c = cip();
+  c.drive_wait_limit = 0.25;  // 250 cycles at 1 ms
+  r.add_axis("D", c);
+  r.fb[0].drive = DriveState::NotReady;
+  r.fb[0].link = DriveLink::Configuring;  // the drive is booting
+  ASSERT_EQ(r.exec("MSO(D, mso);"), Err::None);
+  r.step(250);  // the feedback of update N is judged at the planner's cycle N - 1
+  EXPECT_FALSE(r.tag("mso").er());
+  EXPECT_EQ(r.axis("D").drive_wait_errors, 0u);
+  r.step();
+  EXPECT_TRUE(r.tag("mso").er());
+  EXPECT_EQ(r.tag("mso").err, 12);
+  EXPECT_EQ(r.tag("mso").exerr, 16);
+  ASSERT_EQ(r.axis("D").drive_wait_errors, 1u);
+  const DriveWaitEnd& w = r.axis("D").last_drive_wait;
+  EXPECT_EQ(w.instr, Instr::MSO);
+  EXPECT_EQ(w.cause, DriveWaitCause::Limit);
+  EXPECT_EQ(w.waited_cycles, 250u);
+  EXPECT_EQ(w.err, 12);
+  EXPECT_EQ(w.exerr, 16);
+}
+
+// An MSO still waiting when the axis latches a fault (here the drive
+// rebooted: a drive fault with Stop Drive) ends then, not at its limit: the
+// drive is not enabled again before MAFR.
+TEST(DriveWait, PendingMsoEndsWhenTheAxisFaults) {
+  Rig r;
+  r.add_axis("D", cip());
+  r.fb[0].drive = DriveState::NotReady;
+  ASSERT_EQ(r.exec("MSO(D, mso);"), Err::None);
+  r.step(5);
+  r.fb[0].drive_fault = true;  // e.g. an unexpected boot-up
+  r.fb[0].link = DriveLink::Configuring;
+  r.step(2);
+  EXPECT_TRUE(r.tag("mso").er());
+  EXPECT_EQ(r.tag("mso").err, 12);
+  EXPECT_EQ(r.axis("D").last_drive_wait.cause, DriveWaitCause::AxisFaulted);
+  EXPECT_FALSE(r.out[0].enable);
+}
+
 }  // namespace

@@ -152,6 +152,33 @@ TEST(ScriptRunner, WaitUntilTimeoutFailsWithValue) {
   EXPECT_EQ(r.runner->error(), "t.script:1: WAIT UNTIL X.ActualPosition > 10 timed out after 0.1 s (X.ActualPosition = 0)");
 }
 
+// The instruction a WAIT UNTIL waits for ended with ER while it waited (an
+// MSO whose drive never came): its DN never comes, the script fails at once
+// with the ERR, not at the timeout, and not never without a timeout (issue 26:
+// the burst test waited 60 s for an MSO that had ended with ERR 12 at 5 s).
+TEST(ScriptRunner, WaitUntilDoneFailsAtOnceWhenTheInstructionEndsWithAnError) {
+  ScriptRun r("MSO(X, mso1); WAIT UNTIL mso1.DN;");
+  r.host.tags["mso1.ER"] = 0;
+  r.host.tags["mso1.ERR"] = 0;
+  r.host.tags["mso1.EXERR"] = 0;
+  const auto end = r.until_end(100000, [&](std::uint64_t c) {
+    if (c == 500) {
+      r.host.tags["mso1.ER"] = 1;
+      r.host.tags["mso1.ERR"] = 12;
+      r.host.tags["mso1.EXERR"] = 16;
+    }
+  });
+  EXPECT_EQ(end, 500u);
+  EXPECT_EQ(r.runner->status(), Runner::Status::kFailed);
+  EXPECT_EQ(r.runner->error(), "t.script:1: WAIT UNTIL mso1.DN: mso1.ER is set (ERR 12 EXERR 16): the instruction "
+                               "ended with an error, mso1.DN never comes");
+  // A condition that is not DN/PC as written (negated, compared) is not affected.
+  ScriptRun n("WAIT UNTIL NOT mso1.DN; PRINT Speed;");
+  n.host.tags["mso1.ER"] = 1;
+  n.until_end(10);
+  EXPECT_EQ(n.runner->status(), Runner::Status::kDone);
+}
+
 TEST(ScriptRunner, InstructionErrorIsReportedAndScriptGoesOn) {
   ScriptRun r("MAM(X, mam1); PRINT Speed;");
   r.host.tags["mam1.ER"] = 1;

@@ -158,6 +158,13 @@ class Outputs {
         const auto id = static_cast<motion::AxisId>(e.axis);
         fmt::print(stderr, "canmotiond: axis {}: {}\n", c.axis_name(id),
                    rt::describe_axis_fault(e, c.axis_spec(id), static_cast<std::size_t>(e.axis)));
+      } else if (e.kind == rt::Event::Kind::kDriveWait) {
+        const auto id = static_cast<motion::AxisId>(e.axis);
+        std::string control;
+        for (const auto& [name, cid] : c.controls())
+          if (cid == e.wait.control) control = name;
+        fmt::print(stderr, "canmotiond: axis {}: {}\n", c.axis_name(id),
+                   rt::describe_drive_wait(e, c.axis_spec(id), static_cast<std::size_t>(e.axis), control, c.period_s()));
       } else if (!quiet && e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kEmcy) {
         fmt::print(stderr, "canmotiond: bus {} node {}: EMCY 0x{:04X} {}\n", cfg_.buses[e.bus].name, e.node.node,
                    e.node.emcy.code, canopen::emcy_code_text(e.node.emcy.code));
