@@ -335,6 +335,7 @@ void Emulator::resolve_hot() noexcept {
   h.ip_index = must_find(obj::kInterpolationTimePeriod, 2);
   h.fe_actual = must_find(obj::kFollowingErrorActualValue);
   h.target_velocity = must_find(obj::kTargetVelocity);
+  h.supported_modes = must_find(obj::kSupportedDriveModes);
   h.profile_accel = must_find(obj::kProfileAcceleration);
   h.profile_decel = must_find(obj::kProfileDeceleration);
   auto mds = [&](cia402::MdsObject o) { return must_find(cfg_.mds_objects[o].index, cfg_.mds_objects[o].sub); };
@@ -548,9 +549,16 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   if (index == 0x1017) next_heartbeat_ns_ = now_ns_ + static_cast<std::int64_t>(v) * 1'000'000;
   if (index == 0x1016) consumers_[static_cast<std::size_t>(std::min<std::uint8_t>(sub, 4) - 1)] = Consumer{};
   if (index == kFaultInjection && sub == 0 && v != 0 && !mds) inject_fault(static_cast<std::uint16_t>(v));
-  if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled && !cfg_.refuse_mode_switch &&
-      cfg_.behaviour.mode_switch_syncs == 0)
-    mode_display_ = static_cast<std::int8_t>(v);
+  // A mode written over SDO outside Operation enabled is taken at once, as
+  // an SDO controlword makes its transition at once: no motion is handed
+  // over, and a master may set the mode before it produces any SYNC (a drive
+  // whose 0x6060 starts at 0, e.g. from its EDS). While enabled the switch
+  // waits EmulatorBehaviour::mode_switch_syncs SYNCs (update_mode_display()).
+  if (index == obj::kModesOfOperation && state_ != State::kOperationEnabled && !cfg_.refuse_mode_switch) {
+    mode_wanted_ = static_cast<std::int8_t>(v);
+    mode_countdown_ = 0;
+    set_mode_display(mode_wanted_);
+  }
   if (index == obj::kControlword && out_ != nullptr && cfg_.remote) apply_controlword(static_cast<std::uint16_t>(v), *out_);
   return SdoAbort::kNone;
 }
@@ -592,8 +600,9 @@ void Emulator::power_on(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   sdo_queue_size_ = 0;
   following_error_ = false;
   vel_ = acc_ = 0;
-  mode_display_ = mode_wanted_ = static_cast<std::int8_t>(get(obj::kModesOfOperation));
+  mode_wanted_ = static_cast<std::int8_t>(get(obj::kModesOfOperation));
   mode_countdown_ = 0;
+  set_mode_display(mode_wanted_);
   set(obj::kPositionActualValue, 0, static_cast<std::uint32_t>(position()));
   set(obj::kTargetPosition, 0, static_cast<std::uint32_t>(position()));
   nmt_ = canopen::NmtState::kPreOperational;
@@ -922,7 +931,7 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
       delay_.fill(sp);
       prev_demand_ = sp.position;
       if (!cfg_.refuse_mode_switch && cfg_.behaviour.mode_switch_syncs == 0 && mode_supported(static_cast<std::int8_t>(sval(hot_.modes))))
-        mode_display_ = static_cast<std::int8_t>(sval(hot_.modes));
+        set_mode_display(static_cast<std::int8_t>(sval(hot_.modes)));
       reset_direct_model();
     }
     state_ = r.next;
@@ -1010,7 +1019,6 @@ void Emulator::update_outputs() noexcept {
   put(hot_.position_internal, static_cast<std::uint32_t>(p));
   put(hot_.velocity_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(round_half_away(vel_))));
   put(hot_.fe_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(sval(hot_.target_position) - p)));
-  put(hot_.mode_display, static_cast<std::uint8_t>(mode_display_));
   put(hot_.statusword, statusword());
 }
 
@@ -1093,7 +1101,15 @@ void Emulator::evaluate_controlword(canopen::FrameSink& out) noexcept {
 
 bool Emulator::mode_supported(std::int8_t mode) const noexcept {
   if (mode == 0) return true;  // no mode
-  return (cfg_.supported_modes & cia402::supported_mode_bit(static_cast<cia402::Mode>(mode))) != 0;
+  // 0x6502 as the drive serves it (an EDS's value with cia402-emu --eds);
+  // EmulatorConfig::supported_modes when the drive has no 0x6502.
+  const std::uint64_t modes = hot_.supported_modes != nullptr ? hot_.supported_modes->value : cfg_.supported_modes;
+  return (modes & cia402::supported_mode_bit(static_cast<cia402::Mode>(mode))) != 0;
+}
+
+void Emulator::set_mode_display(std::int8_t mode) noexcept {
+  mode_display_ = mode;
+  put(hot_.mode_display, static_cast<std::uint8_t>(mode));
 }
 
 void Emulator::switch_mode(std::int8_t mode) noexcept {
@@ -1104,7 +1120,7 @@ void Emulator::switch_mode(std::int8_t mode) noexcept {
                          static_cast<std::int16_t>(sval(hot_.target_torque))});
     reset_direct_model();
   }
-  mode_display_ = mode;
+  set_mode_display(mode);
 }
 
 void Emulator::update_mode_display() noexcept {

@@ -149,8 +149,9 @@ struct EmulatorConfig {
   /// Statusword bit 9 (remote): 0 = the drive is under local control and
   /// ignores the bus's controlword (as a drive with its local panel active).
   bool remote = true;
-  /// 0x6502 supported drive modes (bits per CiA 402); 0x6060 values outside
-  /// it are refused.
+  /// 0x6502 supported drive modes (bits per CiA 402) at power-on; 0x6060
+  /// values outside the 0x6502 the drive serves are refused (with `served`,
+  /// an EDS's 0x6502 default wins; without any 0x6502, this mask).
   std::uint32_t supported_modes = cia402::supported_mode_bit(cia402::Mode::kHoming) |
                                   cia402::supported_mode_bit(cia402::Mode::kCsp) |
                                   cia402::supported_mode_bit(cia402::Mode::kCsv) |
@@ -376,6 +377,7 @@ class Emulator final : public canopen::SdoServerBackend {
     Entry* ip_index;            // 0x60C2:2
     Entry* fe_actual;           // 0x60F4
     Entry* target_velocity;     // 0x60FF
+    Entry* supported_modes;     // 0x6502
     // MDS ramps and SLAT (direct_model.cpp)
     Entry* profile_accel;       // 0x6083 RampAcceleration
     Entry* profile_decel;       // 0x6084 RampDeceleration
@@ -446,6 +448,8 @@ class Emulator final : public canopen::SdoServerBackend {
   /// 0x6061 towards 0x6060 (at a SYNC; EmulatorBehaviour::mode_switch_syncs).
   void update_mode_display() noexcept;
   void switch_mode(std::int8_t mode) noexcept;
+  /// The mode the drive runs: mode_display_ and the 0x6061 object (SDO, TPDOs) together.
+  void set_mode_display(std::int8_t mode) noexcept;
   [[nodiscard]] bool mode_supported(std::int8_t mode) const noexcept;
   /// The automatic transitions, all here: 1 (initialisation done after
   /// EmulatorBehaviour::boot_ns), 12 (quick stop completed, at a SYNC),
