@@ -396,6 +396,8 @@ class Emulator final : public canopen::SdoServerBackend {
     bool is_statusword = false;
     bool is_controlword = false;
   };
+  /// Writing an EMCY code here injects that fault (manufacturer area).
+  static constexpr std::uint16_t kFaultInjection = 0x2000;
   static constexpr std::uint32_t key(std::uint16_t index, std::uint8_t sub) noexcept {
     return (static_cast<std::uint32_t>(index) << 8) | sub;
   }
@@ -423,6 +425,13 @@ class Emulator final : public canopen::SdoServerBackend {
   [[nodiscard]] const Entry* served(std::uint16_t index, std::uint8_t sub) const noexcept;  // nullptr: absent or hidden
 
   void handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  // on_frame() by identifier: a SYNC (its length checked against 0x1019),
+  // an SDO request to this node (sdo_server.cpp), a heartbeat (the consumer,
+  // 0x1016), an RPDO (length checked, applied or latched for the SYNC).
+  void on_sync_frame(const can::Frame& f, canopen::FrameSink& out) noexcept;
+  void on_sdo_request(const can::Frame& f, canopen::FrameSink& out) noexcept;
+  void on_heartbeat(std::uint8_t from_node) noexcept;
+  void on_rpdo(const can::Frame& f, canopen::FrameSink& out) noexcept;
   void handle_sync(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
   void apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept;
   void enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept;
