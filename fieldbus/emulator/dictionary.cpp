@@ -35,120 +35,169 @@ void Emulator::set_type(Entry& e, canopen::DataType t) noexcept {
   e.sign = canopen::data_type_signed(t) && !full ? std::uint64_t{1} << (8 * size - 1) : 0;
 }
 
-void Emulator::build_dictionary() {
-  const std::uint8_t n = cfg_.node;
-  od_.clear();
-  add(0x1000, 0, 0x00020192);  // CiA 402, servo drive
-  add(0x1001, 0, 0);
-  add(0x1003, 0, 0);
-  for (std::uint8_t s = 1; s <= 8; ++s) add(0x1003, s, 0);
-  add(0x1005, 0, 0x80);
-  add(0x1006, 0, 0);
-  add(0x1007, 0, 0);
-  add(0x1008, 0, 0, &device_name_);
-  add(0x1009, 0, 0, &hw_version_);
-  add(0x100A, 0, 0, &sw_version_);
-  add(0x1014, 0, canopen::cob::emcy(n));
-  add(0x1015, 0, 0);
-  add(0x1016, 0, 4);
-  for (std::uint8_t s = 1; s <= 4; ++s) add(0x1016, s, 0);
-  add(0x1017, 0, 0);
-  add(0x1018, 0, 4);
-  add(0x1018, 1, cfg_.vendor_id);
-  add(0x1018, 2, cfg_.product_code);
-  add(0x1018, 3, cfg_.revision);
-  add(0x1018, 4, n);
-  add(0x1019, 0, 0);
-  if (cfg_.behaviour.error_behaviour) {
-    add(0x1029, 0, 1);
-    add(0x1029, 1, 0);  // communication error: enter Pre-operational
-  }
-  add(0x1200, 0, 2);
-  add(0x1200, 1, canopen::cob::sdo_rx(n));
-  add(0x1200, 2, canopen::cob::sdo_tx(n));
-  // PDO1 at power-on: CiA 402's predefined RPDO1/TPDO1 (controlword /
-  // statusword only, event-driven), or (permissive) the master's CSP mapping.
-  const bool cia402_pdos = cfg_.behaviour.cia402_default_pdos;
-  const std::uint8_t pdo1_count = cia402_pdos ? 1 : 2;
-  const std::uint8_t pdo1_type = cia402_pdos ? 255 : 1;
-  for (std::uint8_t p = 0; p < 4; ++p) {
-    const auto pn = static_cast<std::uint8_t>(p + 1);
-    const std::uint32_t inval = p == 0 ? 0 : canopen::kPdoInvalid;
-    add(static_cast<std::uint16_t>(0x1400 + p), 0, 2);
-    add(static_cast<std::uint16_t>(0x1400 + p), 1, canopen::cob::rpdo(pn, n) | inval);
-    add(static_cast<std::uint16_t>(0x1400 + p), 2, p == 0 ? pdo1_type : 1);
-    add(static_cast<std::uint16_t>(0x1600 + p), 0, p == 0 ? pdo1_count : 0);
-    for (std::uint8_t s = 1; s <= 8; ++s) {
-      std::uint32_t v = 0;
-      if (p == 0 && s == 1) v = 0x60400010;
-      if (p == 0 && s == 2 && !cia402_pdos) v = 0x607A0020;
-      add(static_cast<std::uint16_t>(0x1600 + p), s, v);
-    }
-    add(static_cast<std::uint16_t>(0x1800 + p), 0, 6);
-    add(static_cast<std::uint16_t>(0x1800 + p), 1, canopen::cob::tpdo(pn, n) | inval);
-    add(static_cast<std::uint16_t>(0x1800 + p), 2, p == 0 ? pdo1_type : 1);
-    add(static_cast<std::uint16_t>(0x1800 + p), 3, 0);
-    add(static_cast<std::uint16_t>(0x1800 + p), 5, 0);
-    add(static_cast<std::uint16_t>(0x1800 + p), 6, 0);
-    add(static_cast<std::uint16_t>(0x1A00 + p), 0, p == 0 ? pdo1_count : 0);
-    for (std::uint8_t s = 1; s <= 8; ++s) {
-      std::uint32_t v = 0;
-      if (p == 0 && s == 1) v = 0x60410010;
-      if (p == 0 && s == 2 && !cia402_pdos) v = 0x60640020;
-      add(static_cast<std::uint16_t>(0x1A00 + p), s, v);
-    }
-  }
-  add(kFaultInjection, 0, 0);
-  add(obj::kErrorCode, 0, 0);
-  add(obj::kControlword, 0, 0);
-  add(obj::kStatusword, 0, 0);
-  add(obj::kQuickStopOptionCode, 0, 2);
-  add(obj::kShutdownOptionCode, 0, 0);
-  add(obj::kDisableOperationOptionCode, 0, 1);
-  add(obj::kHaltOptionCode, 0, 1);
-  add(obj::kFaultReactionOptionCode, 0, 2);
-  add(obj::kModesOfOperation, 0, 8);
-  add(obj::kModesOfOperationDisplay, 0, 8);
-  add(obj::kPositionDemandValue, 0, 0);
-  add(obj::kPositionActualInternalValue, 0, 0);
-  add(obj::kPositionActualValue, 0, 0);
-  add(obj::kFollowingErrorWindow, 0, cfg_.following_error_window);
-  add(obj::kFollowingErrorTimeOut, 0, 0);
-  add(obj::kPositionWindow, 0, 100);
-  add(obj::kPositionWindowTime, 0, 0);
-  add(obj::kVelocityDemandValue, 0, 0);
-  add(obj::kVelocityActualValue, 0, 0);
-  add(obj::kTargetTorque, 0, 0);
-  add(obj::kMaxTorque, 0, 3000);
-  add(0x6074, 0, 0);
-  add(0x6076, 0, 1000);
-  add(obj::kTorqueActualValue, 0, 0);
-  add(obj::kTargetPosition, 0, 0);
-  add(obj::kHomeOffset, 0, 0);
-  add(obj::kSoftwarePositionLimit, 0, 2);
-  add(obj::kSoftwarePositionLimit, 1, 0x80000000u);
-  add(obj::kSoftwarePositionLimit, 2, 0x7FFFFFFFu);
-  add(obj::kMaxProfileVelocity, 0, static_cast<std::uint32_t>(cfg_.max_velocity));
-  add(obj::kProfileVelocity, 0, 100000);
+// The emulator's own objects, one row each (a row with `subs` or `pdos`
+// above 1 stands for a run of sub-indices or for PDOs 1..4). Columns:
+// index, first sub-index, last sub-index, where the power-on value comes
+// from, the value (Default::kValue) or PDO 1's mapping entry, the Hot entry
+// the application reads and writes it through (a Hot array for a run of
+// sub-indices), how many PDOs (consecutive indices), only with
+// EmulatorBehaviour::error_behaviour. Data type, access and PDO mapping come
+// from the project's one table of CiA 301/402 objects,
+// canopen::object_info() (canopen/object_names.hpp). Data table.
+// clang-format off
+const Emulator::ObjectRow Emulator::kObjectTable[] = {
+  // ---- CiA 301 communication profile -------------------------------------------------------
+  {0x1000, 0, 0, Default::kValue, 0x00020192},                     // device type: CiA 402, servo drive
+  {0x1001, 0, 0, Default::kValue, 0, &Hot::error_register},
+  {0x1003, 0, 8, Default::kValue, 0},                              // pre-defined error field
+  {0x1005, 0, 0, Default::kValue, 0x80, &Hot::sync_cob},
+  {obj::kCommunicationCyclePeriod, 0, 0, Default::kValue, 0},
+  {0x1007, 0, 0, Default::kValue, 0},
+  {0x1008, 0, 0, Default::kDeviceName, 0},
+  {0x1009, 0, 0, Default::kHardwareVersion, 0},
+  {0x100A, 0, 0, Default::kSoftwareVersion, 0},
+  {0x1014, 0, 0, Default::kEmcyCobId, 0, &Hot::emcy_cob},
+  {0x1015, 0, 0, Default::kValue, 0},
+  {0x1016, 0, 0, Default::kValue, 4},
+  {0x1016, 1, 4, Default::kValue, 0, nullptr, &Hot::consumer_hb},
+  {0x1017, 0, 0, Default::kValue, 0, &Hot::producer_hb},
+  {obj::kIdentity, 0, 0, Default::kValue, 4},
+  {obj::kIdentity, 1, 1, Default::kVendorId, 0},
+  {obj::kIdentity, 2, 2, Default::kProductCode, 0},
+  {obj::kIdentity, 3, 3, Default::kRevision, 0},
+  {obj::kIdentity, 4, 4, Default::kNodeId, 0},
+  {obj::kSyncCounterOverflow, 0, 0, Default::kValue, 0},
+  {0x1029, 0, 0, Default::kValue, 1, nullptr, nullptr, 1, true},
+  {0x1029, 1, 1, Default::kValue, 0, nullptr, nullptr, 1, true},  // communication error: enter Pre-operational
+  {0x1200, 0, 0, Default::kValue, 2},
+  {0x1200, 1, 1, Default::kSdoRxCobId, 0},
+  {0x1200, 2, 2, Default::kSdoTxCobId, 0},
+  // PDOs 1..4. PDO1 at power-on: CiA 402's predefined RPDO1/TPDO1
+  // (controlword / statusword only, event-driven), or (permissive,
+  // EmulatorBehaviour::cia402_default_pdos false) the master's CSP mapping.
+  {0x1400, 0, 0, Default::kValue, 2, nullptr, nullptr, 4},
+  {0x1400, 1, 1, Default::kRpdoCobId, 0, nullptr, nullptr, 4},
+  {0x1400, 2, 2, Default::kPdo1TransmissionType, 0, nullptr, nullptr, 4},
+  {0x1600, 0, 0, Default::kPdo1MapCount, 0, nullptr, nullptr, 4},
+  {0x1600, 1, 1, Default::kPdo1Map, 0x60400010, nullptr, nullptr, 4},     // controlword
+  {0x1600, 2, 2, Default::kPdo1CspMap, 0x607A0020, nullptr, nullptr, 4},  // target position
+  {0x1600, 3, 8, Default::kValue, 0, nullptr, nullptr, 4},
+  {0x1800, 0, 0, Default::kValue, 6, nullptr, nullptr, 4},
+  {0x1800, 1, 1, Default::kTpdoCobId, 0, nullptr, nullptr, 4},
+  {0x1800, 2, 2, Default::kPdo1TransmissionType, 0, nullptr, nullptr, 4},
+  {0x1800, 3, 3, Default::kValue, 0, nullptr, nullptr, 4},               // inhibit time (100 us)
+  {0x1800, 5, 5, Default::kValue, 0, nullptr, nullptr, 4},               // event timer (ms)
+  {0x1800, 6, 6, Default::kValue, 0, nullptr, nullptr, 4},               // SYNC start value
+  {0x1A00, 0, 0, Default::kPdo1MapCount, 0, nullptr, nullptr, 4},
+  {0x1A00, 1, 1, Default::kPdo1Map, 0x60410010, nullptr, nullptr, 4},     // statusword
+  {0x1A00, 2, 2, Default::kPdo1CspMap, 0x60640020, nullptr, nullptr, 4},  // position actual value
+  {0x1A00, 3, 8, Default::kValue, 0, nullptr, nullptr, 4},
+  // ---- manufacturer area ------------------------------------------------------------------
+  {Emulator::kFaultInjection, 0, 0, Default::kValue, 0},
+  // ---- CiA 402 drive profile ------------------------------------------------------------------
+  {obj::kErrorCode, 0, 0, Default::kValue, 0, &Hot::error_code},
+  {obj::kControlword, 0, 0, Default::kValue, 0, &Hot::controlword},
+  {obj::kStatusword, 0, 0, Default::kValue, 0, &Hot::statusword},
+  {obj::kQuickStopOptionCode, 0, 0, Default::kValue, 2, &Hot::quick_stop_option},
+  {obj::kShutdownOptionCode, 0, 0, Default::kValue, 0},
+  {obj::kDisableOperationOptionCode, 0, 0, Default::kValue, 1},
+  {obj::kHaltOptionCode, 0, 0, Default::kValue, 1},
+  {obj::kFaultReactionOptionCode, 0, 0, Default::kValue, 2},
+  {obj::kModesOfOperation, 0, 0, Default::kValue, 8, &Hot::modes},
+  {obj::kModesOfOperationDisplay, 0, 0, Default::kValue, 8, &Hot::mode_display},
+  {obj::kPositionDemandValue, 0, 0, Default::kValue, 0, &Hot::position_demand},
+  {obj::kPositionActualInternalValue, 0, 0, Default::kValue, 0, &Hot::position_internal},
+  {obj::kPositionActualValue, 0, 0, Default::kValue, 0, &Hot::position_actual},
+  {obj::kFollowingErrorWindow, 0, 0, Default::kFollowingErrorWindow, 0, &Hot::fe_window},
+  {obj::kFollowingErrorTimeOut, 0, 0, Default::kValue, 0, &Hot::fe_timeout},
+  {obj::kPositionWindow, 0, 0, Default::kValue, 100},
+  {obj::kPositionWindowTime, 0, 0, Default::kValue, 0},
+  {obj::kVelocityDemandValue, 0, 0, Default::kValue, 0},
+  {obj::kVelocityActualValue, 0, 0, Default::kValue, 0, &Hot::velocity_actual},
+  {obj::kTargetTorque, 0, 0, Default::kValue, 0, &Hot::target_torque},
+  {obj::kMaxTorque, 0, 0, Default::kValue, 3000, &Hot::max_torque},
+  {0x6074, 0, 0, Default::kValue, 0},                              // torque demand
+  {0x6076, 0, 0, Default::kValue, 1000},                           // motor rated torque
+  {obj::kTorqueActualValue, 0, 0, Default::kValue, 0, &Hot::torque_actual},
+  {obj::kTargetPosition, 0, 0, Default::kValue, 0, &Hot::target_position},
+  {obj::kHomeOffset, 0, 0, Default::kValue, 0, &Hot::home_offset},
+  {obj::kSoftwarePositionLimit, 0, 0, Default::kValue, 2},
+  {obj::kSoftwarePositionLimit, 1, 1, Default::kValue, 0x80000000u},
+  {obj::kSoftwarePositionLimit, 2, 2, Default::kValue, 0x7FFFFFFFu},
+  {obj::kMaxProfileVelocity, 0, 0, Default::kMaxVelocity, 0, &Hot::max_profile_velocity},
+  {obj::kProfileVelocity, 0, 0, Default::kValue, 100000},
   // Ramps of CSV (MDS): by default as fast as the model can go.
-  add(obj::kProfileAcceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
-  add(obj::kProfileDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
-  add(obj::kQuickStopDeceleration, 0, static_cast<std::uint32_t>(cfg_.max_acceleration));
-  add(obj::kHomingMethod, 0, 35);
-  add(obj::kHomingSpeeds, 0, 2);
-  add(obj::kHomingSpeeds, 1, 100000);
-  add(obj::kHomingSpeeds, 2, 10000);
-  add(obj::kHomingAcceleration, 0, 1000000);
-  add(obj::kPositionOffset, 0, 0);
-  add(obj::kVelocityOffset, 0, 0);
-  add(obj::kTorqueOffset, 0, 0);
-  add(obj::kInterpolationTimePeriod, 0, 2);
-  add(obj::kInterpolationTimePeriod, 1, 1);
-  add(obj::kInterpolationTimePeriod, 2, static_cast<std::uint8_t>(std::int8_t{-3}));
-  add(obj::kFollowingErrorActualValue, 0, 0);
-  add(obj::kDigitalInputs, 0, 0);
-  add(obj::kTargetVelocity, 0, 0);
-  add(obj::kSupportedDriveModes, 0, cfg_.supported_modes);
+  {obj::kProfileAcceleration, 0, 0, Default::kMaxAcceleration, 0, &Hot::profile_accel},
+  {obj::kProfileDeceleration, 0, 0, Default::kMaxAcceleration, 0, &Hot::profile_decel},
+  {obj::kQuickStopDeceleration, 0, 0, Default::kMaxAcceleration, 0, &Hot::quick_stop_decel},
+  {obj::kHomingMethod, 0, 0, Default::kValue, 35, &Hot::homing_method},
+  {obj::kHomingSpeeds, 0, 0, Default::kValue, 2},
+  {obj::kHomingSpeeds, 1, 1, Default::kValue, 100000, &Hot::homing_speed_switch},
+  {obj::kHomingSpeeds, 2, 2, Default::kValue, 10000},
+  {obj::kHomingAcceleration, 0, 0, Default::kValue, 1000000},
+  {obj::kPositionOffset, 0, 0, Default::kValue, 0, &Hot::position_offset},
+  {obj::kVelocityOffset, 0, 0, Default::kValue, 0, &Hot::velocity_offset},
+  {obj::kTorqueOffset, 0, 0, Default::kValue, 0, &Hot::torque_offset},
+  {obj::kInterpolationTimePeriod, 0, 0, Default::kValue, 2},
+  {obj::kInterpolationTimePeriod, 1, 1, Default::kValue, 1, &Hot::ip_value},
+  {obj::kInterpolationTimePeriod, 2, 2, Default::kValue, 0xFD, &Hot::ip_index},  // -3: milliseconds
+  {obj::kFollowingErrorActualValue, 0, 0, Default::kValue, 0, &Hot::fe_actual},
+  {obj::kDigitalInputs, 0, 0, Default::kValue, 0},
+  {obj::kTargetVelocity, 0, 0, Default::kValue, 0, &Hot::target_velocity},
+  {obj::kSupportedDriveModes, 0, 0, Default::kSupportedModes, 0, &Hot::supported_modes},
+};
+// clang-format on
+
+std::uint64_t Emulator::default_of(const ObjectRow& r, std::uint8_t pdo) const noexcept {
+  const std::uint8_t n = cfg_.node;
+  const bool cia402_pdos = cfg_.behaviour.cia402_default_pdos;
+  const auto pn = static_cast<std::uint8_t>(pdo + 1);
+  const std::uint32_t invalid = pdo == 0 ? 0 : canopen::kPdoInvalid;  // PDOs 2..4 start invalid
+  switch (r.from) {
+    case Default::kValue: return r.value;
+    case Default::kNodeId: return n;
+    case Default::kEmcyCobId: return canopen::cob::emcy(n);
+    case Default::kSdoRxCobId: return canopen::cob::sdo_rx(n);
+    case Default::kSdoTxCobId: return canopen::cob::sdo_tx(n);
+    case Default::kVendorId: return cfg_.vendor_id;
+    case Default::kProductCode: return cfg_.product_code;
+    case Default::kRevision: return cfg_.revision;
+    case Default::kFollowingErrorWindow: return cfg_.following_error_window;
+    case Default::kMaxVelocity: return static_cast<std::uint32_t>(cfg_.max_velocity);
+    case Default::kMaxAcceleration: return static_cast<std::uint32_t>(cfg_.max_acceleration);
+    case Default::kSupportedModes: return cfg_.supported_modes;
+    case Default::kDeviceName:
+    case Default::kHardwareVersion:
+    case Default::kSoftwareVersion: return 0;  // text_of()
+    case Default::kRpdoCobId: return canopen::cob::rpdo(pn, n) | invalid;
+    case Default::kTpdoCobId: return canopen::cob::tpdo(pn, n) | invalid;
+    case Default::kPdo1TransmissionType: return pdo == 0 && cia402_pdos ? 255 : 1;
+    case Default::kPdo1MapCount: return pdo != 0 ? 0 : cia402_pdos ? 1 : 2;
+    case Default::kPdo1Map: return pdo == 0 ? r.value : 0;
+    case Default::kPdo1CspMap: return pdo == 0 && !cia402_pdos ? r.value : 0;
+  }
+  return 0;
+}
+
+const std::string* Emulator::text_of(const ObjectRow& r) const noexcept {
+  switch (r.from) {
+    case Default::kDeviceName: return &device_name_;
+    case Default::kHardwareVersion: return &hw_version_;
+    case Default::kSoftwareVersion: return &sw_version_;
+    default: return nullptr;
+  }
+}
+
+void Emulator::build_dictionary() {
+  od_.clear();
+  for (const ObjectRow& r : kObjectTable) {
+    if (r.error_behaviour_only && !cfg_.behaviour.error_behaviour) continue;
+    for (std::uint8_t p = 0; p < r.pdos; ++p) {
+      const std::uint64_t v = default_of(r, p);
+      for (unsigned s = r.sub; s <= r.sub_last; ++s)
+        add(static_cast<std::uint16_t>(r.index + p), static_cast<std::uint8_t>(s), v, text_of(r));
+    }
+  }
   const std::vector<std::uint32_t> mds_keys = add_mds_objects();
   // A drive without some optional objects (EmulatorConfig::absent_objects,
   // EmulatorBehaviour::optional_objects_absent: 0x1016 and the MDS objects).
@@ -229,48 +278,16 @@ std::vector<Emulator::ObjectDescription> Emulator::dictionary() const {
 }
 
 void Emulator::resolve_hot() noexcept {
-  // Every object below is added by build_dictionary(); one named in
+  // Every object of kObjectTable is added by build_dictionary(); one named in
   // EmulatorConfig::absent_objects is nullptr here, which val()/sval()/put()
   // accept (the drive then behaves as if it were 0 and ignores writes).
-  auto must_find = [this](std::uint16_t index, std::uint8_t sub = 0) { return find(index, sub); };
   Hot& h = hot_;
-  h.error_register = must_find(0x1001);
-  h.sync_cob = must_find(0x1005);
-  h.emcy_cob = must_find(0x1014);
-  for (std::uint8_t s = 1; s <= 4; ++s) h.consumer_hb[s - 1] = must_find(0x1016, s);
-  h.producer_hb = must_find(0x1017);
-  h.error_code = must_find(obj::kErrorCode);
-  h.controlword = must_find(obj::kControlword);
-  h.statusword = must_find(obj::kStatusword);
-  h.quick_stop_option = must_find(obj::kQuickStopOptionCode);
-  h.modes = must_find(obj::kModesOfOperation);
-  h.mode_display = must_find(obj::kModesOfOperationDisplay);
-  h.position_demand = must_find(obj::kPositionDemandValue);
-  h.position_internal = must_find(obj::kPositionActualInternalValue);
-  h.position_actual = must_find(obj::kPositionActualValue);
-  h.fe_window = must_find(obj::kFollowingErrorWindow);
-  h.fe_timeout = must_find(obj::kFollowingErrorTimeOut);
-  h.velocity_actual = must_find(obj::kVelocityActualValue);
-  h.target_torque = must_find(obj::kTargetTorque);
-  h.max_torque = must_find(obj::kMaxTorque);
-  h.torque_actual = must_find(obj::kTorqueActualValue);
-  h.target_position = must_find(obj::kTargetPosition);
-  h.home_offset = must_find(obj::kHomeOffset);
-  h.max_profile_velocity = must_find(obj::kMaxProfileVelocity);
-  h.quick_stop_decel = must_find(obj::kQuickStopDeceleration);
-  h.homing_method = must_find(obj::kHomingMethod);
-  h.homing_speed_switch = must_find(obj::kHomingSpeeds, 1);
-  h.position_offset = must_find(obj::kPositionOffset);
-  h.velocity_offset = must_find(obj::kVelocityOffset);
-  h.torque_offset = must_find(obj::kTorqueOffset);
-  h.ip_value = must_find(obj::kInterpolationTimePeriod, 1);
-  h.ip_index = must_find(obj::kInterpolationTimePeriod, 2);
-  h.fe_actual = must_find(obj::kFollowingErrorActualValue);
-  h.target_velocity = must_find(obj::kTargetVelocity);
-  h.supported_modes = must_find(obj::kSupportedDriveModes);
-  h.profile_accel = must_find(obj::kProfileAcceleration);
-  h.profile_decel = must_find(obj::kProfileDeceleration);
-  auto mds = [&](cia402::MdsObject o) { return must_find(cfg_.mds_objects[o].index, cfg_.mds_objects[o].sub); };
+  for (const ObjectRow& r : kObjectTable) {
+    if (r.wire != nullptr) h.*r.wire = find(r.index, r.sub);
+    if (r.wires != nullptr)
+      for (unsigned s = r.sub; s <= r.sub_last; ++s) (h.*r.wires)[s - r.sub] = find(r.index, static_cast<std::uint8_t>(s));
+  }
+  auto mds = [&](cia402::MdsObject o) { return find(cfg_.mds_objects[o].index, cfg_.mds_objects[o].sub); };
   h.ramp_vpos = mds(cia402::MdsObject::kRampVelocityPositive);
   h.ramp_vneg = mds(cia402::MdsObject::kRampVelocityNegative);
   h.ramp_jerk = mds(cia402::MdsObject::kRampJerkControl);

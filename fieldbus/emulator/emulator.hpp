@@ -389,6 +389,47 @@ class Emulator final : public canopen::SdoServerBackend {
     Entry* slat_set_point;      // SLAT set point
     Entry* slat_delay;          // SLAT time delay
   };
+  /// Where an object's power-on value comes from (a column of kObjectTable).
+  enum class Default : std::uint8_t {
+    kValue,                 ///< the row's value
+    kNodeId,                ///< EmulatorConfig::node
+    kEmcyCobId,             ///< 0x80 + node
+    kSdoRxCobId,            ///< 0x600 + node
+    kSdoTxCobId,            ///< 0x580 + node
+    kVendorId,              ///< EmulatorConfig::vendor_id
+    kProductCode,           ///< EmulatorConfig::product_code
+    kRevision,              ///< EmulatorConfig::revision
+    kFollowingErrorWindow,  ///< EmulatorConfig::following_error_window
+    kMaxVelocity,           ///< EmulatorConfig::max_velocity (counts/s)
+    kMaxAcceleration,       ///< EmulatorConfig::max_acceleration (counts/s^2)
+    kSupportedModes,        ///< EmulatorConfig::supported_modes
+    kDeviceName,            ///< text: EmulatorConfig::device_name
+    kHardwareVersion,       ///< text
+    kSoftwareVersion,       ///< text
+    kRpdoCobId,             ///< CiA 301 default RPDO COB-ID; PDOs 2..4 invalid (bit 31)
+    kTpdoCobId,             ///< CiA 301 default TPDO COB-ID; PDOs 2..4 invalid
+    kPdo1TransmissionType,  ///< PDO 1: 255 (CiA 402 predefined) or 1; others 1
+    kPdo1MapCount,          ///< PDO 1: 1 (CiA 402 predefined) or 2; others 0
+    kPdo1Map,               ///< PDO 1: the row's mapping entry; others 0
+    kPdo1CspMap,            ///< PDO 1 without the CiA 402 predefined PDOs: the row's entry; else 0
+  };
+  /// One row of the object table the dictionary is built from (dictionary.cpp).
+  struct ObjectRow {
+    std::uint16_t index;
+    std::uint8_t sub;
+    std::uint8_t sub_last;                             ///< sub .. sub_last, the same value each
+    Default from;
+    std::uint64_t value;                               ///< raw bits (kValue) or PDO 1's mapping entry
+    Entry* Hot::* wire = nullptr;                      ///< the Hot entry for it (one sub-index)
+    std::array<Entry*, 4> Hot::* wires = nullptr;      ///< the Hot entries for sub .. sub_last
+    std::uint8_t pdos = 1;                             ///< the row for indices index .. index + pdos - 1 (PDOs 1..4)
+    bool error_behaviour_only = false;                 ///< only with EmulatorBehaviour::error_behaviour
+  };
+  /// The emulator's own objects (dictionary.cpp); data type, access and PDO
+  /// mapping from canopen::object_info().
+  static const ObjectRow kObjectTable[];
+  [[nodiscard]] std::uint64_t default_of(const ObjectRow& r, std::uint8_t pdo) const noexcept;
+  [[nodiscard]] const std::string* text_of(const ObjectRow& r) const noexcept;
   /// Per mapped PDO entry: the dictionary entry (nullptr if absent); where
   /// it sits in the payload is in the PDO's packing plan.
   struct MappedEntry {
