@@ -149,8 +149,9 @@ struct EmulatorConfig {
   /// Statusword bit 9 (remote): 0 = the drive is under local control and
   /// ignores the bus's controlword (as a drive with its local panel active).
   bool remote = true;
-  /// 0x6502 supported drive modes (bits per CiA 402); 0x6060 values outside
-  /// it are refused.
+  /// 0x6502 supported drive modes (bits per CiA 402) at power-on; 0x6060
+  /// values outside the 0x6502 the drive serves are refused (with `served`,
+  /// an EDS's 0x6502 default wins; without any 0x6502, this mask).
   std::uint32_t supported_modes = cia402::supported_mode_bit(cia402::Mode::kHoming) |
                                   cia402::supported_mode_bit(cia402::Mode::kCsp) |
                                   cia402::supported_mode_bit(cia402::Mode::kCsv) |
@@ -376,6 +377,7 @@ class Emulator final : public canopen::SdoServerBackend {
     Entry* ip_index;            // 0x60C2:2
     Entry* fe_actual;           // 0x60F4
     Entry* target_velocity;     // 0x60FF
+    Entry* supported_modes;     // 0x6502
     // MDS ramps and SLAT (direct_model.cpp)
     Entry* profile_accel;       // 0x6083 RampAcceleration
     Entry* profile_decel;       // 0x6084 RampDeceleration
@@ -387,6 +389,47 @@ class Emulator final : public canopen::SdoServerBackend {
     Entry* slat_set_point;      // SLAT set point
     Entry* slat_delay;          // SLAT time delay
   };
+  /// Where an object's power-on value comes from (a column of kObjectTable).
+  enum class Default : std::uint8_t {
+    kValue,                 ///< the row's value
+    kNodeId,                ///< EmulatorConfig::node
+    kEmcyCobId,             ///< 0x80 + node
+    kSdoRxCobId,            ///< 0x600 + node
+    kSdoTxCobId,            ///< 0x580 + node
+    kVendorId,              ///< EmulatorConfig::vendor_id
+    kProductCode,           ///< EmulatorConfig::product_code
+    kRevision,              ///< EmulatorConfig::revision
+    kFollowingErrorWindow,  ///< EmulatorConfig::following_error_window
+    kMaxVelocity,           ///< EmulatorConfig::max_velocity (counts/s)
+    kMaxAcceleration,       ///< EmulatorConfig::max_acceleration (counts/s^2)
+    kSupportedModes,        ///< EmulatorConfig::supported_modes
+    kDeviceName,            ///< text: EmulatorConfig::device_name
+    kHardwareVersion,       ///< text
+    kSoftwareVersion,       ///< text
+    kRpdoCobId,             ///< CiA 301 default RPDO COB-ID; PDOs 2..4 invalid (bit 31)
+    kTpdoCobId,             ///< CiA 301 default TPDO COB-ID; PDOs 2..4 invalid
+    kPdo1TransmissionType,  ///< PDO 1: 255 (CiA 402 predefined) or 1; others 1
+    kPdo1MapCount,          ///< PDO 1: 1 (CiA 402 predefined) or 2; others 0
+    kPdo1Map,               ///< PDO 1: the row's mapping entry; others 0
+    kPdo1CspMap,            ///< PDO 1 without the CiA 402 predefined PDOs: the row's entry; else 0
+  };
+  /// One row of the object table the dictionary is built from (dictionary.cpp).
+  struct ObjectRow {
+    std::uint16_t index;
+    std::uint8_t sub;
+    std::uint8_t sub_last;                             ///< sub .. sub_last, the same value each
+    Default from;
+    std::uint64_t value;                               ///< raw bits (kValue) or PDO 1's mapping entry
+    Entry* Hot::* wire = nullptr;                      ///< the Hot entry for it (one sub-index)
+    std::array<Entry*, 4> Hot::* wires = nullptr;      ///< the Hot entries for sub .. sub_last
+    std::uint8_t pdos = 1;                             ///< the row for indices index .. index + pdos - 1 (PDOs 1..4)
+    bool error_behaviour_only = false;                 ///< only with EmulatorBehaviour::error_behaviour
+  };
+  /// The emulator's own objects (dictionary.cpp); data type, access and PDO
+  /// mapping from canopen::object_info().
+  static const ObjectRow kObjectTable[];
+  [[nodiscard]] std::uint64_t default_of(const ObjectRow& r, std::uint8_t pdo) const noexcept;
+  [[nodiscard]] const std::string* text_of(const ObjectRow& r) const noexcept;
   /// Per mapped PDO entry: the dictionary entry (nullptr if absent); where
   /// it sits in the payload is in the PDO's packing plan.
   struct MappedEntry {
@@ -394,6 +437,8 @@ class Emulator final : public canopen::SdoServerBackend {
     bool is_statusword = false;
     bool is_controlword = false;
   };
+  /// Writing an EMCY code here injects that fault (manufacturer area).
+  static constexpr std::uint16_t kFaultInjection = 0x2000;
   static constexpr std::uint32_t key(std::uint16_t index, std::uint8_t sub) noexcept {
     return (static_cast<std::uint32_t>(index) << 8) | sub;
   }
@@ -421,6 +466,13 @@ class Emulator final : public canopen::SdoServerBackend {
   [[nodiscard]] const Entry* served(std::uint16_t index, std::uint8_t sub) const noexcept;  // nullptr: absent or hidden
 
   void handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  // on_frame() by identifier: a SYNC (its length checked against 0x1019),
+  // an SDO request to this node (sdo_server.cpp), a heartbeat (the consumer,
+  // 0x1016), an RPDO (length checked, applied or latched for the SYNC).
+  void on_sync_frame(const can::Frame& f, canopen::FrameSink& out) noexcept;
+  void on_sdo_request(const can::Frame& f, canopen::FrameSink& out) noexcept;
+  void on_heartbeat(std::uint8_t from_node) noexcept;
+  void on_rpdo(const can::Frame& f, canopen::FrameSink& out) noexcept;
   void handle_sync(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
   void apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noexcept;
   void enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept;
@@ -446,6 +498,8 @@ class Emulator final : public canopen::SdoServerBackend {
   /// 0x6061 towards 0x6060 (at a SYNC; EmulatorBehaviour::mode_switch_syncs).
   void update_mode_display() noexcept;
   void switch_mode(std::int8_t mode) noexcept;
+  /// The mode the drive runs: mode_display_ and the 0x6061 object (SDO, TPDOs) together.
+  void set_mode_display(std::int8_t mode) noexcept;
   [[nodiscard]] bool mode_supported(std::int8_t mode) const noexcept;
   /// The automatic transitions, all here: 1 (initialisation done after
   /// EmulatorBehaviour::boot_ns), 12 (quick stop completed, at a SYNC),

@@ -466,6 +466,16 @@ TEST(EmulatorStrict, ModeSwitchDelayedAndUnsupportedModesRefused) {
   ASSERT_EQ(s.read(0x6502, 0, v), 0u);
   EXPECT_EQ(v, c.supported_modes);
   s.start();
+  // Outside Operation enabled an SDO-written mode is taken at once (issue 26
+  // item 3: a master may set it before it produces SYNC); 0x6061 shows it.
+  ASSERT_EQ(s.write(0x6060, 0, 6, 1), 0u);
+  EXPECT_EQ(s.emu.mode_display(), 6);
+  ASSERT_EQ(s.read(0x6061, 0, v), 0u);
+  EXPECT_EQ(v, 6u);
+  ASSERT_EQ(s.write(0x6060, 0, 8, 1), 0u);
+  EXPECT_EQ(s.emu.mode_display(), 8);
+  // While enabled the switch hands the motion over at the drive's cycle.
+  ASSERT_TRUE(s.enable());
   ASSERT_EQ(s.write(0x6060, 0, 6, 1), 0u);
   EXPECT_EQ(s.emu.mode_display(), 8);
   s.sync();

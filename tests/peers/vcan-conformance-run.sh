@@ -1,14 +1,18 @@
 #!/usr/bin/env bash
-# vcan.peer.conformance and vcan.peer.conformance_emu: one drive as a separate
-# process on vcan0 (node 5), checked by conformance.py (spec_checks.py) over
-# real SocketCAN.
-#   vcan-conformance-run.sh PYTHON                         the peer (cia402_peer.py)
-#   vcan-conformance-run.sh PYTHON CIA402_EMU [OPTION...]  canmotion's emulator
+# vcan.peer.conformance, vcan.peer.conformance_emu and vcan.peer.master_csp_eds:
+# one drive as a separate process on vcan0 (node 5), checked over real
+# SocketCAN by conformance.py (spec_checks.py) or, with --run, by another
+# program of this folder taking -i vcan0 -n 5 (master_csp.py: the
+# independent CSP master).
+#   vcan-conformance-run.sh [--run SCRIPT] PYTHON                         the peer (cia402_peer.py)
+#   vcan-conformance-run.sh [--run SCRIPT] PYTHON CIA402_EMU [OPTION...]  canmotion's emulator
 #                                                          (cia402-emu -v OPTION...;
 #                                                          none: --profile strict)
 # Artefacts: peer.log or emu.log (the drive's verbose log and its summary),
-# conformance.log (every check's result and note).
+# conformance.log or SCRIPT's name .log (every check's or step's result and note).
 set -uo pipefail
+checker=conformance.py
+if [[ "${1:-}" == --run ]]; then checker="$2"; shift 2; fi
 py="$1"; shift
 emu="${1:-}"; [[ $# -gt 0 ]] && shift
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)"
@@ -33,7 +37,7 @@ if ! grep -Eq "$ready" "$log"; then
   exit 1
 fi
 echo "vcan-conformance-run: $(head -n 1 "$log")"
-"$py" "$here/conformance.py" -i vcan0 -n 5 | tee "$art/conformance.log"
+"$py" "$here/$checker" -i vcan0 -n 5 | tee "$art/${checker%.py}.log"
 rc=${PIPESTATUS[0]}
 kill -TERM "$drive"
 wait "$drive"
