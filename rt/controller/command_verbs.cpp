@@ -1,0 +1,108 @@
+// The command server's verb table (command_verbs.hpp) and what is generated
+// from it: HELP and the "unknown request" message. Dispatch is in
+// command_requests.cpp, the handlers in command_handlers.cpp and
+// command_stream.cpp. The protocol reference is tools/canmotionctl/README.md.
+#include "rt/controller/command_verbs.hpp"
+
+#include <fmt/format.h>
+
+#include "rt/controller/command_service.hpp"
+
+namespace canmotion::rt::command {
+namespace {
+
+// A data table: one row per verb, in HELP order (exempt from the function length limit).
+constexpr Verb kVerbs[] = {
+    {"", "", "e.g. MAJ(X, maj1, Forward, 10, UnitsPerSec, 100, UnitsPerSec2, 100, UnitsPerSec2, Trapezoidal, 100, "
+             "100, %ofTime, Disabled, Programmed): execute it, wait until the planner ran it, answer with the control "
+             "tag: OK|ERR mam1 EN= DN= ER= PC= IP= AC= ERR= EXERR= STATE=",
+     &Service::do_call, false},
+    {"GET", "tag...", "OK tag=value ...", &Service::do_get, false},
+    {"SET", "tag value", "write a writable (numeric) tag: OK tag=value", &Service::do_set, false},
+    {"STATUS", "", "one line per axis (axis=... key=value ...), then OK", &Service::do_status, false},
+    {"WATCH", "interval_s tag...",
+     "OK, then a line t=<s> tag=value ... every interval (controller time) until UNWATCH", &Service::do_watch, false},
+    {"UNWATCH", "", "stop watching: OK", &Service::do_unwatch, true},
+    {"RUN", "[name]",
+     "followed by script lines and a line END: run the motion script, streaming its PRINT lines (t=...), then OK or "
+     "ERR <script error>",
+     &Service::do_run, false},
+    {"END", "", "ends the script lines of RUN (a script line that must read END is sent as 'END ')", &Service::do_end,
+     false},
+    {"STATS", "", "controller statistics, key=value lines, then OK", &Service::do_stats, false},
+    {"MODE", "[run|program]",
+     "the controller mode (OK mode=run|program); program stops every axis by its Programmed Stop Mode, breaks the "
+     "MDAC links and refuses motion (ERR 24) until run",
+     &Service::do_mode, false},
+    {"HELP", "", "this text", &Service::do_help, false},
+    {"QUIT", "", "OK, then the server closes the connection", &Service::do_quit, true},
+};
+
+constexpr std::size_t kSyntaxWidth = 26;  // "WATCH interval_s tag..." and two spaces
+constexpr std::size_t kLineWidth = 112;   // HELP's lines, wrapped at spaces
+
+/// "  <syntax>  <help>", the help wrapped at spaces into the column after the syntax.
+void help_row(std::vector<std::string>& out, std::string_view syntax, std::string_view help) {
+  const std::size_t indent = 2 + kSyntaxWidth;
+  std::string line = fmt::format("  {:<{}}", syntax, kSyntaxWidth);
+  if (line.size() > indent) {  // a long syntax gets a line of its own
+    out.push_back(line);
+    line.assign(indent, ' ');
+  }
+  std::size_t pos = 0;
+  while (pos < help.size()) {
+    std::size_t end = help.find(' ', pos);
+    if (end == std::string_view::npos) end = help.size();
+    const std::string_view word = help.substr(pos, end - pos);
+    if (line.size() > indent && line.size() + 1 + word.size() > kLineWidth) {
+      out.push_back(line);
+      line.assign(indent, ' ');
+    }
+    if (line.size() > indent) line += ' ';
+    line += word;
+    pos = end + 1;
+  }
+  out.push_back(line);
+}
+
+}  // namespace
+
+std::span<const Verb> verbs() noexcept { return kVerbs; }
+
+const Verb* find_verb(std::string_view word) noexcept {
+  for (const Verb& v : kVerbs)
+    if (!v.name.empty() && iequals(v.name, word)) return &v;
+  return nullptr;
+}
+
+const Verb& call_verb() noexcept {
+  static_assert(kVerbs[0].name.empty(), "the first row is the instruction call");
+  return kVerbs[0];
+}
+
+std::vector<std::string> help_lines() {
+  std::vector<std::string> out{"requests (one per line; every response ends with a line OK ... or ERR <message>):"};
+  for (const Verb& v : kVerbs) {
+    const std::string syntax = v.name.empty() ? std::string("<instruction call>")
+                               : v.args.empty() ? std::string(v.name)
+                                                : fmt::format("{} {}", v.name, v.args);
+    help_row(out, syntax, v.help);
+  }
+  out.emplace_back(
+      "tags: X.ActualPosition X.CommandPosition X.ActualVelocity X.CommandVelocity X.PositionError X.MotionStatus");
+  out.emplace_back("      X.AxisStatus X.AxisFault X.AxisState X.<status bit> mam1.DN .ER .ERR .EXERR .STATE "
+                   "Controller.Time ...");
+  return out;
+}
+
+std::string unknown_request(std::string_view word) {
+  std::string names;
+  std::size_t left = std::size(kVerbs) - 1;  // the named rows
+  for (const Verb& v : kVerbs) {
+    if (v.name.empty()) continue;
+    names += fmt::format("{}{}", v.name, --left == 0 ? "" : left == 1 ? " or " : ", ");
+  }
+  return fmt::format("unknown request '{}': expected an instruction call like MSO(X, mso1), {}", word, names);
+}
+
+}  // namespace canmotion::rt::command
