@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "rt/controller/command_help.hpp"
 #include "rt/controller/command_service.hpp"
 
 namespace canmotion::rt::command {
@@ -38,32 +39,8 @@ constexpr Verb kVerbs[] = {
     {"QUIT", "", "OK, then the server closes the connection", &Service::do_quit, true},
 };
 
-constexpr std::size_t kSyntaxWidth = 26;  // "WATCH interval_s tag..." and two spaces
+constexpr std::size_t kSyntaxWidth = 26;  // "WATCH interval_s tag..." (23) and spaces
 constexpr std::size_t kLineWidth = 112;   // HELP's lines, wrapped at spaces
-
-/// "  <syntax>  <help>", the help wrapped at spaces into the column after the syntax.
-void help_row(std::vector<std::string>& out, std::string_view syntax, std::string_view help) {
-  const std::size_t indent = 2 + kSyntaxWidth;
-  std::string line = fmt::format("  {:<{}}", syntax, kSyntaxWidth);
-  if (line.size() > indent) {  // a long syntax gets a line of its own
-    out.push_back(line);
-    line.assign(indent, ' ');
-  }
-  std::size_t pos = 0;
-  while (pos < help.size()) {
-    std::size_t end = help.find(' ', pos);
-    if (end == std::string_view::npos) end = help.size();
-    const std::string_view word = help.substr(pos, end - pos);
-    if (line.size() > indent && line.size() + 1 + word.size() > kLineWidth) {
-      out.push_back(line);
-      line.assign(indent, ' ');
-    }
-    if (line.size() > indent) line += ' ';
-    line += word;
-    pos = end + 1;
-  }
-  out.push_back(line);
-}
 
 }  // namespace
 
@@ -86,7 +63,7 @@ std::vector<std::string> help_lines() {
     const std::string syntax = v.name.empty() ? std::string("<instruction call>")
                                : v.args.empty() ? std::string(v.name)
                                                 : fmt::format("{} {}", v.name, v.args);
-    help_row(out, syntax, v.help);
+    help_row(out, syntax, v.help, kSyntaxWidth, kLineWidth);
   }
   out.emplace_back(
       "tags: X.ActualPosition X.CommandPosition X.ActualVelocity X.CommandVelocity X.PositionError X.MotionStatus");
