@@ -165,7 +165,8 @@ void Service::do_stats(Client& c, const Request&) {
   send_line(c, fmt::format("clients={}", clients.size()));
   if (opt.cycle_stats) {
     const CycleStats st = opt.cycle_stats();
-    for (std::string_view n : stat_tag_names()) send_line(c, fmt::format("{}={}", n, stat_tag_value(st, n).value_or(0)));
+    for (std::string_view n : stat_tag_names())
+      send_line(c, fmt::format("{}={}", n, stat_tag_value(st, n).value_or(0)));
   }
   send_line(c, "OK");
 }

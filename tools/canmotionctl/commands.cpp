@@ -158,8 +158,9 @@ int do_send(const Command&, const Options& o, const Words& w) {
 
 // A data table: one row per command, in --help order (exempt from the function length limit).
 constexpr Command kCommands[] = {
-    {"", "", "execute a Logix motion instruction (ST syntax) and print its control tag (EN DN ER PC IP AC ERR EXERR STATE)",
-     "", &do_call},
+    {"", "",
+     "execute a Logix motion instruction (ST syntax) and print its control tag (EN DN ER PC IP AC ERR EXERR STATE)", "",
+     &do_call},
     {"get", "TAG...", "print tag values (one tag: the value; more: TAG=VALUE lines)", "GET", &do_get},
     {"set", "TAG VALUE", "write a writable (numeric) tag", "SET", &do_set},
     {"status", "", "table of the axes: state, drive, positions, velocity, status bits, faults, last EMCY", "STATUS",
