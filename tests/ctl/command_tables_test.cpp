@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
@@ -144,6 +145,18 @@ TEST(CommandTables, ServerHelpAndUnknownRequestListExactlyTheVerbs) {
   }
   EXPECT_TRUE(call);
   EXPECT_EQ(joined(names), joined(server_verbs()));
+}
+
+TEST(CommandTables, TheReadmeShowsWhatHelpPrints) {
+  const std::string path = std::string(CANMOTION_SOURCE_DIR) + "/tools/canmotionctl/README.md";
+  std::ifstream f(path);
+  ASSERT_TRUE(f) << path;
+  const std::string readme((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const std::string u = canmotionctl::usage();
+  const std::string shown = u.substr(0, u.find("\nExamples:\n"));  // Usage, Commands and Options
+  EXPECT_NE(readme.find("```\n" + shown + "```\n"), std::string::npos)
+      << path << ": the Usage block is not what canmotionctl --help prints; it prints:\n"
+      << shown;
 }
 
 TEST(CommandTables, HelpLinesStayWithinTheirWidth) {

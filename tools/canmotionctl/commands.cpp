@@ -162,7 +162,7 @@ constexpr Command kCommands[] = {
      "execute a Logix motion instruction (ST syntax) and print its control tag (EN DN ER PC IP AC ERR EXERR STATE)", "",
      &do_call},
     {"get", "TAG...", "print tag values (one tag: the value; more: TAG=VALUE lines)", "GET", &do_get},
-    {"set", "TAG VALUE", "write a writable (numeric) tag", "SET", &do_set},
+    {"set", "TAG VALUE", "write a writable tag (numeric user tag or array element)", "SET", &do_set},
     {"status", "", "table of the axes: state, drive, positions, velocity, status bits, faults, last EMCY", "STATUS",
      &do_status},
     {"watch", "TAG... [-i S] [-n N]",
