@@ -1,8 +1,9 @@
 #pragma once
 /// \file
-/// The layout of a help row, shared by the command server's HELP
-/// (command_verbs.cpp) and canmotionctl's --help (tools/canmotionctl), which
-/// both generate their text from their command tables. Header-only: the tool
+/// Texts generated from a command table, shared by the command server
+/// (command_verbs.cpp: HELP, the unknown-request message) and canmotionctl
+/// (tools/canmotionctl/commands.cpp: --help, the unknown-command message):
+/// the layout of a help row and the list of a table's names. Header-only: the tool
 /// does not link the runtime for it. Not realtime (allocates).
 
 #include <cstddef>
@@ -39,6 +40,21 @@ inline void help_row(std::vector<std::string>& out, std::string_view syntax, std
     pos = end + 1;
   }
   out.push_back(line);
+}
+
+/// "a, b, c or d" of the non-empty names (the rows of a command table; the
+/// empty name is the instruction call, which the messages name themselves).
+template <typename Rows, typename Name>
+std::string name_list(const Rows& rows, Name name) {
+  std::vector<std::string_view> names;
+  for (const auto& r : rows)
+    if (!name(r).empty()) names.push_back(name(r));
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) out += i + 1 == names.size() ? " or " : ", ";
+    out += names[i];
+  }
+  return out;
 }
 
 }  // namespace canmotion::rt::command

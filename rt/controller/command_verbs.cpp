@@ -74,13 +74,8 @@ std::vector<std::string> help_lines() {
 }
 
 std::string unknown_request(std::string_view word) {
-  std::string names;
-  std::size_t left = std::size(kVerbs) - 1;  // the named rows
-  for (const Verb& v : kVerbs) {
-    if (v.name.empty()) continue;
-    names += fmt::format("{}{}", v.name, --left == 0 ? "" : left == 1 ? " or " : ", ");
-  }
-  return fmt::format("unknown request '{}': expected an instruction call like MSO(X, mso1), {}", word, names);
+  return fmt::format("unknown request '{}': expected an instruction call like MSO(X, mso1), {}", word,
+                     name_list(kVerbs, [](const Verb& v) { return v.name; }));
 }
 
 }  // namespace canmotion::rt::command

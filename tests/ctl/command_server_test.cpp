@@ -388,27 +388,9 @@ TEST(CommandServer, HelpDispatchAndUnknownRequestComeFromTheVerbTable) {
   for (const command::Verb& v : command::verbs()) {
     if (v.while_watching) continue;
     const std::string line = v.name.empty() ? "MSO(X, mso1)" : std::string(v.name);
-    c.send(line + "\n");
-    std::string reply;
-    r.run_until(
-        [&] {
-          while (auto l = c.line())
-            if (l->rfind("t=", 0) != 0) reply = *l;
-          return !reply.empty();
-        },
-        100);
-    EXPECT_EQ(reply, "ERR a WATCH is running: send UNWATCH first") << line;
+    EXPECT_EQ(r.request(c, line), "ERR a WATCH is running: send UNWATCH first") << line;  // after WATCH lines
   }
-  c.send("UNWATCH\n");
-  std::string reply;
-  r.run_until(
-      [&] {
-        while (auto l = c.line())
-          if (l->rfind("t=", 0) != 0) reply = *l;
-        return !reply.empty();
-      },
-      100);
-  EXPECT_EQ(reply, "OK unwatched");
+  EXPECT_EQ(r.request(c, "UNWATCH"), "OK unwatched");
   EXPECT_EQ(r.request(c, "QUIT"), "OK bye");
 }
 
@@ -475,19 +457,24 @@ TEST(CommandServer, TooManyClientsAreTurnedAway) {
   EXPECT_EQ(r.request(a, "GET Controller.Cycle").rfind("OK", 0), 0u);
 }
 
-TEST(CommandServer, InstructionTimesOutWhenTheCycleDoesNotRun) {
-  Rig r([](CommandServerOptions& o) { o.instruction_timeout_s = 0.05; });
-  Client c(r.sock);
-  c.send("MSO(X, mso1)\n");
-  // Poll without running cycles: the planner never takes the command.
+/// Send `line` and poll the server without running cycles (the planner never
+/// takes the command) until the first line of the answer, at most 10 s.
+std::string answer_without_cycles(Rig& r, Client& c, const std::string& line) {
+  c.send(line + "\n");
   std::optional<std::string> l;
   const auto t0 = std::chrono::steady_clock::now();
   while (!(l = c.line()) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(10)) {
     r.server->poll(r.now_s());
     std::this_thread::sleep_for(std::chrono::milliseconds(1));  // wall-time timeout: nothing virtual to step
   }
-  ASSERT_TRUE(l.has_value());
-  EXPECT_TRUE(contains(*l, "ERR timeout: the controller did not execute the instruction within 0.05 s")) << *l;
+  return l.value_or("<no answer within 10 s>");
+}
+
+TEST(CommandServer, InstructionTimesOutWhenTheCycleDoesNotRun) {
+  Rig r([](CommandServerOptions& o) { o.instruction_timeout_s = 0.05; });
+  Client c(r.sock);
+  const std::string l = answer_without_cycles(r, c, "MSO(X, mso1)");
+  EXPECT_TRUE(contains(l, "ERR timeout: the controller did not execute the instruction within 0.05 s")) << l;
 }
 
 // A MODE change that timed out (the cycle did not run) leaves no reply
@@ -495,15 +482,8 @@ TEST(CommandServer, InstructionTimesOutWhenTheCycleDoesNotRun) {
 TEST(CommandServer, ATimedOutRequestDoesNotAnswerTheNextCall) {
   Rig r([](CommandServerOptions& o) { o.instruction_timeout_s = 0.05; });
   Client c(r.sock);
-  c.send("MODE program\n");
-  std::optional<std::string> l;
-  const auto t0 = std::chrono::steady_clock::now();
-  while (!(l = c.line()) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(10)) {
-    r.server->poll(r.now_s());
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));  // wall-time timeout: nothing virtual to step
-  }
-  ASSERT_TRUE(l.has_value());
-  EXPECT_TRUE(contains(*l, "ERR timeout")) << *l;
+  const std::string l = answer_without_cycles(r, c, "MODE program");
+  EXPECT_TRUE(contains(l, "ERR timeout")) << l;
   r.boot();
   const std::string reply = r.request(c, "MSO(X, mso1)");
   EXPECT_EQ(reply.rfind("OK mso1 EN=1", 0), 0u) << reply;

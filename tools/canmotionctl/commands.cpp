@@ -253,14 +253,8 @@ std::string usage() {
 }
 
 std::string unknown_command(std::string_view word) {
-  std::string names;
-  std::size_t left = std::size(kCommands) - 1;  // the named rows
-  for (const Command& c : kCommands) {
-    if (c.name.empty()) continue;
-    names += fmt::format("{}{}", c.name, --left == 0 ? "" : left == 1 ? " or " : ", ");
-  }
   return fmt::format("unknown command '{}': expected an instruction like 'MSO(X, mso1)', {} (see --help)", word,
-                     names);
+                     canmotion::rt::command::name_list(kCommands, [](const Command& c) { return c.name; }));
 }
 
 int run_command(const Options& o, const std::vector<std::string>& words) {
