@@ -3,7 +3,9 @@
 /// CommandServer: the canmotionctl socket. A UNIX stream socket that serves
 /// the line-based text protocol of tools/canmotionctl/README.md to several
 /// clients at once: instruction calls, GET/SET of tags, STATUS, WATCH, RUN
-/// (motion scripts), STATS, HELP.
+/// (motion scripts), STATS, HELP. The verbs are one table
+/// (command_verbs.hpp); the parts of the server are listed in
+/// command_service.hpp.
 ///
 /// Non-RT. Everything happens in poll(), which the owner calls from its non-RT
 /// housekeeping (once per cycle: between cycles in --sim, half a period
@@ -35,6 +37,10 @@
 #include "rt/cycle_stats.hpp"
 
 namespace canmotion::rt {
+
+namespace command {
+struct Service;  // the server's state and its parts (command_service.hpp)
+}
 
 /// How a CommandServer is set up.
 struct CommandServerOptions {
@@ -112,8 +118,7 @@ class CommandServer {
   [[nodiscard]] ControllerHost& host() noexcept;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<command::Service> impl_;
 };
 
 }  // namespace canmotion::rt

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "tests/ctl/ctl_rig.hpp"
+#include "tools/canmotionctl/commands.hpp"
 
 extern char** environ;
 
@@ -83,12 +84,15 @@ TEST(Canmotionctl, HelpAndBadArguments) {
   EXPECT_TRUE(contains(h.out, "Options:"));
   EXPECT_TRUE(contains(h.out, "Examples:"));
   EXPECT_TRUE(contains(h.out, "/run/canmotion/canmotiond.sock"));
+  EXPECT_EQ(h.out, canmotionctl::usage());  // generated from the command table
   const Result none = ctl(nullptr, d.path, {});
   EXPECT_EQ(none.status, 2);
   EXPECT_TRUE(contains(none.err, "no command given"));
   const Result unknown = ctl(nullptr, d.path, {"frobnicate"});
   EXPECT_EQ(unknown.status, 2);
-  EXPECT_TRUE(contains(unknown.err, "unknown command 'frobnicate'")) << unknown.err;
+  EXPECT_EQ(unknown.err,
+            "canmotionctl: " + canmotionctl::unknown_command("frobnicate") + "\nTry 'canmotionctl --help'.\n");
+  EXPECT_TRUE(contains(unknown.err, ", mode or send")) << unknown.err;  // mode was missing before the table
 }
 
 TEST(Canmotionctl, ConnectionFailureSaysWhatToDo) {

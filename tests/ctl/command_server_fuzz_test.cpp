@@ -5,19 +5,29 @@
 #include <cstdio>
 #include <random>
 
+#include "rt/controller/command_verbs.hpp"
 #include "tests/ctl/ctl_rig.hpp"
 #include "tests/support/random_seed.hpp"
 
 namespace canmotion::rt::ctltest {
 namespace {
 
+/// The protocol's verbs (the server's table), then instructions, tags, operands and junk.
+std::vector<std::string> vocabulary() {
+  std::vector<std::string> words;
+  for (const command::Verb& v : command::verbs())
+    if (!v.name.empty()) words.emplace_back(v.name);
+  words.insert(words.end(), {
+      "program", "run", "MSO", "MSF", "MAM", "MAJ", "MAS", "MAG", "MATC", "MCD", "X", "Master", "Nope", "mam1",
+      "mso1", "X.ActualPosition", "mam1.DN", "mam1.ERR", "Controller.Time", "Controller.Cycle", "Distance",
+      "X.GearingLockStatus", "WAIT", "UNTIL", "PRINT", "TIMEOUT", ":=", "(", ")", ",", ";", "0", "1", "-1", "0.001",
+      "1e308", "nan", "inf", "%oftime", "unitspersec", "All", "\"",
+      "(*", "*)", "//", "#", "\t", "\\", "\xff\xfe", "\x01", std::string(1, '\0')});
+  return words;
+}
+
 std::string random_line(std::mt19937_64& rng) {
-  static const std::vector<std::string> words = {
-      "GET", "SET", "STATUS", "WATCH", "UNWATCH", "RUN", "END", "STATS", "HELP", "MSO", "MSF", "MAM", "MAJ", "MAS",
-      "MAG", "MATC", "MCD", "X", "Master", "Nope", "mam1", "mso1", "X.ActualPosition", "mam1.DN", "mam1.ERR",
-      "Controller.Time", "Controller.Cycle", "Distance", "X.GearingLockStatus", "WAIT", "UNTIL", "PRINT", "TIMEOUT",
-      ":=", "(", ")", ",", ";", "0", "1", "-1", "0.001", "1e308", "nan", "inf", "%oftime", "unitspersec", "All", "\"",
-      "(*", "*)", "//", "#", "\t", "\\", "\xff\xfe", "\x01", std::string(1, '\0')};
+  static const std::vector<std::string> words = vocabulary();
   std::uniform_int_distribution<int> nwords(0, 24);
   std::uniform_int_distribution<std::size_t> pick(0, words.size() - 1);
   std::uniform_int_distribution<int> kind(0, 999);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <thread>
 
+#include "rt/controller/command_verbs.hpp"
 #include "tests/ctl/ctl_rig.hpp"
 
 namespace canmotion::rt::ctltest {
@@ -364,6 +365,35 @@ TEST(CommandServer, MalformedInputGetsErrAndTheConnectionStaysUsable) {
   EXPECT_TRUE(c.eof());
 }
 
+TEST(CommandServer, HelpDispatchAndUnknownRequestComeFromTheVerbTable) {
+  Rig r;
+  Client c(r.sock);
+  c.send("HELP\n");
+  std::vector<std::string> want = command::help_lines();
+  want.emplace_back("OK");
+  EXPECT_EQ(r.response(c), want);
+  EXPECT_EQ(r.request(c, "FROB 1 2"), "ERR " + command::unknown_request("FROB"));
+  // Every verb of the table reaches its handler (none is answered as unknown).
+  for (const command::Verb& v : command::verbs()) {
+    if (v.name.empty() || v.name == "QUIT") continue;
+    const std::string line = v.name == "RUN" ? "RUN\nEND" : std::string(v.name);
+    const std::string reply = r.request(c, line);
+    EXPECT_FALSE(reply.empty()) << v.name;
+    EXPECT_FALSE(contains(reply, "unknown request")) << v.name << ": " << reply;
+  }
+  EXPECT_EQ(r.request(c, "RUN\nEND"), "OK script done (0 statements)");
+  EXPECT_EQ(r.request(c, "end"), "ERR END without RUN");
+  // While a WATCH runs, only the rows marked while_watching are served.
+  EXPECT_EQ(r.request(c, "WATCH 1 Controller.Cycle").rfind("OK watching", 0), 0u);
+  for (const command::Verb& v : command::verbs()) {
+    if (v.while_watching) continue;
+    const std::string line = v.name.empty() ? "MSO(X, mso1)" : std::string(v.name);
+    EXPECT_EQ(r.request(c, line), "ERR a WATCH is running: send UNWATCH first") << line;  // after WATCH lines
+  }
+  EXPECT_EQ(r.request(c, "UNWATCH"), "OK unwatched");
+  EXPECT_EQ(r.request(c, "QUIT"), "OK bye");
+}
+
 TEST(CommandServer, OverlongLineDisconnectsWithAnErrLine) {
   Rig r([](CommandServerOptions& o) { o.max_line = 256; });
   Client bad(r.sock), good(r.sock);
@@ -427,19 +457,36 @@ TEST(CommandServer, TooManyClientsAreTurnedAway) {
   EXPECT_EQ(r.request(a, "GET Controller.Cycle").rfind("OK", 0), 0u);
 }
 
-TEST(CommandServer, InstructionTimesOutWhenTheCycleDoesNotRun) {
-  Rig r([](CommandServerOptions& o) { o.instruction_timeout_s = 0.05; });
-  Client c(r.sock);
-  c.send("MSO(X, mso1)\n");
-  // Poll without running cycles: the planner never takes the command.
+/// Send `line` and poll the server without running cycles (the planner never
+/// takes the command) until the first line of the answer, at most 10 s.
+std::string answer_without_cycles(Rig& r, Client& c, const std::string& line) {
+  c.send(line + "\n");
   std::optional<std::string> l;
   const auto t0 = std::chrono::steady_clock::now();
   while (!(l = c.line()) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(10)) {
     r.server->poll(r.now_s());
     std::this_thread::sleep_for(std::chrono::milliseconds(1));  // wall-time timeout: nothing virtual to step
   }
-  ASSERT_TRUE(l.has_value());
-  EXPECT_TRUE(contains(*l, "ERR timeout: the controller did not execute the instruction within 0.05 s")) << *l;
+  return l.value_or("<no answer within 10 s>");
+}
+
+TEST(CommandServer, InstructionTimesOutWhenTheCycleDoesNotRun) {
+  Rig r([](CommandServerOptions& o) { o.instruction_timeout_s = 0.05; });
+  Client c(r.sock);
+  const std::string l = answer_without_cycles(r, c, "MSO(X, mso1)");
+  EXPECT_TRUE(contains(l, "ERR timeout: the controller did not execute the instruction within 0.05 s")) << l;
+}
+
+// A MODE change that timed out (the cycle did not run) leaves no reply
+// behind: the next instruction call is answered with its own control tag.
+TEST(CommandServer, ATimedOutRequestDoesNotAnswerTheNextCall) {
+  Rig r([](CommandServerOptions& o) { o.instruction_timeout_s = 0.05; });
+  Client c(r.sock);
+  const std::string l = answer_without_cycles(r, c, "MODE program");
+  EXPECT_TRUE(contains(l, "ERR timeout")) << l;
+  r.boot();
+  const std::string reply = r.request(c, "MSO(X, mso1)");
+  EXPECT_EQ(reply.rfind("OK mso1 EN=1", 0), 0u) << reply;
 }
 
 /// Connect as another user in a forked child; returns the first line the
