@@ -32,74 +32,6 @@
 
 namespace canmotion::config {
 
-std::string Diagnostic::str() const {
-  return fmt::format("{}:{}:{}: {}: {}{}{}", file, where.line, where.column,
-                     severity == Severity::kError ? "error" : "warning", key, key.empty() ? "" : ": ", message);
-}
-
-namespace {
-
-std::string join_errors(const std::vector<Diagnostic>& d) {
-  std::string s;
-  for (const auto& x : d) {
-    if (!s.empty()) s += '\n';
-    s += x.str();
-  }
-  return s;
-}
-
-}  // namespace
-
-ConfigError::ConfigError(std::vector<Diagnostic> diags) : std::runtime_error(join_errors(diags)), diags_(std::move(diags)) {}
-
-const BusSettings* Config::find_bus(std::string_view name) const noexcept {
-  for (const auto& b : buses)
-    if (b.name == name) return &b;
-  return nullptr;
-}
-
-const AxisSettings* Config::find_axis(std::string_view name) const noexcept {
-  for (const auto& a : axes)
-    if (a.name == name) return &a;
-  return nullptr;
-}
-
-std::optional<std::string> nearest(std::string_view word, const std::vector<std::string_view>& candidates) {
-  std::size_t best = std::string_view::npos;
-  std::string_view best_word;
-  for (std::string_view c : candidates) {
-    // Levenshtein distance, two rows.
-    std::vector<std::size_t> prev(c.size() + 1), cur(c.size() + 1);
-    for (std::size_t j = 0; j <= c.size(); ++j) prev[j] = j;
-    for (std::size_t i = 1; i <= word.size(); ++i) {
-      cur[0] = i;
-      for (std::size_t j = 1; j <= c.size(); ++j) {
-        const bool same = std::tolower(static_cast<unsigned char>(word[i - 1])) ==
-                          std::tolower(static_cast<unsigned char>(c[j - 1]));
-        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (same ? 0 : 1)});
-      }
-      std::swap(prev, cur);
-    }
-    if (prev[c.size()] < best) {
-      best = prev[c.size()];
-      best_word = c;
-    }
-  }
-  const std::size_t limit = std::max<std::size_t>(2, word.size() / 3);
-  if (best_word.empty() || best > limit) return std::nullopt;
-  return std::string(best_word);
-}
-
-std::optional<InterpolationPeriod> interpolation_period(double period_s) noexcept {
-  // The drive proxy's own encoder (cia402.hpp), on the period in ns as the
-  // runtime uses it: what is checked here is what is written. 255 s is the
-  // longest period 0x60C2 can hold (255 x 10^0).
-  if (!(period_s > 0) || period_s > 255.0) return std::nullopt;
-  const auto ip = cia402::encode_interpolation_period(static_cast<std::int64_t>(std::llround(period_s * 1e9)));
-  if (!ip) return std::nullopt;
-  return InterpolationPeriod{ip->value, ip->index};
-}
-
 namespace {
 
 using Severity = Diagnostic::Severity;
@@ -252,8 +184,8 @@ class Loader {
     ControllerSettings c;
     c.where = loc(n);
     if (!check_map(n, "controller", {"period_ms", "priority", "cpu", "lock_memory", "cpu_dma_latency_us"})) return c;
-    double ms = c.period_s * 1e3;
-    if (scalar(n, "controller", "period_ms", ms, 0.25, 100.0, "ms")) c.period_s = ms / 1e3;
+    double ms = c.period_ms();
+    if (scalar(n, "controller", "period_ms", ms, 0.25, 100.0, "ms")) c.period_s = period_s_from_ms(ms);
     scalar(n, "controller", "priority", c.priority, 0, 99);
     scalar(n, "controller", "cpu", c.cpu, -1, 1023);
     scalar(n, "controller", "lock_memory", c.lock_memory, false, true);
@@ -939,7 +871,7 @@ class Loader {
     if (!ip)
       error_at(cfg.controller.where, "controller.period_ms",
                fmt::format("{} ms cannot be written to 0x60C2 (mantissa 1..255 x 10^exponent); use e.g. 0.5, 1, 2 or 4",
-                           cfg.controller.period_s * 1e3));
+                           cfg.controller.period_ms()));
 
     // Per bus: axes on it, node ids, COB-ID clashes, 0x60C2 writes, budget.
     for (std::size_t bi = 0; bi < cfg.buses.size(); ++bi) {
@@ -989,11 +921,11 @@ class Loader {
             error_at(w.where, fmt::format("axes[{}].drive.sdo_writes[{}]", ai, wi),
                      fmt::format("0x60C2:{:02X} = {} contradicts the controller period {} ms (0x60C2 = {} x 10^{} s, "
                                  "written automatically; remove this write)",
-                                 w.sub, w.value, cfg.controller.period_s * 1e3, ip->mantissa, ip->exponent));
+                                 w.sub, w.value, cfg.controller.period_ms(), ip->mantissa, ip->exponent));
         }
       }
       canopen::BusBudgetInput in;
-      in.cycle_ns = static_cast<std::int64_t>(std::llround(cfg.controller.period_s * 1e9));
+      in.cycle_ns = cfg.controller.period_ns();
       in.bitrate = bus.bitrate;
       in.sync_counter = bus.sync_counter_overflow != 0;
       in.master_heartbeat_ms = bus.master_heartbeat_ms;
@@ -1001,7 +933,7 @@ class Loader {
       const canopen::BusBudget b = canopen::bus_budget(in);
       const std::string msg = fmt::format(
           "worst-case bus load {:.1f} % ({} frames, {:.0f} of {:.0f} bits per {} ms cycle at {} bit/s)", b.load_percent,
-          b.frames_per_cycle, b.bits_per_cycle, b.capacity_bits, cfg.controller.period_s * 1e3, bus.bitrate);
+          b.frames_per_cycle, b.bits_per_cycle, b.capacity_bits, cfg.controller.period_ms(), bus.bitrate);
       if (b.load_percent > 100.0)
         error_at(bus.where, fmt::format("buses[{}]", bi),
                  msg + "; over 100 % cannot work: lengthen the period, raise the bitrate or move axes to another bus");
