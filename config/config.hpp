@@ -53,9 +53,24 @@ class ConfigError : public std::runtime_error {
   std::vector<Diagnostic> diags_;
 };
 
+/// The period's unit conversions, here and nowhere else in config/ and
+/// tools/canmotiond/: the file writes milliseconds (`controller.period_ms`),
+/// the configuration keeps seconds (ControllerSettings::period_s), and the
+/// controller (rt::ControllerSpec::period_ns), the drives (DriveConfig::
+/// cycle_ns, 0x60C2) and the bus budget take nanoseconds, rounded to 1 ns.
+[[nodiscard]] std::int64_t period_ns(double period_s) noexcept;
+/// Seconds to milliseconds (`period_ms:` and the messages that name it).
+[[nodiscard]] double period_ms(double period_s) noexcept;
+/// `period_ms:` as read from the file, to seconds.
+[[nodiscard]] double period_s_from_ms(double ms) noexcept;
+
 /// `controller:` section.
 struct ControllerSettings {
   double period_s = 0.001;  ///< cycle period; 0.25 ms .. 100 ms
+  /// The period in ns (config::period_ns()).
+  [[nodiscard]] std::int64_t period_ns() const noexcept { return config::period_ns(period_s); }
+  /// The period in ms (config::period_ms()).
+  [[nodiscard]] double period_ms() const noexcept { return config::period_ms(period_s); }
   int priority = 80;        ///< SCHED_FIFO priority 1..99; 0 = run without real-time scheduling
   int cpu = -1;             ///< CPU to pin the cyclic thread to; -1 = no affinity
   bool lock_memory = true;  ///< mlockall + stack prefault

@@ -51,9 +51,9 @@ void check_interpolation_index(const Config& cfg, const AxisSettings& a, const s
   if (o == nullptr) return;  // no 0x60C2: its :1 write is refused
   const eds::SubObject* s = o->find(2);
   if (s != nullptr && eds::writable(s->access)) return;
-  const std::int64_t cycle_ns = std::llround(cfg.controller.period_s * 1e9);
+  const std::int64_t cycle_ns = cfg.controller.period_ns();
   const auto ip = cia402::encode_interpolation_period(cycle_ns);
-  const std::string period = fmt::format("{:g} ms", static_cast<double>(cycle_ns) / 1e6);
+  const std::string period = fmt::format("{:g} ms", cfg.controller.period_ms());
   const std::string key = "controller.period_ms";
   const Location where = cfg.controller.where.line > 0 ? cfg.controller.where : a.drive.eds_where;
   if (s == nullptr) {

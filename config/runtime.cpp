@@ -2,16 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
-#include "fieldbus/can/can_netlink.hpp"
-#include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/object_names.hpp"
-#include "fieldbus/canopen/receive_filters.hpp"
-#include "fieldbus/canopen/tx_queue.hpp"
 #include "fieldbus/emulator/eds_dictionary.hpp"
 
 namespace canmotion::config {
@@ -145,7 +140,7 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
     d.needed_modes.push_back({cia402::Mode::kHoming, fmt::format("{}.homing.sequence (MAH homes on the drive, mode 6)", axis)});
   d.node = a.node;
   d.mode = cia402::Mode::kCsp;
-  d.cycle_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));
+  d.cycle_ns = period_ns(period_s);
   d.pdo_profile = a.drive.pdo;
   d.producer_heartbeat_ms = a.drive.heartbeat_ms;
   d.consumer_heartbeat_ms = bus.master_heartbeat_ms > 0 ? a.drive.master_heartbeat_timeout_ms : 0;
@@ -213,134 +208,127 @@ emulator::EmulatorConfig emulator_config(const AxisSettings& a) {
   return e;
 }
 
-Runtime build_runtime(const Config& cfg, bool force_sim) {
-  Runtime rt;
-  rt::ControllerSpec spec;
-  spec.period_ns = static_cast<std::int64_t>(std::llround(cfg.controller.period_s * 1e9));
-  for (const BusSettings& b : cfg.buses) {
-    rt::BusSpec bs;
-    bs.name = b.name;
-    bs.network.master.node_id = b.master_node;
-    bs.network.master.heartbeat_period_ms = b.master_heartbeat_ms;
-    bs.network.master.sync_counter_overflow = b.sync_counter_overflow;
+namespace {
+
+/// A `buses:` entry as the controller sees it, without its transport.
+rt::BusSpec bus_spec(const BusSettings& b) {
+  rt::BusSpec bs;
+  bs.name = b.name;
+  bs.network.master.node_id = b.master_node;
+  bs.network.master.heartbeat_period_ms = b.master_heartbeat_ms;
+  bs.network.master.sync_counter_overflow = b.sync_counter_overflow;
+  return bs;
+}
+
+/// An `axes:` entry (the `index`th): its planner configuration, and for a
+/// CIP axis its bus (an index into cfg.buses) and drive configuration.
+rt::AxisSpec axis_spec(const Config& cfg, const AxisSettings& a, std::size_t index) {
+  rt::AxisSpec as;
+  as.name = a.name;
+  as.config = a.axis;
+  if (a.axis.type != motion::AxisType::CipDrive) return as;
+  std::size_t bi = 0;
+  while (bi < cfg.buses.size() && cfg.buses[bi].name != a.bus) ++bi;
+  as.bus = static_cast<int>(bi);
+  as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s, index);
+  as.config.drive_wait_limit = drive_wait_limit_s(a.drive.timeouts);
+  return as;
+}
+
+rt::CamSpec cam_spec(const CamSettings& c) {
+  rt::CamSpec cs;
+  cs.name = c.name;
+  cs.start_slope = c.start_slope;
+  cs.end_slope = c.end_slope;
+  cs.points = motion_points(c.points);
+  return cs;
+}
+
+rt::ArraySpec array_spec(const ArraySettings& a) {
+  rt::ArraySpec as;
+  as.name = a.name;
+  as.size = a.size;
+  as.type = a.type == ArraySettings::Type::kCam          ? rt::ArraySpec::Type::kCam
+            : a.type == ArraySettings::Type::kCamProfile ? rt::ArraySpec::Type::kCamProfile
+                                                         : rt::ArraySpec::Type::kReal;
+  as.cam_values = motion_points(a.cam_values);
+  as.real_values = a.real_values;
+  return as;
+}
+
+/// A `coordinate_systems:` entry, its members named by their index in `axes`.
+rt::CoordSystemSpec coordinate_system_spec(const CoordinateSystemSettings& c, const std::vector<rt::AxisSpec>& axes) {
+  rt::CoordSystemSpec cs;
+  cs.name = c.name;
+  motion::CoordSystemConfig& m = cs.config;
+  m.dim = static_cast<int>(c.axes.size());
+  for (std::size_t k = 0; k < c.axes.size(); ++k) {
+    for (std::size_t a = 0; a < axes.size(); ++a)
+      if (axes[a].name == c.axes[k]) m.axes[k] = static_cast<motion::AxisId>(a);
+    if (k < c.conversion_ratios.size()) m.ratio[k] = c.conversion_ratios[k];
+  }
+  m.max_speed = c.max_speed;
+  m.max_accel = c.max_accel;
+  m.max_decel = c.max_decel;
+  m.max_accel_jerk = c.max_accel_jerk;
+  m.max_decel_jerk = c.max_decel_jerk;
+  m.actual_tolerance = c.actual_position_tolerance;
+  m.command_tolerance = c.command_position_tolerance;
+  return cs;
+}
+
+}  // namespace
+
+RuntimeSpec build_spec(const Config& cfg, bool force_sim) {
+  RuntimeSpec r;
+  rt::ControllerSpec& spec = r.controller;
+  spec.period_ns = cfg.controller.period_ns();
+  // The simulated buses' indices in the SimWorld (added in order), per bus.
+  std::vector<std::size_t> sim_index(cfg.buses.size(), 0);
+  std::size_t sim_buses = 0;
+  for (std::size_t bi = 0; bi < cfg.buses.size(); ++bi) {
+    const BusSettings& b = cfg.buses[bi];
+    rt::BusSpec bs = bus_spec(b);
     if (force_sim || b.is_sim()) {
-      if (!rt.sim) rt.sim = std::make_unique<rt::SimWorld>();
-      bs.transport = &rt.sim->add_bus(b.name);
-      rt.trace_names.push_back(b.name);
+      if (!r.sim) r.sim = std::make_unique<rt::SimWorld>();
+      bs.transport = &r.sim->add_bus(b.name);
+      sim_index[bi] = sim_buses++;
+      r.trace_names.push_back(b.name);
     } else {
-      // Receive only what a CANopen master needs: the nodes' EMCY, TPDOs,
-      // SDO responses and heartbeats (the list DriveNetwork::receive_filters() gives).
-      std::vector<std::uint8_t> nodes;
-      for (const AxisSettings& a : cfg.axes)
-        if (a.axis.type == motion::AxisType::CipDrive && a.bus == b.name) nodes.push_back(a.node);
-      const std::vector<can::Filter> filters = canopen::master_receive_filters(nodes);
-      std::error_code ec;
-      std::string why;
-      auto sock = can::SocketCanBus::open(b.interface, filters, ec, &why);
-      if (!sock) throw std::runtime_error(fmt::format("{}: bus '{}' (line {}): {}", cfg.path, b.name, b.where.line, why));
-      // The interface's transmit queue must hold one cycle's burst.
-      canopen::TxBurst burst;
-      burst.master_heartbeat = b.master_heartbeat_ms > 0;
-      for (const AxisSettings& a : cfg.axes) {
-        if (a.axis.type != motion::AxisType::CipDrive || a.bus != b.name) continue;
-        burst.rpdos += cia402::default_drive_pdos(a.drive.pdo, a.node).rpdo_count;
-        ++burst.sdo_nodes;
-      }
-      if (const std::int64_t qlen = sock->tx_queue_len(); qlen >= 0) {
-        const canopen::TxQueueCheck chk = canopen::check_tx_queue(static_cast<std::uint32_t>(qlen), burst, true);
-        if (chk.action == canopen::TxQueueCheck::Action::kRaise) {
-          if (const int err = sock->set_tx_queue_len(chk.needed); err != 0)
-            throw std::runtime_error(fmt::format("{}: bus '{}' (line {}): {} (raising it failed: {})", cfg.path, b.name,
-                                                 b.where.line, chk.message(b.interface), std::strerror(err)));
-          rt.notes.push_back(fmt::format("bus '{}': raised the txqueuelen of {} from {} to {} (one cycle's burst)",
-                                         b.name, b.interface, chk.current, chk.needed));
-        }
-        // The cycle keeps within the queue and a place for the SYNC.
-        // (0: no queue, no limit)
-        bs.network.tx_queue_frames = std::max(chk.current, chk.action == canopen::TxQueueCheck::Action::kRaise ? chk.needed : 0u);
-      }
-      // restart-ms 0 (the kernel's default) keeps a bus-off controller off:
-      // say so once, with the command (nothing for vcan: no CAN attributes).
-      std::string link_why;
-      if (const auto link = can::query_can_link(b.interface, &link_why)) {
-        if (std::string w = can::restart_ms_warning(*link); !w.empty())
-          rt.notes.push_back(fmt::format("bus '{}': {}", b.name, w));
-        if (std::string w = can::bitrate_note(*link, b.bitrate); !w.empty())
-          rt.notes.push_back(fmt::format("bus '{}' (line {}): {}", b.name, b.where.line, w));
-      } else {
-        rt.notes.push_back(fmt::format("bus '{}': could not read the CAN settings: {}", b.name, link_why));
-      }
-      bs.transport = sock.get();
-      rt.sockets.push_back(std::move(sock));
-      rt.trace_names.push_back(b.interface);
+      r.trace_names.push_back(b.interface);  // transport left null: a SocketCAN bus is opened by its user
     }
     spec.buses.push_back(bs);
   }
   for (const AxisSettings& a : cfg.axes) {
-    rt::AxisSpec as;
-    as.name = a.name;
-    as.config = a.axis;
-    if (a.axis.type == motion::AxisType::CipDrive) {
-      std::size_t bi = 0;
-      while (bi < cfg.buses.size() && cfg.buses[bi].name != a.bus) ++bi;
-      as.bus = static_cast<int>(bi);
-      as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s, spec.axes.size());
-      as.config.drive_wait_limit = drive_wait_limit_s(a.drive.timeouts);
-      if (force_sim || cfg.buses[bi].is_sim()) {
-        // The simulated bus index equals the bus index: every simulated bus was added in order.
-        std::size_t sim_index = 0;
-        for (std::size_t k = 0; k < bi; ++k)
-          if (force_sim || cfg.buses[k].is_sim()) ++sim_index;
-        rt.sim->add_drive(sim_index, emulator_config(a));
-      }
-    }
-    spec.axes.push_back(as);
+    spec.axes.push_back(axis_spec(cfg, a, spec.axes.size()));
+    const int bi = spec.axes.back().bus;
+    if (bi >= 0 && spec.buses[static_cast<std::size_t>(bi)].transport != nullptr)
+      r.sim->add_drive(sim_index[static_cast<std::size_t>(bi)], emulator_config(a));
   }
-  for (const CamSettings& c : cfg.cams) {
-    rt::CamSpec cs;
-    cs.name = c.name;
-    cs.start_slope = c.start_slope;
-    cs.end_slope = c.end_slope;
-    cs.points = motion_points(c.points);
-    spec.cams.push_back(std::move(cs));
-  }
-  for (const ArraySettings& a : cfg.arrays) {
-    rt::ArraySpec as;
-    as.name = a.name;
-    as.size = a.size;
-    as.type = a.type == ArraySettings::Type::kCam          ? rt::ArraySpec::Type::kCam
-              : a.type == ArraySettings::Type::kCamProfile ? rt::ArraySpec::Type::kCamProfile
-                                                           : rt::ArraySpec::Type::kReal;
-    as.cam_values = motion_points(a.cam_values);
-    as.real_values = a.real_values;
-    spec.arrays.push_back(std::move(as));
-  }
-  for (const CoordinateSystemSettings& c : cfg.coordinate_systems) {
-    rt::CoordSystemSpec cs;
-    cs.name = c.name;
-    motion::CoordSystemConfig& m = cs.config;
-    m.dim = static_cast<int>(c.axes.size());
-    for (std::size_t k = 0; k < c.axes.size(); ++k) {
-      for (std::size_t a = 0; a < spec.axes.size(); ++a)
-        if (spec.axes[a].name == c.axes[k]) m.axes[k] = static_cast<motion::AxisId>(a);
-      if (k < c.conversion_ratios.size()) m.ratio[k] = c.conversion_ratios[k];
-    }
-    m.max_speed = c.max_speed;
-    m.max_accel = c.max_accel;
-    m.max_decel = c.max_decel;
-    m.max_accel_jerk = c.max_accel_jerk;
-    m.max_decel_jerk = c.max_decel_jerk;
-    m.actual_tolerance = c.actual_position_tolerance;
-    m.command_tolerance = c.command_position_tolerance;
-    spec.coordinate_systems.push_back(std::move(cs));
-  }
+  for (const CamSettings& c : cfg.cams) spec.cams.push_back(cam_spec(c));
+  for (const ArraySettings& a : cfg.arrays) spec.arrays.push_back(array_spec(a));
+  for (const CoordinateSystemSettings& c : cfg.coordinate_systems)
+    spec.coordinate_systems.push_back(coordinate_system_spec(c, spec.axes));
+  return r;
+}
+
+Runtime build_runtime(const Config& cfg, RuntimeSpec spec, std::vector<std::unique_ptr<can::SocketCanBus>> sockets) {
+  for (const rt::BusSpec& b : spec.controller.buses)
+    if (b.transport == nullptr)
+      throw std::logic_error(fmt::format("{}: bus '{}' has no transport: open its SocketCAN interface first", cfg.path, b.name));
+  Runtime rt;
+  rt.sockets = std::move(sockets);
+  rt.sim = std::move(spec.sim);
+  rt.trace_names = std::move(spec.trace_names);
   try {
-    rt.controller = std::make_unique<rt::Controller>(std::move(spec));
+    rt.controller = std::make_unique<rt::Controller>(std::move(spec.controller));
   } catch (const std::invalid_argument& e) {
     // e.g. a cam whose MCCP fails: name the file (the message names the cam).
     throw std::runtime_error(fmt::format("{}: {}", cfg.path, e.what()));
   }
   return rt;
 }
+
+Runtime simulated_runtime(const Config& cfg) { return build_runtime(cfg, build_spec(cfg, true)); }
 
 }  // namespace canmotion::config

@@ -1,8 +1,10 @@
 #pragma once
 /// \file
-/// From a validated Config to a running set of parts: the buses (SocketCAN
-/// sockets, or in-process SimBuses with an emulated CiA 402 drive per
-/// AXIS_CIP_DRIVE node), and the Controller. Not realtime.
+/// From a validated Config to a running set of parts, without I/O: the
+/// controller spec (build_spec: buses described, simulated ones as in-process
+/// SimBuses with an emulated CiA 402 drive per AXIS_CIP_DRIVE node), then the
+/// Controller over the buses' transports (build_runtime). Opening SocketCAN
+/// buses is the daemon's (tools/canmotiond/bus_opener.hpp). Not realtime.
 
 #include <memory>
 #include <string>
@@ -15,6 +17,29 @@
 
 namespace canmotion::config {
 
+/// A configuration as the controller's spec, before any bus is opened
+/// (build_spec): what it runs, and for simulated buses the in-process world
+/// they run on.
+struct RuntimeSpec {
+  /// Period, buses, axes with their drive configurations, cams, arrays,
+  /// coordinate systems. A simulated bus has its transport (a SimBus of
+  /// `sim`); a SocketCAN bus has none (null) until its user opens it
+  /// (canmotiond: tools/canmotiond/bus_opener.hpp).
+  rt::ControllerSpec controller;
+  std::unique_ptr<rt::SimWorld> sim;  ///< set when any bus is simulated, with an emulated drive per CIP axis on it
+  /// Name used for each bus in traces: the SocketCAN interface, or the bus name for simulated buses.
+  std::vector<std::string> trace_names;
+};
+
+/// The controller spec of a configuration: no socket, no netlink, no I/O
+/// (building the simulated world does none either). With `force_sim` every
+/// bus is simulated (`--sim`, `--check-args`, tests); otherwise buses with
+/// `interface: sim` are simulated and the others are described, their
+/// transport left null. The period is cfg.controller.period_ns(); each CIP
+/// axis's drive configuration is drive_config(), its planner's wait limit
+/// drive_wait_limit_s().
+[[nodiscard]] RuntimeSpec build_spec(const Config& cfg, bool force_sim);
+
 /// Everything a run needs, owned together (the controller refers to the buses).
 struct Runtime {
   std::vector<std::unique_ptr<can::SocketCanBus>> sockets;
@@ -22,20 +47,18 @@ struct Runtime {
   std::unique_ptr<rt::Controller> controller;
   /// Name used for each bus in traces: the SocketCAN interface, or the bus name for simulated buses.
   std::vector<std::string> trace_names;
-  /// What build_runtime changed on the host, one sentence each (e.g. a
-  /// raised txqueuelen), for the daemon to log.
-  std::vector<std::string> notes;
 };
 
-/// Build the runtime. With `force_sim` every bus is simulated (`--sim`);
-/// otherwise buses with `interface: sim` are simulated and the others are
-/// SocketCAN interfaces, opened with receive filters for the COB-IDs in use.
-/// Throws std::runtime_error naming the bus and interface when a socket
-/// cannot be opened (nothing has been sent on any bus then), and when an
-/// interface's txqueuelen is shorter than one cycle's burst and cannot be
-/// raised (canopen::check_tx_queue: the message has the numbers and the
-/// command to run).
-[[nodiscard]] Runtime build_runtime(const Config& cfg, bool force_sim);
+/// The runtime of a spec whose every bus has its transport: the controller
+/// is built (the cams computed by MCCP) and owned with `sockets`, the opened
+/// SocketCAN buses it refers to. Throws std::runtime_error naming the file
+/// when the controller refuses the spec (e.g. a cam), std::logic_error when a
+/// bus has no transport (a SocketCAN bus not opened). No I/O.
+[[nodiscard]] Runtime build_runtime(const Config& cfg, RuntimeSpec spec,
+                                    std::vector<std::unique_ptr<can::SocketCanBus>> sockets = {});
+
+/// Every bus simulated (`--sim`, tests): build_runtime(cfg, build_spec(cfg, true)).
+[[nodiscard]] Runtime simulated_runtime(const Config& cfg);
 
 /// The master-side drive configuration of a CIP axis (timeouts in ns, extra
 /// SDO writes, heartbeats, PDO profile), for the controller's period. The

@@ -116,7 +116,7 @@ struct CoordSystemSpec {
   motion::CoordSystemConfig config{};  ///< member axis ids resolved
 };
 
-/// Everything a Controller is built from (config::build_runtime makes it from a file).
+/// Everything a Controller is built from (config::build_spec makes it from a file).
 struct ControllerSpec {
   std::int64_t period_ns = 1'000'000;
   std::vector<BusSpec> buses;

@@ -84,7 +84,7 @@ TEST(ConfigArrays, RealElementBoundIsTheControllers) {
     return kHead + "arrays:\n  - {name: a, type: REAL, size: " + std::to_string(a) + "}\n  - {name: b, type: REAL, size: " +
            std::to_string(b) + "}\n";
   };
-  const Runtime rt = build_runtime(load_string(reals(max - 1, 1), "arr.yaml"), true);
+  const Runtime rt = simulated_runtime(load_string(reals(max - 1, 1), "arr.yaml"));
   ASSERT_NE(rt.controller, nullptr);
   std::string e = errors_of(reals(max, 1));
   EXPECT_NE(e.find("arrays[1].size: REAL arrays may hold " + std::to_string(max) + " elements together; this one "

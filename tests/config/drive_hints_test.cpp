@@ -41,7 +41,7 @@ axes:
 TEST(DriveWriteHints, EveryBootWriteNamesItsKey) {
   Config c;
   ASSERT_NO_THROW(c = load_string(kYaml, "hints.yaml"));
-  const Runtime rt = build_runtime(c, true);
+  const Runtime rt = simulated_runtime(c);
   const cia402::DriveConfig& x = rt.controller->axis_spec(1).drive;
   EXPECT_EQ(x.hints.interpolation_period, "controller.period_ms");
   EXPECT_EQ(x.hints.pdo, "axes[1].drive.pdo (or drives.pdo)");
@@ -95,7 +95,7 @@ axes:
     direct_control: {mode: torque}
 )",
                                   "id.yaml"));
-  const Runtime rt = build_runtime(c, true);
+  const Runtime rt = simulated_runtime(c);
   const cia402::DriveConfig& x = rt.controller->axis_spec(0).drive;
   EXPECT_TRUE(x.identity.has_vendor_id);
   EXPECT_EQ(x.identity.vendor_id, 0x9Au);

@@ -1,7 +1,7 @@
 // Instructions that wait on a drive always end (issue 26): an MSO, MSF,
 // MAFR, MASR or MAH ends with DN/PC or with ER within its limit, whatever
 // happens to the node meanwhile. The runtime is built from a configuration
-// (config::build_runtime, every bus simulated) so that the limit is the one
+// (config::simulated_runtime, every bus simulated) so that the limit is the one
 // canmotiond uses: drive.timeouts.wait_ms, by default 3 x boot_ms +
 // mode_switch_ms + 4 x transition_ms (config::drive_wait_limit_s).
 #include <gtest/gtest.h>
@@ -42,7 +42,7 @@ struct WaitRig : test::RuntimeRig {
       texts.push_back(rt::describe_drive_wait(e, ctl().axis_spec(id), id, control, ctl().period_s()));
     }
   }
-  std::int64_t period_ns() { return static_cast<std::int64_t>(std::llround(ctl().period_s() * 1e9)); }
+  std::int64_t period_ns() { return ctl().spec().period_ns; }
   bool run_until(const std::function<bool()>& done, int max_cycles) {
     for (int i = 0; i < max_cycles; ++i) {
       cycle();

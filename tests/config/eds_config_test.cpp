@@ -71,7 +71,7 @@ TEST(EdsConfig, RelativePathResolvesAgainstTheYamlFolderAndFillsTheDictionary) {
   // The default master_heartbeat_timeout_ms: 0x1016 is optional, left out (a warning says so).
   ASSERT_EQ(c.warnings.size(), 1u);
   EXPECT_NE(c.warnings[0].message.find("minimal-drive.eds has no 0x1016:01"), std::string::npos) << c.warnings[0].str();
-  const Runtime rt = build_runtime(c, true);
+  const Runtime rt = simulated_runtime(c);
   EXPECT_EQ(rt.controller->axis_spec(0).drive.consumer_heartbeat_ms, 0);
 }
 

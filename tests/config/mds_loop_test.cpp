@@ -433,7 +433,7 @@ TEST(MdsLoop, ObjectsAtTheDrivesOwnIndicesRampsAndSlat) {
 // project's indices: the boot fails at the first ramp object, naming both keys.
 TEST(MdsLoop, RelocatedObjectsOnADriveWithoutThemFailTheBootNamingTheKeys) {
   Config c = load_string(kRelocatedYaml, "mds.yaml");
-  Runtime rt = build_runtime(c, true);
+  Runtime rt = simulated_runtime(c);
   // Node 2's simulated drive (drive 0 on can0) replaced by one that keeps the
   // objects at the project's indices.
   emulator::EmulatorConfig e = emulator_config(c.axes[0]);

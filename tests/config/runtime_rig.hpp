@@ -18,7 +18,7 @@ struct RuntimeRig {
   rt::ControllerHost host;
   std::int64_t now = 0;
 
-  explicit RuntimeRig(const Config& cfg) : rt(build_runtime(cfg, true)), host(*rt.controller) {}
+  explicit RuntimeRig(const Config& cfg) : rt(simulated_runtime(cfg)), host(*rt.controller) {}
   virtual ~RuntimeRig() = default;
   RuntimeRig(const RuntimeRig&) = delete;
   RuntimeRig& operator=(const RuntimeRig&) = delete;
@@ -29,7 +29,7 @@ struct RuntimeRig {
     if (rt.sim) rt.sim->begin_cycle(now);
     ctl().cycle(now);
     if (rt.sim) rt.sim->end_cycle(now);
-    now += static_cast<std::int64_t>(std::llround(ctl().period_s() * 1e9));
+    now += ctl().spec().period_ns;
     after_cycle();
   }
   void cycles(int n) {

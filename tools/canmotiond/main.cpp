@@ -35,6 +35,7 @@
 #include "rt/controller/script.hpp"
 #include "rt/cyclic_executive.hpp"
 #include "rt/systemd_notify.hpp"
+#include "tools/canmotiond/bus_opener.hpp"
 
 namespace {
 
@@ -359,11 +360,14 @@ config::Config load_config(const Options& o) {
   return cfg;
 }
 
-/// 2. Buses and controller (--check-args: simulated buses, nothing opened).
+/// 2. Buses and controller: the spec, the SocketCAN buses opened (before the
+/// RT thread starts), the controller (--check-args: simulated buses, nothing opened).
 config::Runtime open_runtime(const Options& o, const config::Config& cfg) {
   try {
-    config::Runtime rt = config::build_runtime(cfg, o.sim || o.check_args);
-    for (const auto& n : rt.notes) fmt::print(stderr, "canmotiond: {}\n", n);  // e.g. a raised txqueuelen
+    config::RuntimeSpec spec = config::build_spec(cfg, o.sim || o.check_args);
+    daemon::OpenedBuses buses = daemon::open_buses(cfg, spec.controller);
+    config::Runtime rt = config::build_runtime(cfg, std::move(spec), std::move(buses.sockets));
+    for (const auto& n : buses.notes) fmt::print(stderr, "canmotiond: {}\n", n);  // e.g. a raised txqueuelen
     return rt;
   } catch (const std::exception& e) {
     fmt::print(stderr, "canmotiond: {}\n", e.what());
@@ -606,7 +610,7 @@ int run(const Options& o) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 
-  const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(std::llround(ctl.period_s() * 1e9)));
+  const auto period = std::chrono::nanoseconds(ctl.spec().period_ns);
   rt::VirtualClock vclock;
   rt::MonotonicClock mclock;
   rt::Clock& clock = o.sim ? static_cast<rt::Clock&>(vclock) : static_cast<rt::Clock&>(mclock);
@@ -615,7 +619,7 @@ int run(const Options& o) {
   const std::unique_ptr<rt::CommandServer> server = open_socket(o, ctl, host, exec);
 
   fmt::print("canmotiond: {} axes, {} buses ({}), period {} ms{}\n", ctl.axis_count(), cfg.buses.size(),
-             o.sim ? "simulated, virtual time" : "real time", ctl.period_s() * 1e3,
+             o.sim ? "simulated, virtual time" : "real time", config::period_ms(ctl.period_s()),
              script ? ", script " + o.script : std::string());
   Housekeeping hk(o, host, exec, *out, server.get(), runner.get());
   if (rt.sim) rt.sim->power_on(o.sim ? 0 : clock.now().count());  // boot-up frames at the run's start time
