@@ -17,6 +17,7 @@
 
 #include "fieldbus/eds/dcf.hpp"
 #include "fieldbus/eds/eds.hpp"
+#include "tests/eds/eds_test_util.hpp"
 
 using namespace canmotion;
 
@@ -108,24 +109,15 @@ TEST(EdsGolden, CorpusAndShippedFilesReadAsRecorded) {
   for (const fs::path& p : files) golden(p.filename().string() + ".txt", read_eds(p));
 }
 
+/// eds::test::dcf_spec() and more writes: a second mapping entry and the
+/// final 0x1600:0, a TPDO mapping, a VAR with its key, a 3-byte value.
 eds::DcfSpec boot_writes() {
-  eds::DcfSpec s;
-  s.node_id = 5;
-  s.baudrate_kbit = 500;
-  s.node_name = "X";
-  s.writes = {{0x6060, 0, 1, 8, ""},
-              {0x60C2, 1, 1, 1, "controller.period_ms"},
-              {0x60C2, 2, 1, 0xFD, "controller.period_ms"},
-              {0x1400, 1, 4, 0x80000205u, "axes[0].drive.pdo"},
-              {0x1600, 0, 1, 0, "axes[0].drive.pdo"},
-              {0x1600, 1, 4, 0x60400010u, "axes[0].drive.pdo"},
-              {0x1600, 2, 4, 0x607A0020u, "axes[0].drive.pdo"},
-              {0x1600, 0, 1, 2, "axes[0].drive.pdo"},
-              {0x1400, 1, 4, 0x205u, "axes[0].drive.pdo"},
-              {0x1A00, 1, 4, 0x60410010u, "axes[0].drive.pdo"},
-              {0x1017, 0, 2, 100, "drive.heartbeat_ms"},
-              {0x2100, 3, 2, 0x1234, "axes[0].drive.sdo_writes[0] (line 9)"},
-              {0x4000, 0, 3, 0xABCDEF, ""}};
+  eds::DcfSpec s = eds::test::dcf_spec();
+  s.writes.insert(s.writes.end(), {{0x1600, 2, 4, 0x607A0020u, "axes[0].drive.pdo"},
+                                   {0x1600, 0, 1, 2, "axes[0].drive.pdo"},
+                                   {0x1A00, 1, 4, 0x60410010u, "axes[0].drive.pdo"},
+                                   {0x1017, 0, 2, 100, "drive.heartbeat_ms"},
+                                   {0x4000, 0, 3, 0xABCDEF, ""}});
   return s;
 }
 
