@@ -16,10 +16,9 @@ using detail::Out;
 using detail::put;
 using detail::us;
 
-class JsonSummary {
+class JsonSummary : detail::Summary {
  public:
-  JsonSummary(const Analyzer& a, const ReportOptions& opt, Out& out)
-      : a_(a), b_(a.bus()), ao_(a.options()), opt_(opt), out_(out) {}
+  JsonSummary(const Analyzer& a, const ReportOptions& opt, Out& out) : Summary(a, opt, out) {}
 
   void render(std::string_view iface) {
     put(out_, "{\"iface\":");
@@ -45,11 +44,6 @@ class JsonSummary {
   }
 
  private:
-  template <typename... Args>
-  void print(fmt::format_string<Args...> f, Args&&... args) {
-    fmt::format_to(fmt::appender(out_), f, std::forward<Args>(args)...);
-  }
-
   /// A time in seconds, or null without timestamps.
   void time(std::int64_t ns) {
     if (opt_.has_time) {
@@ -202,11 +196,6 @@ class JsonSummary {
     }
   }
 
-  const Analyzer& a_;
-  const BusSummary& b_;
-  const AnalyzerOptions& ao_;
-  const ReportOptions& opt_;
-  Out& out_;
 };
 
 }  // namespace

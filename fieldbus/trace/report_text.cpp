@@ -19,10 +19,9 @@ using detail::Out;
 using detail::put;
 using detail::us;
 
-class TextSummary {
+class TextSummary : detail::Summary {
  public:
-  TextSummary(const Analyzer& a, const ReportOptions& opt, Out& out)
-      : a_(a), b_(a.bus()), ao_(a.options()), opt_(opt), out_(out), t0_(a.bus().t_first) {}
+  TextSummary(const Analyzer& a, const ReportOptions& opt, Out& out) : Summary(a, opt, out), t0_(a.bus().t_first) {}
 
   void render(std::string_view iface) {
     header(iface);
@@ -36,11 +35,6 @@ class TextSummary {
   }
 
  private:
-  template <typename... Args>
-  void print(fmt::format_string<Args...> f, Args&&... args) {
-    fmt::format_to(fmt::appender(out_), f, std::forward<Args>(args)...);
-  }
-
   /// "1700000000.000100 (+0.000100)", or "-" without timestamps.
   void time_at(std::int64_t t) {
     if (!opt_.has_time) {
@@ -282,11 +276,6 @@ class TextSummary {
     }
   }
 
-  const Analyzer& a_;
-  const BusSummary& b_;
-  const AnalyzerOptions& ao_;
-  const ReportOptions& opt_;
-  Out& out_;
   std::int64_t t0_;
 };
 

@@ -85,6 +85,15 @@ void SdoTransfer::describe(Decoded& d) const noexcept {
   d.sdo_dir = t_.dir;
 }
 
+bool SdoTransfer::segment_of(SdoDir dir, Decoded& d) const noexcept {
+  if (t_.dir != dir || !t_.segmented) {
+    d.sdo_orphan = true;
+    return false;
+  }
+  describe(d);
+  return true;
+}
+
 void SdoTransfer::append(const Decoded& d) noexcept {
   for (std::uint8_t i = 0; i < d.sdo.data_len; ++i) {
     if (t_.received < kSdoValueCapacity) t_.buf[t_.received] = d.sdo.data[i];
@@ -133,22 +142,14 @@ std::optional<ConfirmedWrite> SdoTransfer::download_confirmed(Decoded& d) noexce
 }
 
 void SdoTransfer::download_segment(Decoded& d) noexcept {
-  if (t_.dir != SdoDir::kDownload || !t_.segmented) {
-    d.sdo_orphan = true;
-    return;
-  }
-  describe(d);
+  if (!segment_of(SdoDir::kDownload, d)) return;
   t_.toggle = d.sdo.toggle;
   append(d);
   if (d.sdo.last) finish_segmented(d);
 }
 
 std::optional<ConfirmedWrite> SdoTransfer::download_segment_confirmed(Decoded& d) noexcept {
-  if (t_.dir != SdoDir::kDownload || !t_.segmented) {
-    d.sdo_orphan = true;
-    return std::nullopt;
-  }
-  describe(d);
+  if (!segment_of(SdoDir::kDownload, d)) return std::nullopt;
   if (d.sdo.toggle != t_.toggle) d.problem = "toggle bit does not match the request";
   // A response to the last segment completes the write.
   if (t_.announced == 0 || t_.received < t_.announced) return std::nullopt;
@@ -191,20 +192,12 @@ void SdoTransfer::upload_response(Decoded& d) noexcept {
 }
 
 void SdoTransfer::upload_segment_request(Decoded& d) noexcept {
-  if (t_.dir != SdoDir::kUpload || !t_.segmented) {
-    d.sdo_orphan = true;
-    return;
-  }
-  describe(d);
+  if (!segment_of(SdoDir::kUpload, d)) return;
   t_.toggle = d.sdo.toggle;
 }
 
 void SdoTransfer::upload_segment(Decoded& d) noexcept {
-  if (t_.dir != SdoDir::kUpload || !t_.segmented) {
-    d.sdo_orphan = true;
-    return;
-  }
-  describe(d);
+  if (!segment_of(SdoDir::kUpload, d)) return;
   if (d.sdo.toggle != t_.toggle) d.problem = "toggle bit does not match the request";
   append(d);
   if (!d.sdo.last) return;

@@ -45,6 +45,10 @@ class SdoTransfer {
 
   /// The transfer's object and direction into d.
   void describe(Decoded& d) const noexcept;
+  /// A segment (or its request or response) of a segmented transfer in
+  /// direction `dir`: describe() it; false (an orphan) when no such transfer
+  /// was initiated in the trace.
+  bool segment_of(SdoDir dir, Decoded& d) const noexcept;
   /// A segment's bytes into the buffer (beyond its capacity only counted).
   void append(const Decoded& d) noexcept;
   /// The reassembled value into d.
