@@ -40,4 +40,25 @@ struct Number {
   return r;
 }
 
+[[nodiscard]] inline bool is_space(char c) noexcept { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+
+/// `s` without leading and trailing white space.
+[[nodiscard]] inline std::string_view trim(std::string_view s) noexcept {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+/// Whether `s` starts with four hex digits (an index, as in a section name "1A00sub1").
+[[nodiscard]] inline bool is_hex4(std::string_view s) noexcept {
+  if (s.size() < 4) return false;
+  for (std::size_t i = 0; i < 4; ++i)
+    if (std::isxdigit(static_cast<unsigned char>(s[i])) == 0) return false;
+  return true;
+}
+/// The four hex digits `s` starts with (is_hex4(s) must hold).
+[[nodiscard]] inline std::uint16_t hex4(std::string_view s) {
+  return static_cast<std::uint16_t>(std::stoul(std::string(s.substr(0, 4)), nullptr, 16));
+}
+
 }  // namespace canmotion::eds

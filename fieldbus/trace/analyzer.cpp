@@ -214,7 +214,7 @@ void Analyzer::on_sync(const Decoded& d, const Decoder& decoder) {
   frames_since_sync_ = 0;
 }
 
-bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
+void Analyzer::account(const Decoded& d) {
   const std::int64_t t = d.tf.t_ns;
   if (bus_.frames == 0) {
     bus_.t_first = t;
@@ -225,46 +225,51 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
   ++bus_.kind_counts[static_cast<std::size_t>(d.kind)];
   if (d.problem != nullptr) ++bus_.problems;
   add_load(t, frame_bits_worst_case(d.tf.frame));
-  if (d.kind == EventKind::kSync) {
-    on_sync(d, decoder);
-    return false;
+}
+
+void Analyzer::on_error_frame(const Decoded& d) {
+  ++bus_.error_frames;
+  for (unsigned b = 0; b < bus_.error_class_counts.size(); ++b) {
+    if ((d.tf.frame.id & (1U << b)) != 0) ++bus_.error_class_counts[b];
   }
-  ++frames_since_sync_;
-  if (d.kind == EventKind::kErrorFrame) {
-    ++bus_.error_frames;
-    for (unsigned b = 0; b < bus_.error_class_counts.size(); ++b) {
-      if ((d.tf.frame.id & (1U << b)) != 0) ++bus_.error_class_counts[b];
-    }
-    if (bus_.error_list.size() < opt_.list_cap) {
-      bus_.error_list.push_back(ErrorFrameRecord{t, d.tf.frame.id, d.tf.frame.data});
-    }
-    return false;
+  if (bus_.error_list.size() < opt_.list_cap) {
+    bus_.error_list.push_back(ErrorFrameRecord{d.tf.t_ns, d.tf.frame.id, d.tf.frame.data});
   }
-  if (d.kind == EventKind::kNmt && d.problem == nullptr) {
-    // Commands change the NMT state of the addressed nodes; keep the
-    // "producing" flag honest so stopped nodes do not count as missing TPDOs.
-    const auto apply = [&](std::uint8_t n) {
-      if (d.nmt_command == 0x01) return;  // start: wait for its heartbeat/TPDOs
-      live_[n].producing = false;
-    };
-    if (d.nmt_target == 0) {
-      for (std::uint8_t n = 1; n <= kMaxNode; ++n) apply(n);
-    } else if (d.nmt_target <= kMaxNode) {
-      apply(d.nmt_target);
-    }
-    return false;
+}
+
+void Analyzer::on_nmt_command(const Decoded& d) {
+  // Commands change the NMT state of the addressed nodes; keep the
+  // "producing" flag honest so stopped nodes do not count as missing TPDOs.
+  const auto apply = [&](std::uint8_t n) {
+    if (d.nmt_command == 0x01) return;  // start: wait for its heartbeat/TPDOs
+    live_[n].producing = false;
+  };
+  if (d.nmt_target == 0) {
+    for (std::uint8_t n = 1; n <= kMaxNode; ++n) apply(n);
+  } else if (d.nmt_target <= kMaxNode) {
+    apply(d.nmt_target);
   }
-  if (d.node == 0 || d.node > kMaxNode) return false;
-  NodeSummary& ns = nodes_[d.node];
-  Live& l = live_[d.node];
-  ns.seen = true;
-  ++ns.frames;
+}
+
+void Analyzer::on_tpdo1(NodeSummary& ns, Live& l) {
+  if (l.tpdos_this_cycle != 0 && l.unconfirmed_missing != 0) {
+    // A second TPDO in one cycle: the one counted missing came late.
+    --l.unconfirmed_missing;
+    if (ns.missing_tpdo <= ns.missing_times.size() && !ns.missing_times.empty()) ns.missing_times.pop_back();
+    --ns.missing_tpdo;
+    ++ns.late_tpdo;
+  }
+  ++l.tpdos_this_cycle;
+  l.producing = true;
+  l.syncs_since_tpdo = 0;
+}
+
+void Analyzer::count_node_event(const Decoded& d, NodeSummary& ns, Live& l) {
+  const std::int64_t t = d.tf.t_ns;
   switch (d.kind) {
     case EventKind::kEmcy:
       ++ns.emcy_count;
-      if (ns.emcys.size() < opt_.list_cap) {
-        ns.emcys.push_back(EmcyRecord{t, d.emcy_code, d.emcy_register, d.emcy_vendor});
-      }
+      if (ns.emcys.size() < opt_.list_cap) ns.emcys.push_back(EmcyRecord{t, d.emcy_code, d.emcy_register, d.emcy_vendor});
       break;
     case EventKind::kBootUp:
       set_nmt(d.node, co::NmtState::kBootUp, t);
@@ -277,40 +282,26 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
       if (d.nmt_state != co::NmtState::kUnknown) set_nmt(d.node, d.nmt_state, t);
       break;
     case EventKind::kSdo:
-      if (d.sdo_response) {
-        ++ns.sdo_responses;
-      } else {
-        ++ns.sdo_requests;
-      }
+      ++(d.sdo_response ? ns.sdo_responses : ns.sdo_requests);
       if (d.sdo.kind == canopen::sdo::SdoFrameKind::kAbort) {
         ++ns.abort_count;
-        if (ns.aborts.size() < opt_.list_cap) {
-          ns.aborts.push_back(AbortRecord{t, d.sdo_index, d.sdo_sub, d.sdo.abort_code, d.sdo_response});
-        }
+        if (ns.aborts.size() < opt_.list_cap) ns.aborts.push_back(AbortRecord{t, d.sdo_index, d.sdo_sub, d.sdo.abort_code, d.sdo_response});
       }
       break;
     case EventKind::kPdo:
-      if (d.pdo_tx) {
-        ++ns.tpdos;
-        if (d.pdo_number == 1) {
-          if (l.tpdos_this_cycle != 0 && l.unconfirmed_missing != 0) {
-            // A second TPDO in one cycle: the one counted missing came late.
-            --l.unconfirmed_missing;
-            if (ns.missing_tpdo <= ns.missing_times.size() && !ns.missing_times.empty()) ns.missing_times.pop_back();
-            --ns.missing_tpdo;
-            ++ns.late_tpdo;
-          }
-          ++l.tpdos_this_cycle;
-          l.producing = true;
-          l.syncs_since_tpdo = 0;
-        }
-      } else {
+      if (!d.pdo_tx) {
         ++ns.rpdos;
+        break;
       }
+      ++ns.tpdos;
+      if (d.pdo_number == 1) on_tpdo1(ns, l);
       break;
     default:
       break;
   }
+}
+
+void Analyzer::track_drive(const Decoded& d, NodeSummary& ns, Live& l) {
   if (d.has_controlword) {
     l.has_cw = true;
     l.cw = d.controlword;
@@ -319,23 +310,24 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
     l.has_target = true;
     l.target = d.target_position;
   }
-  if (d.has_statusword) {
-    const cia402::State s = cia402::decode_state(d.statusword);
-    if (!l.has_sw || s != l.state) {
-      if (ns.timeline.size() < opt_.timeline_cap) {
-        ns.timeline.push_back(StateChange{t, s, d.statusword, l.has_cw, l.cw});
-      } else {
-        ++ns.timeline_dropped;
-      }
+  if (!d.has_statusword) return;
+  const cia402::State s = cia402::decode_state(d.statusword);
+  if (!l.has_sw || s != l.state) {
+    if (ns.timeline.size() < opt_.timeline_cap) {
+      ns.timeline.push_back(StateChange{d.tf.t_ns, s, d.statusword, l.has_cw, l.cw});
+    } else {
+      ++ns.timeline_dropped;
     }
-    l.has_sw = true;
-    l.sw = d.statusword;
-    l.state = s;
   }
-  if (d.kind != EventKind::kPdo || !d.pdo_tx || (!d.has_statusword && !d.has_actual)) return false;
+  l.has_sw = true;
+  l.sw = d.statusword;
+  l.state = s;
+}
+
+Sample Analyzer::sample_of(const Decoded& d, NodeSummary& ns, const Live& l) {
   Sample s;
   s.node = d.node;
-  s.t_ns = t;
+  s.t_ns = d.tf.t_ns;
   s.has_controlword = l.has_cw;
   s.controlword = l.cw;
   s.has_statusword = l.has_sw;
@@ -345,7 +337,8 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
   s.target = l.applied;
   s.has_actual = d.has_actual;
   s.actual = d.actual_position;
-  if (d.has_actual && l.has_applied && l.has_sw && l.state == cia402::State::kOperationEnabled) {
+  const bool enabled = d.has_actual && l.has_sw && l.state == cia402::State::kOperationEnabled;
+  if (enabled && l.has_applied) {
     s.has_following_error = true;
     s.following_error = l.applied - d.actual_position;
     const std::int64_t a = s.following_error < 0 ? -s.following_error : s.following_error;
@@ -354,10 +347,11 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
     if (a > ns.ferr_max_abs || ns.ferr_count == 1) {
       ns.ferr_max_abs = a;
       ns.ferr_at_max = s.following_error;
-      ns.ferr_t_max = t;
+      ns.ferr_t_max = d.tf.t_ns;
     }
   }
-  if (d.has_actual && l.has_sw && l.state == cia402::State::kOperationEnabled) {
+  if (enabled) {
+    // The same error against the targets applied 0..kLagFit-1 SYNCs earlier.
     const auto n = static_cast<std::uint32_t>(l.history.size());
     for (std::uint32_t lag = 0; lag < NodeSummary::kLagFit && lag < l.history_len; ++lag) {
       const std::int64_t e = l.history[(l.history_head + n - lag) % n] - d.actual_position;
@@ -366,6 +360,34 @@ bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
       ns.lag_max_abs[lag] = std::max(ns.lag_max_abs[lag], e < 0 ? -e : e);
     }
   }
+  return s;
+}
+
+bool Analyzer::feed(const Decoded& d, const Decoder& decoder, Sample* sample) {
+  account(d);
+  if (d.kind == EventKind::kSync) {
+    on_sync(d, decoder);
+    return false;
+  }
+  ++frames_since_sync_;
+  if (d.kind == EventKind::kErrorFrame) {
+    on_error_frame(d);
+    return false;
+  }
+  if (d.kind == EventKind::kNmt && d.problem == nullptr) {
+    on_nmt_command(d);
+    return false;
+  }
+  if (d.node == 0 || d.node > kMaxNode) return false;
+  NodeSummary& ns = nodes_[d.node];
+  Live& l = live_[d.node];
+  ns.seen = true;
+  ++ns.frames;
+  count_node_event(d, ns, l);
+  track_drive(d, ns, l);
+  // A sample per TPDO that carries the statusword or the actual position.
+  if (d.kind != EventKind::kPdo || !d.pdo_tx || (!d.has_statusword && !d.has_actual)) return false;
+  const Sample s = sample_of(d, ns, l);
   if (sample != nullptr) *sample = s;
   return true;
 }

@@ -213,6 +213,15 @@ class Analyzer {
     std::uint32_t unconfirmed_missing = 0;  // misses a late TPDO may still make up
     canopen::NmtState nmt = canopen::NmtState::kUnknown;
   };
+  // feed(), by concern: the bus counters, the frames without a node, the
+  // node's counters and lists, its drive state, the sample of a TPDO.
+  void account(const Decoded& d);
+  void on_error_frame(const Decoded& d);
+  void on_nmt_command(const Decoded& d);
+  void count_node_event(const Decoded& d, NodeSummary& ns, Live& l);
+  static void on_tpdo1(NodeSummary& ns, Live& l);
+  void track_drive(const Decoded& d, NodeSummary& ns, Live& l);
+  static Sample sample_of(const Decoded& d, NodeSummary& ns, const Live& l);
   void on_sync(const Decoded& d, const Decoder& decoder);
   void add_period(std::int64_t p);
   void calibrate(const Decoder& decoder);

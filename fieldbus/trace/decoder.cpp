@@ -10,13 +10,6 @@ namespace canmotion::trace {
 namespace {
 
 namespace co = canmotion::canopen;
-namespace sdo = canmotion::canopen::sdo;
-
-std::uint32_t le32(std::span<const std::uint8_t> v) noexcept {
-  std::uint32_t x = 0;
-  for (std::size_t i = 0; i < v.size() && i < 4; ++i) x |= static_cast<std::uint32_t>(v[i]) << (8 * i);
-  return x;
-}
 
 std::int64_t sign_extend(std::uint64_t v, unsigned bits) noexcept {
   if (bits == 0 || bits >= 64) return static_cast<std::int64_t>(v);
@@ -162,9 +155,10 @@ void Decoder::reroute(std::uint8_t node, bool tx, std::uint8_t number, std::uint
   if (valid) routes_[id] = Route{EventKind::kPdo, node, number, tx};
 }
 
-void Decoder::apply_write(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
-                          std::uint8_t len) noexcept {
-  (void)len;
+void Decoder::apply_write(std::uint8_t node, const detail::ConfirmedWrite& w) noexcept {
+  const std::uint16_t index = w.index;
+  const std::uint8_t sub = w.sub;
+  const std::uint32_t value = w.value;
   if (index == 0x1006 && sub == 0) {
     // 0 is no period (SYNC watch off): canmotiond writes it to every drive
     // before 0x1019, and with drive.sync_watch the period after it; the next
@@ -196,183 +190,6 @@ void Decoder::apply_write(std::uint8_t node, std::uint16_t index, std::uint8_t s
     } else if (sub <= kMaxPdoEntries) {
       p.pending.entries[sub - 1] = MapEntry::from_raw(value);
     }
-  }
-}
-
-void Decoder::set_cia402_from_object(Decoded& d, std::uint16_t index, std::uint8_t sub,
-                                     std::span<const std::uint8_t> v) noexcept {
-  if (sub != 0 || v.empty()) return;
-  const std::uint32_t x = le32(v);
-  switch (index) {
-    case cia402::obj::kControlword:
-      d.has_controlword = true;
-      d.controlword = static_cast<std::uint16_t>(x);
-      break;
-    case cia402::obj::kStatusword:
-      d.has_statusword = true;
-      d.statusword = static_cast<std::uint16_t>(x);
-      break;
-    case cia402::obj::kTargetPosition:
-      d.has_target = true;
-      d.target_position = static_cast<std::int32_t>(x);
-      break;
-    case cia402::obj::kPositionActualValue:
-      d.has_actual = true;
-      d.actual_position = static_cast<std::int32_t>(x);
-      break;
-    case cia402::obj::kModesOfOperation:
-    case cia402::obj::kModesOfOperationDisplay:
-      d.has_mode = true;
-      d.mode = static_cast<std::int8_t>(x & 0xFFU);
-      break;
-    default:
-      break;
-  }
-}
-
-void Decoder::decode_sdo(Node& n, Decoded& d) noexcept {
-  Transfer& t = n.sdo;
-  const sdo::SdoFrame s = sdo::decode(d.tf.frame, d.sdo_response);
-  d.sdo = s;
-  auto from_transfer = [&] {
-    d.sdo_index = t.index;
-    d.sdo_sub = t.sub;
-    d.sdo_dir = t.dir;
-  };
-  auto append = [&] {
-    for (std::uint8_t i = 0; i < d.sdo.data_len; ++i) {
-      if (t.received < kSdoValueCapacity) t.buf[t.received] = d.sdo.data[i];
-      ++t.received;
-    }
-  };
-  auto finish_segmented = [&] {
-    d.sdo_has_value = true;
-    d.sdo_segmented = true;
-    d.sdo_total = t.received;
-    d.value = std::span<const std::uint8_t>(t.buf.data(), std::min<std::size_t>(t.received, kSdoValueCapacity));
-  };
-  switch (s.kind) {
-    case sdo::SdoFrameKind::kInitiateDownloadRequest:
-      t = Transfer{};
-      t.dir = SdoDir::kDownload;
-      t.index = s.index;
-      t.sub = s.sub;
-      from_transfer();
-      if (s.expedited) {
-        d.sdo_has_value = true;
-        d.sdo_total = s.data_len;
-        d.value = std::span<const std::uint8_t>(d.sdo.data, s.data_len);
-        t.write_pending = true;
-        t.write_value = le32(d.value);
-        t.write_len = s.data_len;
-        set_cia402_from_object(d, s.index, s.sub, d.value);
-      } else {
-        t.segmented = true;
-        t.announced = s.size_indicated ? s.size : 0;
-        d.sdo_total = t.announced;
-      }
-      break;
-    case sdo::SdoFrameKind::kInitiateDownloadResponse:
-      d.sdo_index = s.index;
-      d.sdo_sub = s.sub;
-      d.sdo_dir = SdoDir::kDownload;
-      if (t.dir == SdoDir::kDownload && t.index == s.index && t.sub == s.sub && t.write_pending) {
-        d.node = d.node;
-        apply_write(d.node, s.index, s.sub, t.write_value, t.write_len);
-        d.sdo_complete = true;
-        t = Transfer{};
-      }
-      break;
-    case sdo::SdoFrameKind::kDownloadSegmentRequest:
-      if (t.dir == SdoDir::kDownload && t.segmented) {
-        from_transfer();
-        t.toggle = s.toggle;
-        append();
-        if (s.last) finish_segmented();
-      } else {
-        d.sdo_orphan = true;
-      }
-      break;
-    case sdo::SdoFrameKind::kDownloadSegmentResponse:
-      if (t.dir == SdoDir::kDownload && t.segmented) {
-        from_transfer();
-        if (s.toggle != t.toggle) d.problem = "toggle bit does not match the request";
-        // A response to the last segment completes the write.
-        if (t.announced != 0 ? t.received >= t.announced : false) {
-          d.sdo_complete = true;
-          d.sdo_total = t.received;
-          if (t.received <= 4) apply_write(d.node, t.index, t.sub, le32(std::span(t.buf.data(), t.received)),
-                                           static_cast<std::uint8_t>(t.received));
-          t = Transfer{};
-        }
-      } else {
-        d.sdo_orphan = true;
-      }
-      break;
-    case sdo::SdoFrameKind::kInitiateUploadRequest:
-      t = Transfer{};
-      t.dir = SdoDir::kUpload;
-      t.index = s.index;
-      t.sub = s.sub;
-      from_transfer();
-      break;
-    case sdo::SdoFrameKind::kInitiateUploadResponse:
-      d.sdo_index = s.index;
-      d.sdo_sub = s.sub;
-      d.sdo_dir = SdoDir::kUpload;
-      if (s.expedited) {
-        d.sdo_has_value = true;
-        d.sdo_complete = true;
-        d.sdo_total = s.data_len;
-        d.value = std::span<const std::uint8_t>(d.sdo.data, s.data_len);
-        set_cia402_from_object(d, s.index, s.sub, d.value);
-        t = Transfer{};
-      } else {
-        t = Transfer{};
-        t.dir = SdoDir::kUpload;
-        t.index = s.index;
-        t.sub = s.sub;
-        t.segmented = true;
-        t.announced = s.size_indicated ? s.size : 0;
-        d.sdo_total = t.announced;
-      }
-      break;
-    case sdo::SdoFrameKind::kUploadSegmentRequest:
-      if (t.dir == SdoDir::kUpload && t.segmented) {
-        from_transfer();
-        t.toggle = s.toggle;
-      } else {
-        d.sdo_orphan = true;
-      }
-      break;
-    case sdo::SdoFrameKind::kUploadSegmentResponse:
-      if (t.dir == SdoDir::kUpload && t.segmented) {
-        from_transfer();
-        if (s.toggle != t.toggle) d.problem = "toggle bit does not match the request";
-        append();
-        if (s.last) {
-          finish_segmented();
-          d.sdo_complete = true;
-          if (t.announced != 0 && t.announced != t.received) d.problem = "segmented upload size differs from the announced size";
-          t.dir = SdoDir::kNone;  // buffer stays valid for this Decoded
-          t.segmented = false;
-        }
-      } else {
-        d.sdo_orphan = true;
-      }
-      break;
-    case sdo::SdoFrameKind::kAbort:
-      d.sdo_index = s.index;
-      d.sdo_sub = s.sub;
-      d.sdo_dir = t.dir;
-      t = Transfer{};
-      break;
-    case sdo::SdoFrameKind::kBlock:
-      d.problem = "SDO block transfer (not decoded)";
-      break;
-    case sdo::SdoFrameKind::kInvalid:
-      d.problem = d.tf.frame.len != 8 ? "SDO frame is not 8 bytes long" : "invalid SDO command specifier";
-      break;
   }
 }
 
@@ -411,33 +228,7 @@ void Decoder::decode_pdo(Decoded& d) noexcept {
     fld.value = fld.is_signed ? sign_extend(v, e.bits) : static_cast<std::int64_t>(v);
     fld.present = true;
     offset += e.bits;
-    if (e.sub == 0) {
-      switch (e.index) {
-        case cia402::obj::kControlword:
-          d.has_controlword = true;
-          d.controlword = static_cast<std::uint16_t>(v);
-          break;
-        case cia402::obj::kStatusword:
-          d.has_statusword = true;
-          d.statusword = static_cast<std::uint16_t>(v);
-          break;
-        case cia402::obj::kTargetPosition:
-          d.has_target = true;
-          d.target_position = fld.value;
-          break;
-        case cia402::obj::kPositionActualValue:
-          d.has_actual = true;
-          d.actual_position = fld.value;
-          break;
-        case cia402::obj::kModesOfOperation:
-        case cia402::obj::kModesOfOperationDisplay:
-          d.has_mode = true;
-          d.mode = static_cast<std::int8_t>(v & 0xFFU);
-          break;
-        default:
-          break;
-      }
-    }
+    if (e.sub == 0) detail::set_cia402(d, e.index, v, fld.value);
   }
   d.field_count = count;
   d.pdo_mapped_bits = static_cast<std::uint16_t>(offset);
@@ -518,7 +309,7 @@ const Decoded& Decoder::decode(const can::TimedFrame& tf) noexcept {
       if (f.remote()) {
         d.problem = "remote request on an SDO id";
       } else {
-        decode_sdo(nodes_[r.node], d);
+        if (const auto w = nodes_[r.node].sdo.step(d)) apply_write(d.node, *w);
       }
       break;
     case EventKind::kPdo:

@@ -10,6 +10,7 @@
 #include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 #include "fieldbus/cia402/cia402.hpp"
+#include "fieldbus/trace/report_detail.hpp"
 
 namespace canmotion::trace {
 namespace {
@@ -19,7 +20,7 @@ namespace sdo = canmotion::canopen::sdo;
 
 constexpr char kHex[] = "0123456789ABCDEF";
 
-void put(fmt::memory_buffer& out, std::string_view s) { out.append(s.data(), s.data() + s.size()); }
+using detail::put;
 
 void put_hex(fmt::memory_buffer& out, std::uint32_t v, int digits) {
   for (int i = digits - 1; i >= 0; --i) out.push_back(kHex[(v >> (4 * i)) & 0xFU]);
@@ -299,6 +300,49 @@ void describe_pdo(const Decoded& d, fmt::memory_buffer& out) {
   }
 }
 
+
+void json_sdo(const Decoded& d, const FormatOptions& opt, fmt::memory_buffer& out) {
+  fmt::format_to(fmt::appender(out), ",\"sdo\":\"{}\",\"index\":{},\"sub\":{}", sdo::sdo_frame_kind_name(d.sdo.kind),
+                 d.sdo_index, d.sdo_sub);
+  if (!co::object_name(d.sdo_index, d.sdo_sub).empty()) {
+    put(out, ",\"name\":");
+    append_json_string(out, co::object_name(d.sdo_index, d.sdo_sub));
+  }
+  if (d.sdo.kind == sdo::SdoFrameKind::kAbort) {
+    fmt::format_to(fmt::appender(out), ",\"abort_code\":{},\"abort_text\":", d.sdo.abort_code);
+    append_json_string(out, co::sdo_abort_text(d.sdo.abort_code));
+  }
+  if (d.sdo_has_value) {
+    put(out, ",\"value_hex\":\"");
+    for (std::uint8_t b : d.value) put_hex(out, b, 2);
+    put(out, "\",\"value\":");
+    fmt::memory_buffer v;
+    put_value(v, dictionary_of(opt.names, d.node), d.sdo_index, d.sdo_sub, d.value, d.sdo_total);
+    append_json_string(out, std::string_view(v.data(), v.size()));
+    fmt::format_to(fmt::appender(out), ",\"size\":{}", d.sdo_total);
+  }
+  if (d.sdo_complete) put(out, ",\"complete\":true");
+}
+
+void json_pdo(const Decoded& d, fmt::memory_buffer& out) {
+  fmt::format_to(fmt::appender(out), ",\"pdo\":{},\"layout\":\"{}\",\"fields\":[", d.pdo_number,
+                 layout_source_name(d.layout));
+  for (std::uint8_t i = 0; i < d.field_count; ++i) {
+    const PdoField& fl = d.fields[i];
+    if (i != 0) out.push_back(',');
+    fmt::format_to(fmt::appender(out), "{{\"index\":{},\"sub\":{},\"bits\":{},\"name\":", fl.index, fl.sub, fl.bits);
+    append_json_string(out, fl.name);
+    put(out, ",\"value\":");
+    if (fl.present) {
+      put_dec(out, fl.value);
+    } else {
+      put(out, "null");
+    }
+    out.push_back('}');
+  }
+  out.push_back(']');
+}
+
 }  // namespace
 
 void append_emcy(fmt::memory_buffer& out, std::uint16_t code, std::uint8_t error_register) {
@@ -516,22 +560,11 @@ void append_json_string(fmt::memory_buffer& out, std::string_view s) {
   out.push_back('"');
 }
 
-void format_json(const Decoded& d, std::string_view iface, const FormatOptions& opt, fmt::memory_buffer& out) {
-  const can::Frame& f = d.tf.frame;
-  put(out, "{\"t\":");
-  if (opt.has_time) {
-    append_time(out, d.tf.t_ns, opt.time_digits);
-  } else {
-    put(out, "null");
-  }
-  put(out, ",\"iface\":");
-  append_json_string(out, iface);
-  put(out, ",\"raw\":\"");
-  put_raw(out, f);
-  put(out, "\",\"kind\":\"");
-  put(out, event_kind_name(d));
-  put(out, "\"");
-  if (d.node != 0) fmt::format_to(fmt::appender(out), ",\"node\":{}", d.node);
+namespace {
+
+/// The members of d's protocol (NMT command, SYNC counter, EMCY, NMT state,
+/// SDO transfer, PDO fields, error classes).
+void json_protocol(const Decoded& d, const FormatOptions& opt, fmt::memory_buffer& out) {
   switch (d.kind) {
     case EventKind::kNmt:
       if (d.problem == nullptr) {
@@ -550,53 +583,23 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
       fmt::format_to(fmt::appender(out), ",\"nmt_state\":\"{}\"", co::nmt_state_name(d.nmt_state));
       break;
     case EventKind::kSdo:
-      fmt::format_to(fmt::appender(out), ",\"sdo\":\"{}\",\"index\":{},\"sub\":{}",
-                     sdo::sdo_frame_kind_name(d.sdo.kind), d.sdo_index, d.sdo_sub);
-      if (!co::object_name(d.sdo_index, d.sdo_sub).empty()) {
-        put(out, ",\"name\":");
-        append_json_string(out, co::object_name(d.sdo_index, d.sdo_sub));
-      }
-      if (d.sdo.kind == sdo::SdoFrameKind::kAbort) {
-        fmt::format_to(fmt::appender(out), ",\"abort_code\":{},\"abort_text\":", d.sdo.abort_code);
-        append_json_string(out, co::sdo_abort_text(d.sdo.abort_code));
-      }
-      if (d.sdo_has_value) {
-        put(out, ",\"value_hex\":\"");
-        for (std::uint8_t b : d.value) put_hex(out, b, 2);
-        put(out, "\",\"value\":");
-        fmt::memory_buffer v;
-        put_value(v, dictionary_of(opt.names, d.node), d.sdo_index, d.sdo_sub, d.value, d.sdo_total);
-        append_json_string(out, std::string_view(v.data(), v.size()));
-        fmt::format_to(fmt::appender(out), ",\"size\":{}", d.sdo_total);
-      }
-      if (d.sdo_complete) put(out, ",\"complete\":true");
+      json_sdo(d, opt, out);
       break;
     case EventKind::kPdo:
-      fmt::format_to(fmt::appender(out), ",\"pdo\":{},\"layout\":\"{}\",\"fields\":[", d.pdo_number,
-                     layout_source_name(d.layout));
-      for (std::uint8_t i = 0; i < d.field_count; ++i) {
-        const PdoField& fl = d.fields[i];
-        if (i != 0) out.push_back(',');
-        fmt::format_to(fmt::appender(out), "{{\"index\":{},\"sub\":{},\"bits\":{},\"name\":", fl.index, fl.sub, fl.bits);
-        append_json_string(out, fl.name);
-        put(out, ",\"value\":");
-        if (fl.present) {
-          put_dec(out, fl.value);
-        } else {
-          put(out, "null");
-        }
-        out.push_back('}');
-      }
-      out.push_back(']');
+      json_pdo(d, out);
       break;
     case EventKind::kErrorFrame:
       put(out, ",\"classes\":\"");
-      append_error_classes(out, f.id);
+      append_error_classes(out, d.tf.frame.id);
       out.push_back('"');
       break;
     default:
       break;
   }
+}
+
+/// The CiA 402 values the frame carries.
+void json_cia402(const Decoded& d, fmt::memory_buffer& out) {
   if (d.has_statusword) {
     fmt::format_to(fmt::appender(out), ",\"statusword\":{},\"state\":\"{}\"", d.statusword,
                    statusword_state_name(d.statusword));
@@ -607,6 +610,27 @@ void format_json(const Decoded& d, std::string_view iface, const FormatOptions& 
   }
   if (d.has_target) fmt::format_to(fmt::appender(out), ",\"target_position\":{}", d.target_position);
   if (d.has_actual) fmt::format_to(fmt::appender(out), ",\"actual_position\":{}", d.actual_position);
+}
+
+}  // namespace
+
+void format_json(const Decoded& d, std::string_view iface, const FormatOptions& opt, fmt::memory_buffer& out) {
+  put(out, "{\"t\":");
+  if (opt.has_time) {
+    append_time(out, d.tf.t_ns, opt.time_digits);
+  } else {
+    put(out, "null");
+  }
+  put(out, ",\"iface\":");
+  append_json_string(out, iface);
+  put(out, ",\"raw\":\"");
+  put_raw(out, d.tf.frame);
+  put(out, "\",\"kind\":\"");
+  put(out, event_kind_name(d));
+  put(out, "\"");
+  if (d.node != 0) fmt::format_to(fmt::appender(out), ",\"node\":{}", d.node);
+  json_protocol(d, opt, out);
+  json_cia402(d, out);
   put(out, ",\"text\":");
   fmt::memory_buffer desc;
   format_description(d, desc, opt.names);

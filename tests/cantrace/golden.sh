@@ -71,6 +71,59 @@ case "$case" in
     "$bin" - < "$data/boot_enable.log" > "$tmp/stdin.txt"
     diff -u "$tmp/ref.txt" "$tmp/stdin.txt" || fail "stdin input decodes differently"
     ;;
+  protocol)
+    # Synthetic (scenarios/gen-synthetic.py): every kind of frame and SDO transfer shape, then the analysis.
+    "$bin" -s "$data/protocol.log" > "$tmp/protocol.txt"
+    check "protocol.txt"
+    ;;
+  protocol_json)
+    "$bin" -j -s "$data/protocol.log" > "$tmp/protocol.json"
+    jq -e . "$tmp/protocol.json" > /dev/null || fail "output is not valid JSON"
+    check "protocol.json"
+    ;;
+  protocol_eds)
+    # Node 1's objects named and typed by an EDS (--eds), text and JSON.
+    eds="$data/../../../config/examples/cia402-emu.eds"
+    "$bin" --eds "1=$eds" "$data/protocol.log" > "$tmp/protocol_eds.txt"
+    check "protocol_eds.txt"
+    "$bin" -j --eds "1=$eds" "$data/protocol.log" > "$tmp/protocol_eds.json"
+    jq -e . "$tmp/protocol_eds.json" > /dev/null || fail "output is not valid JSON"
+    check "protocol_eds.json"
+    ;;
+  cyclic)
+    # Synthetic, two buses: jitter beyond the histogram, missing and late TPDOs, a fault, error frames.
+    "$bin" -q -s "$data/cyclic.log" > "$tmp/cyclic.txt"
+    check "cyclic.txt"
+    "$bin" -q -j -s "$data/cyclic.log" > "$tmp/cyclic.json"
+    jq -e . "$tmp/cyclic.json" > /dev/null || fail "output is not valid JSON"
+    check "cyclic.json"
+    ;;
+  cyclic_options)
+    # The analysis options: lag, nominal period, bitrate, a window small enough to group the load rows.
+    opts=(--lag 1 --period 990 --bitrate 500000 --window 2)
+    "$bin" -q -s "${opts[@]}" "$data/cyclic.log" > "$tmp/cyclic_options.txt"
+    check "cyclic_options.txt"
+    "$bin" -q -j -s "${opts[@]}" "$data/cyclic.log" > "$tmp/cyclic_options.json"
+    jq -e . "$tmp/cyclic_options.json" > /dev/null || fail "output is not valid JSON"
+    check "cyclic_options.json"
+    ;;
+  cyclic_config)
+    # Axis names and units from a configuration, on both buses; the CSV files with user units.
+    "$bin" -q -s -c "$data/axes.yaml" --csv "$tmp/csv" "$data/cyclic.log" > "$tmp/cyclic_config.txt"
+    check "cyclic_config.txt"
+    "$bin" -q -j -s -c "$data/axes.yaml" "$data/cyclic.log" > "$tmp/cyclic_config.json"
+    check "cyclic_config.json"
+    (cd "$tmp/csv" && for f in *.csv; do echo "== $f"; cat "$f"; done) > "$tmp/cyclic_config_csv.txt"
+    check "cyclic_config_csv.txt"
+    ;;
+  no_time)
+    # Screen output without timestamps: "-" times, no timing statistics.
+    "$bin" -s "$data/boot_enable.screen" > "$tmp/no_time.txt"
+    check "no_time.txt"
+    "$bin" -j -s "$data/boot_enable.screen" > "$tmp/no_time.json"
+    jq -e . "$tmp/no_time.json" > /dev/null || fail "output is not valid JSON"
+    check "no_time.json"
+    ;;
   malformed)
     # Bad lines are reported with their line number and skipped; exit status 0.
     "$bin" -s "$data/malformed.log" > "$tmp/malformed.out" 2> "$tmp/malformed.err"

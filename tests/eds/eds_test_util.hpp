@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldbus/eds/dcf.hpp"
 #include "fieldbus/eds/eds.hpp"
 
 namespace canmotion::eds::test {
@@ -93,6 +94,26 @@ inline std::vector<Diagnostic> errors_of(const std::string& text, const std::str
 inline std::string error_text(const std::string& text, const std::string& file = "bad.eds") {
   const auto e = errors_of(text, file);
   return e.empty() ? std::string() : ParseError(e).what();
+}
+
+/// A master's boot writes to node 5 (500 kbit/s, "X"): a VAR, a record
+/// without its sub-index 0, the PDO procedure writing 0x1400:1 and 0x1600:0
+/// twice, a manufacturer object unknown to the object table.
+inline DcfSpec dcf_spec() {
+  DcfSpec s;
+  s.node_id = 5;
+  s.baudrate_kbit = 500;
+  s.node_name = "X";
+  s.writes = {{0x6060, 0, 1, 8, ""},
+              {0x60C2, 1, 1, 1, "controller.period_ms"},
+              {0x60C2, 2, 1, 0xFD, "controller.period_ms"},
+              {0x1400, 1, 4, 0x80000205u, "axes[0].drive.pdo"},
+              {0x1600, 0, 1, 0, "axes[0].drive.pdo"},
+              {0x1600, 1, 4, 0x60400010u, "axes[0].drive.pdo"},
+              {0x1600, 0, 1, 1, "axes[0].drive.pdo"},
+              {0x1400, 1, 4, 0x205u, "axes[0].drive.pdo"},
+              {0x2100, 3, 2, 0x1234, "axes[0].drive.sdo_writes[0] (line 9)"}};
+  return s;
 }
 
 }  // namespace canmotion::eds::test

@@ -5,30 +5,14 @@
 
 #include "fieldbus/eds/dcf.hpp"
 #include "fieldbus/eds/eds.hpp"
+#include "tests/eds/eds_test_util.hpp"
 
 using namespace canmotion;
 
 namespace {
 
-eds::DcfSpec spec() {
-  eds::DcfSpec s;
-  s.node_id = 5;
-  s.baudrate_kbit = 500;
-  s.node_name = "X";
-  s.writes = {{0x6060, 0, 1, 8, ""},
-              {0x60C2, 1, 1, 1, "controller.period_ms"},
-              {0x60C2, 2, 1, 0xFD, "controller.period_ms"},
-              {0x1400, 1, 4, 0x80000205u, "axes[0].drive.pdo"},
-              {0x1600, 0, 1, 0, "axes[0].drive.pdo"},
-              {0x1600, 1, 4, 0x60400010u, "axes[0].drive.pdo"},
-              {0x1600, 0, 1, 1, "axes[0].drive.pdo"},
-              {0x1400, 1, 4, 0x205u, "axes[0].drive.pdo"},
-              {0x2100, 3, 2, 0x1234, "axes[0].drive.sdo_writes[0] (line 9)"}};
-  return s;
-}
-
 TEST(Dcf, ReadsBackWithTheLastValues) {
-  const std::string text = eds::format_dcf(spec());
+  const std::string text = eds::format_dcf(eds::test::dcf_spec());
   eds::Eds e;
   ASSERT_NO_THROW(e = eds::parse(text, "X.dcf")) << text;
   EXPECT_TRUE(e.is_dcf());
@@ -89,7 +73,7 @@ AccessType=rww
 PDOMapping=1
 )",
                                      "acme.eds");
-  eds::DcfSpec s = spec();
+  eds::DcfSpec s = eds::test::dcf_spec();
   s.eds = &vendor;
   const eds::Eds e = eds::parse(eds::format_dcf(s), "X.dcf");
   EXPECT_EQ(e.device_info.vendor_name, "ACME");

@@ -1,0 +1,116 @@
+#pragma once
+/// \file
+/// The interpretation of an EDS/DCF's sections (internal to fieldbus/eds):
+/// the Builder turns the INI sections read by ini.hpp into an Eds, with an
+/// error or a warning (file:line) for what CiA 306 does not allow.
+/// builder.cpp reads the file's header sections ([FileInfo], [DeviceInfo],
+/// [DummyUsage], [DeviceComissioning]) and the object lists; objects.cpp
+/// reads the object sections. Set-up only (allocates, throws).
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "fieldbus/eds/eds.hpp"
+#include "fieldbus/eds/ini.hpp"
+#include "fieldbus/eds/text.hpp"
+
+namespace canmotion::eds {
+
+/// The sections that describe one object.
+struct ObjectSections {
+  const RawSection* main = nullptr;
+  std::map<unsigned, const RawSection*> subs;  // [xxxxsubN]
+  const RawSection* names = nullptr;           // [xxxxName]
+  const RawSection* values = nullptr;          // [xxxxValue]
+  const RawSection* denotations = nullptr;     // [xxxxDenotation]
+};
+
+/// Where an index is listed ([MandatoryObjects], ...).
+struct Listed {
+  ObjectList list = ObjectList::kNone;
+  int line = 0;
+};
+
+class Builder {
+ public:
+  explicit Builder(std::string file) { eds_.file = std::move(file); }
+
+  /// The Eds of `ini`, its warnings sorted by line; throws ParseError with
+  /// every error (the INI syntax errors first), sorted by line.
+  Eds build(const IniFile& ini);
+
+  void error(int line, std::string msg) { errors_.push_back(Diagnostic{eds_.file, line, std::move(msg)}); }
+  void warning(int line, std::string msg) { eds_.warnings.push_back(Diagnostic{eds_.file, line, std::move(msg)}); }
+  [[nodiscard]] bool failed() const { return !errors_.empty(); }
+
+ private:
+  // ---- sections (builder.cpp) ----------------------------------------------
+  void index_sections(const IniFile& ini);
+  const RawSection* section(std::string_view name) const;
+
+  // ---- numbers -------------------------------------------------------------
+  /// An unsigned number key in [0, max]; false (and an error) when malformed.
+  template <typename T>
+  bool number(const RawSection& s, const RawKey& k, T& out, std::uint64_t max) {
+    const Number n = parse_number(trim(k.value));
+    if (!n.ok || n.negative) {
+      error(k.line, fmt::format("[{}] {}={} is not a number (decimal, 0x hex or 0 octal)", s.name, k.name, k.value));
+      return false;
+    }
+    if (n.magnitude > max) {
+      error(k.line, fmt::format("[{}] {}={} is out of range (0 .. {})", s.name, k.name, k.value, max));
+      return false;
+    }
+    out = static_cast<T>(n.magnitude);
+    return true;
+  }
+  template <typename T>
+  bool number(const RawSection& s, std::string_view key, T& out, std::uint64_t max, int* line = nullptr) {
+    const RawKey* k = s.get(key);
+    if (k == nullptr) return false;
+    if (line != nullptr) *line = k->line;
+    return number(s, *k, out, max);
+  }
+  bool flag(const RawSection& s, std::string_view key, bool& out);
+  static void text(const RawSection& s, std::string_view key, std::string& out);
+
+  // ---- [FileInfo], [DeviceInfo], [DummyUsage], [DeviceComissioning] (builder.cpp)
+  void file_info(const RawSection& s);
+  void device_info(const RawSection& s);
+  void dummy_usage(const RawSection& s);
+  void comissioning(const RawSection& s);
+
+  // ---- object lists (builder.cpp) ------------------------------------------
+  void object_list(ObjectList list);
+
+  // ---- objects (objects.cpp) -----------------------------------------------
+  void objects();
+  void object(std::uint16_t index, const ObjectSections& secs);
+  /// DataType, AccessType, PDOMapping, ObjFlags, values of one VAR or
+  /// sub-index section. `code` is the object's (a DOMAIN may leave out
+  /// DataType and AccessType).
+  bool variable(const RawSection& s, ObjectCode code, SubObject& v);
+  void value(const RawSection& s, std::string_view key, const SubObject& v, std::optional<Value>& out);
+  std::optional<Value> value_text(const RawSection& s, const RawKey& k, canopen::DataType t);
+  /// LowLimit <= HighLimit, and DefaultValue / ParameterValue within them.
+  void limits(const RawSection& s, const SubObject& v);
+  /// ARRAY with CompactSubObj=N: sub 0 (UNSIGNED8 ro = N) and subs 1..N of the
+  /// main section's type; names from [xxxxName], defaults from [xxxxValue].
+  void compact(Object& o, const ObjectSections& secs);
+  /// ARRAY/RECORD with SubNumber sub-index sections.
+  void subs(Object& o, const ObjectSections& secs, const RawKey* subnum_key);
+  bool failed_number(const RawKey& k) const;
+
+  Eds eds_;
+  std::vector<Diagnostic> errors_;
+  std::map<std::string, const RawSection*> by_name_;  // lower-case name -> first occurrence
+  std::map<std::uint16_t, Listed> listed_;
+};
+
+}  // namespace canmotion::eds
