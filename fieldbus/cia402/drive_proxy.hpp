@@ -303,6 +303,13 @@ struct Failure {
   /// non-RT thread.
   std::size_t describe(std::span<char> out) const noexcept;
   [[nodiscard]] std::string to_string() const;
+
+ private:
+  // describe()'s longer cases (drive_failure.cpp); snprintf's result.
+  int describe_sdo_abort(std::span<char> out, double waited_ms) const noexcept;
+  int describe_transition(std::span<char> out, double waited_ms, const char* emcy) const noexcept;
+  int describe_boot_check(std::span<char> out, double waited_ms) const noexcept;
+  int describe_nmt_state(std::span<char> out, const char* emcy) const noexcept;
 };
 
 /// Feedback from the TPDOs, in drive units (counts).
