@@ -56,6 +56,10 @@ struct NodeEvent {
   std::uint8_t sub = 0;
   std::uint32_t abort = 0;  ///< kObjectAbsent: the SDO abort code
   std::int32_t detail = 0;  ///< kObjectAbsent: 0x60C2:2, the drive's own index
+  /// kObjectAbsent: the fallback the master took, a static sentence (printf
+  /// format; may hold one %d: `detail`), or null (not written; the drive
+  /// keeps its own setting).
+  const char* note = nullptr;
 };
 
 /// What the master knows about one node.

@@ -1,7 +1,8 @@
 // The texts of the drive proxy's failures and notices (DESIGN.md: a failure
-// explains itself): Failure::describe, describe_notice and what a refused
-// boot write is for. snprintf into the caller's buffer: call them from a
-// non-RT thread (write_hint_key is realtime-safe).
+// explains itself): Failure::describe and describe_notice. What a refused
+// boot transfer is for, the fallback taken and a failed check's sentence
+// come from the boot plan (boot_plan.cpp, boot_checks.cpp). snprintf into
+// the caller's buffer: call them from a non-RT thread.
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
@@ -14,101 +15,12 @@
 
 namespace canmotion::cia402 {
 
-namespace {
-
-/// The sentence that follows a refused write in Failure::describe: where its
-/// value comes from (`key`, may be null) and what to do.
-int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key) noexcept {
-  const bool k = key != nullptr && key[0] != '\0';
-  switch (origin) {
-    case WriteOrigin::kMode:
-      return std::snprintf(out, size, "; canmotiond runs every drive in a cyclic synchronous mode (0x6060 = 8, 9 or 10): "
-                                      "the drive must accept it");
-    case WriteOrigin::kInterpolationPeriod:
-      return std::snprintf(out, size, "; 0x60C2 is the cycle period%s%s: the drive must accept it in cyclic synchronous modes",
-                           k ? ", " : "", k ? key : "");
-    case WriteOrigin::kPdo:
-      return std::snprintf(out, size, "; the PDO mapping comes from %s: the drive must accept it (see fieldbus/README.md, PDO mapping)",
-                           k ? key : "the drive's PDO profile");
-    case WriteOrigin::kUnusedPdo:
-      return std::snprintf(out, size, "; canmotiond writes the PDOs it does not use invalid (a drive without that PDO may "
-                                      "answer 0x06020000 or 0x06090011, which is accepted)");
-    case WriteOrigin::kProducerHeartbeat:
-      return std::snprintf(out, size, "; the drive's heartbeat period comes from %s", k ? key : "the drive configuration");
-    case WriteOrigin::kConsumerHeartbeat:
-      return k ? std::snprintf(out, size, "; to leave this write out (the drive then does not watch the master's heartbeat) set %s: 0", key)
-               : std::snprintf(out, size, "; set the drive's consumer_heartbeat_ms to 0 to leave this write out");
-    case WriteOrigin::kExtra:
-      return std::snprintf(out, size, "; the write comes from %s: correct or remove it", k ? key : "the extra configuration writes");
-    case WriteOrigin::kCheck:
-      return std::snprintf(out, size, "; canmotiond reads it at boot to check the drive (CiA 301 mandatory object)");
-    case WriteOrigin::kSyncPeriod:
-      return std::snprintf(out, size, "; canmotiond writes 0x1006 = 0 before 0x1019 (CiA 301 allows a 0x1019 change only "
-                                      "while 0x1006 is 0), and the SYNC period after it when %s is true (false leaves "
-                                      "that write out)",
-                           k ? key : "the drive's sync_watch");
-    case WriteOrigin::kSyncCounter:
-      return std::snprintf(out, size, "; 0x1019 must match the SYNC the master sends (a drive drops SYNCs of another "
-                                      "length, EMCY 8240h): it comes from %s",
-                           k ? key : "the master's SYNC counter overflow");
-  }
-  return 0;
-}
-
-/// The drive's EDS name of index:sub (`d`: its dictionary, may be null),
-/// else `standard` (CiA 301/402's). Realtime-safe.
-const char* eds_name_or(const canopen::DeviceDictionary* d, std::uint16_t index, std::uint8_t sub,
-                        const char* standard) noexcept {
-  const char* n = d != nullptr ? d->name(index, sub) : nullptr;
-  return n != nullptr ? n : standard;
-}
-}  // namespace
-
-const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept {
-  switch (w.origin) {
-    case WriteOrigin::kInterpolationPeriod: return &hints.interpolation_period;
-    case WriteOrigin::kPdo: return &hints.pdo;
-    case WriteOrigin::kProducerHeartbeat: return &hints.producer_heartbeat;
-    case WriteOrigin::kConsumerHeartbeat: return &hints.consumer_heartbeat;
-    case WriteOrigin::kExtra: return w.extra < hints.extra.size() ? &hints.extra[w.extra] : nullptr;
-    case WriteOrigin::kSyncPeriod: return &hints.sync_watch;
-    case WriteOrigin::kSyncCounter: return &hints.sync_counter;
-    case WriteOrigin::kMode:
-    case WriteOrigin::kUnusedPdo:
-    case WriteOrigin::kCheck: return nullptr;
-  }
-  return nullptr;
-}
-
 std::string describe_notice(const canopen::NodeEvent& e, const canopen::DeviceDictionary* dictionary) {
   const std::string_view name =
       dictionary != nullptr ? dictionary->name_or_standard(e.index, e.sub) : canopen::object_name(e.index, e.sub);
-  const char* fallback = "not written; the drive keeps its own setting";
-  char buf[160];
-  if (e.index == 0x1016) {
-    fallback = "the drive does not watch the master's heartbeat (a lost master is not detected by the drive)";
-  } else if (e.index == obj::kInterpolationTimePeriod && e.detail != 0) {
-    std::snprintf(buf, sizeof buf, "0x60C2:1 written in the drive's unit 10^%d s", static_cast<int>(e.detail));
-    fallback = buf;
-  } else if (e.index == obj::kInterpolationTimePeriod) {
-    fallback = "0x60C2:1 written with the master's value; the unit is the drive's own";
-  } else if (e.index == obj::kSupportedDriveModes) {
-    fallback = "the modes the configuration needs are not checked";
-  } else if (e.index == obj::kModesOfOperationDisplay) {
-    fallback = "the mode written to 0x6060 is taken as the one the drive runs";
-  } else if (e.index == obj::kSlatConfiguration || e.index == obj::kSlatSetPoint || e.index == obj::kSlatTimeDelay) {
-    fallback = "the drive has no SLAT: MDS runs without it (direct_control.slat is not set)";
-  } else if (e.index == obj::kCommunicationCyclePeriod) {
-    fallback = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly)
-                   ? "the drive keeps its own SYNC watch period"
-                   : "the drive has no SYNC watch period (0x1006) to set";
-  } else if (e.index == obj::kSyncCounterOverflow &&
-             canopen::object_absent(static_cast<canopen::SdoAbort>(e.abort))) {
-    fallback = "the drive has no SYNC counter setting: it must take the master's SYNC as it is (buses[].sync_counter_overflow)";
-  } else if (e.index == obj::kSyncCounterOverflow) {
-    std::snprintf(buf, sizeof buf, "it already holds %d, the master's SYNC counter overflow value", static_cast<int>(e.detail));
-    fallback = buf;
-  }
+  // The fallback the proxy took, from the boot plan's row (BootNotes).
+  char fallback[160] = "not written; the drive keeps its own setting";
+  if (e.note != nullptr) std::snprintf(fallback, sizeof fallback, e.note, static_cast<int>(e.detail));
   char out[512];
   if (e.abort == 0) {  // no transfer: the drive's EDS has it read-only (DriveProxy leaves the write out)
     std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) read-only in the drive's EDS (not written): %s",
@@ -133,8 +45,12 @@ int Failure::describe_sdo_abort(std::span<char> out, double waited_ms) const noe
                                     : canopen::object_name(sdo_index, sdo_sub);
   if (name.empty()) name = "an object canmotion does not know";
   const auto text = canopen::sdo_abort_text(sdo_abort);
+  // What the refused transfer is for and what to do: its boot plan row's sentence.
   char why[320] = "";
-  write_hint(why, sizeof why, sdo_origin, hint);
+  if (boot_row != nullptr) {
+    const bool k = hint != nullptr && hint[0] != '\0';
+    std::snprintf(why, sizeof why, k ? boot_row->hint.with_key : boot_row->hint.without_key, hint);
+  }
   return std::snprintf(out.data(), out.size(),
                        "node %u: configuration %s 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms: %s%s",
                        node, sdo_origin == WriteOrigin::kCheck ? "read of" : "write to", sdo_index, sdo_sub, static_cast<int>(name.size()), name.data(), sdo_abort,
@@ -160,89 +76,6 @@ int Failure::describe_transition(std::span<char> out, double waited_ms, const ch
                            ? "; the drive is under local control (statusword bit 9 remote = 0: it does not process "
                              "the controlword): switch it to bus/remote control on the drive"
                            : "");
-}
-
-int Failure::describe_boot_check(std::span<char> out, double waited_ms) const noexcept {
-  int n = 0;
-  const bool k = hint != nullptr && hint[0] != '\0';
-  switch (check) {
-    case BootCheck::kDeviceType:
-      n = k ? std::snprintf(out.data(), out.size(), "node %u: 0x1000 (%s) is 0x%08" PRIX32 ", %s expects 0x%08" PRIX32,
-                            node, eds_name_or(dictionary, 0x1000, 0, "Device type"), read_value, hint, expected)
-            : std::snprintf(out.data(), out.size(),
-                            "node %u: 0x1000 (%s) is 0x%08" PRIX32 ": device profile %" PRIu32
-                            ", not 402 (CiA 402 drive); canmotiond drives CiA 402 drives only",
-                            node, eds_name_or(dictionary, 0x1000, 0, "Device type"), read_value,
-                            read_value & 0xFFFFu);
-      break;
-    case BootCheck::kVendorId:
-    case BootCheck::kProductCode:
-    case BootCheck::kRevision: {
-      const std::uint8_t si = check == BootCheck::kVendorId ? 1 : check == BootCheck::kProductCode ? 2 : 3;
-      const char* what = eds_name_or(dictionary, obj::kIdentity, si,
-                                     si == 1 ? "Vendor-ID" : si == 2 ? "Product code" : "Revision number");
-      const char* sub = check == BootCheck::kVendorId ? "vendor_id" : check == BootCheck::kProductCode ? "product_code" : "revision";
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: identity 0x1018:%u (%s) is 0x%08" PRIX32 ", the configuration expects 0x%08" PRIX32
-                        " (%s%s%s): another drive than configured is on this node",
-                        node, si, what, read_value, expected, k ? hint : "drive.identity", ".", sub);
-      break;
-    }
-    case BootCheck::kSupportedModes: {
-      const auto mn = mode_name(static_cast<std::int8_t>(expected));
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: the drive does not support mode %d (%.*s): 0x6502 (%s) is 0x%08" PRIX32
-                        "; the mode is needed by %s",
-                        node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(mn.size()), mn.data(),
-                        eds_name_or(dictionary, obj::kSupportedDriveModes, 0, "Supported drive modes"), read_value,
-                        k ? hint : "the drive's configured mode");
-      break;
-    }
-    case BootCheck::kModeDisplay: {
-      const auto rq = mode_name(static_cast<std::int8_t>(expected));
-      const auto sh = mode_name(static_cast<std::int8_t>(read_value));
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: 0x6060 = %d (%.*s) written, but 0x6061 (%s) still shows %d (%.*s) "
-                        "after %.1f ms (%s): the drive does not run the mode it accepted",
-                        node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(rq.size()), rq.data(),
-                        eds_name_or(dictionary, obj::kModesOfOperationDisplay, 0, "Modes of operation display"),
-                        static_cast<int>(static_cast<std::int8_t>(read_value)), static_cast<int>(sh.size()), sh.data(),
-                        waited_ms, k ? hint : "mode switch timeout");
-      break;
-    }
-    case BootCheck::kInterpolationIndex: {
-      const auto idx = static_cast<int>(static_cast<std::int8_t>(read_value & 0xFFu));
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: 0x60C2:2 (%s) is read-only at %d (periods in units of "
-                        "10^%d s) and the cycle period %.6g ms (%s) is not a whole number 1..255 of that unit: "
-                        "choose a period the drive can take",
-                        node, eds_name_or(dictionary, obj::kInterpolationTimePeriod, 2, "Interpolation time index"), idx, idx, static_cast<double>(expected) / 1e6, k ? hint : "the cycle period");
-      break;
-    }
-    case BootCheck::kSyncCounter: {
-      const auto text = canopen::sdo_abort_text(sdo_abort);
-      char why[160];
-      if (expected == 0)
-        std::snprintf(why, sizeof why, "the drive expects SYNCs with a counter (up to %" PRIu32
-                      ") and would drop every SYNC of the master, which has none (EMCY 8240h)", read_value);
-      else if (read_value == 0)
-        std::snprintf(why, sizeof why, "the drive takes SYNCs without a counter and would drop every SYNC of the "
-                      "master, which carries one (EMCY 8240h)");
-      else
-        std::snprintf(why, sizeof why, "the drive counts SYNCs up to %" PRIu32 ", the master up to %" PRIu32,
-                      read_value, expected);
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: 0x1019:0 (%s) refused the write of %" PRIu32
-                        " (SDO abort 0x%08" PRIX32 " %.*s) and holds %" PRIu32 ": %s; set %s: %" PRIu32
-                        ", or give the drive's 0x1019 the value %" PRIu32,
-                        node, eds_name_or(dictionary, obj::kSyncCounterOverflow, 0, "Synchronous counter overflow value"),
-                        expected, sdo_abort, static_cast<int>(text.size()), text.data(), read_value, why,
-                        k ? hint : "the master's SYNC counter overflow", read_value, expected);
-      break;
-    }
-    case BootCheck::kNone: n = std::snprintf(out.data(), out.size(), "node %u: boot check failed", node); break;
-  }
-  return n;
 }
 
 int Failure::describe_nmt_state(std::span<char> out, const char* emcy) const noexcept {
@@ -322,7 +155,7 @@ std::size_t Failure::describe(std::span<char> out) const noexcept {
                         "configured again)%s",
                         node, static_cast<int>(phase_name(phase).size()), phase_name(phase).data(), emcy);
       break;
-    case FailureKind::kBootCheck: n = describe_boot_check(out, waited_ms); break;
+    case FailureKind::kBootCheck: n = boot_check_rule(check).describe(*this, out, waited_ms); break;
     case FailureKind::kNmtState: n = describe_nmt_state(out, emcy); break;
   }
   if (n < 0) {

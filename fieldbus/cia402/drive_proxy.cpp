@@ -303,6 +303,52 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   return true;
 }
 
+// The drive is in the state the proxy steers to: the controlword that keeps
+// it there (in Operation enabled, with the homing start bit when a homing
+// runs). From step_state_machine() only: inlined there.
+[[gnu::always_inline]] inline void DriveProxy::hold_state(State target) noexcept {
+  in_flight_ = false;
+  reset_requested_ = false;
+  switch (target) {
+    case State::kOperationEnabled:
+      cw_ = cia402::controlword(Command::kEnableOperation);
+      if (homing_step_ == HomingStep::kWaitMode && mode_ == Mode::kHoming && !mode_switch_pending_ &&
+          fb_.mode_display == static_cast<std::int8_t>(Mode::kHoming)) {
+        // Bit 4 went out clear in the last RPDO (it is clear in every
+        // other step): this one is the rising edge.
+        homing_step_ = HomingStep::kStarted;
+        homing_sync_ = homing_fresh_ = false;
+      }
+      if (homing_step_ == HomingStep::kStarted) cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
+      break;
+    case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
+    case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
+    case State::kQuickStopActive: cw_ = cia402::controlword(Command::kQuickStop); break;
+    default: cw_ = cia402::controlword(Command::kDisableVoltage); break;
+  }
+}
+
+// Transition 15: the drive acts on the rising edge of bit 7. In Fault the
+// proxy sends it clear, so the reset goes out in this cycle's RPDO; only
+// when the last controlword had it set does one cycle without it come
+// first. A drive refuses the reset while the cause remains: every
+// fault_reset_repeat_ns one RPDO with bit 7 clear, then a new edge, until it
+// leaves Fault or the transition times out. From step_state_machine() only:
+// inlined there.
+[[gnu::always_inline]] inline void DriveProxy::send_fault_reset(std::int64_t now_ns) noexcept {
+  const bool set = (cw_ & cw::kFaultReset) != 0;
+  if (set && (flight_cycles_ == 0 ||
+              (cfg_.fault_reset_repeat_ns > 0 && now_ns - reset_edge_ns_ >= cfg_.fault_reset_repeat_ns))) {
+    cw_ = 0;
+  } else {
+    if (!set) {
+      reset_edge_ns_ = now_ns;
+      ++reset_edges_;
+    }
+    cw_ = cia402::controlword(Command::kFaultReset);
+  }
+}
+
 // Called once per drive per cycle from step() only: inlined there.
 [[gnu::always_inline]] inline void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
   state_ = decode_state(fb_.statusword);
@@ -329,25 +375,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   // transition times out), then the enable climbs from where it is.
   const State target = leaving_enabled() && wanted_ == State::kOperationEnabled ? leave_.expect : wanted_;
   if (state_ == target) {
-    in_flight_ = false;
-    reset_requested_ = false;
-    switch (target) {
-      case State::kOperationEnabled:
-        cw_ = cia402::controlword(Command::kEnableOperation);
-        if (homing_step_ == HomingStep::kWaitMode && mode_ == Mode::kHoming && !mode_switch_pending_ &&
-            fb_.mode_display == static_cast<std::int8_t>(Mode::kHoming)) {
-          // Bit 4 went out clear in the last RPDO (it is clear in every
-          // other step): this one is the rising edge.
-          homing_step_ = HomingStep::kStarted;
-          homing_sync_ = homing_fresh_ = false;
-        }
-        if (homing_step_ == HomingStep::kStarted) cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
-        break;
-      case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
-      case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
-      case State::kQuickStopActive: cw_ = cia402::controlword(Command::kQuickStop); break;
-      default: cw_ = cia402::controlword(Command::kDisableVoltage); break;
-    }
+    hold_state(target);
     return;
   }
   const auto plan = next_step(state_, target);
@@ -389,23 +417,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   }
   if (plan) {
     if (plan->command == Command::kFaultReset) {
-      // The drive acts on the rising edge of bit 7. In Fault the proxy sends
-      // it clear, so the reset goes out in this cycle's RPDO; only when the
-      // last controlword had it set does one cycle without it come first. A
-      // drive refuses the reset while the cause remains: every
-      // fault_reset_repeat_ns one RPDO with bit 7 clear, then a new edge,
-      // until it leaves Fault or the transition times out.
-      const bool set = (cw_ & cw::kFaultReset) != 0;
-      if (set && (flight_cycles_ == 0 ||
-                  (cfg_.fault_reset_repeat_ns > 0 && now_ns - reset_edge_ns_ >= cfg_.fault_reset_repeat_ns))) {
-        cw_ = 0;
-      } else {
-        if (!set) {
-          reset_edge_ns_ = now_ns;
-          ++reset_edges_;
-        }
-        cw_ = cia402::controlword(Command::kFaultReset);
-      }
+      send_fault_reset(now_ns);
     } else {
       cw_ = cia402::controlword(plan->command);
     }
