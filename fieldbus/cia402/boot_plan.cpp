@@ -1,8 +1,7 @@
 // The drive boot as data (boot_plan.hpp): kBootPlan, one row per object the
 // master writes or reads at boot, and its expansion into one drive's SDO
-// transfers. The plan is the one data table of this folder exempt from the
-// size limits (fieldbus/README.md). Set-up time, apart from boot_plan(),
-// write_hint_key() and boot_note().
+// transfers. Set-up time, apart from boot_plan(), write_hint_key() and
+// boot_note() (realtime-safe).
 #include "fieldbus/cia402/boot_plan.hpp"
 
 #include <array>
