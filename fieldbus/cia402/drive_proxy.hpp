@@ -412,8 +412,6 @@ class DriveProxy {
   void step_state_machine(std::int64_t now_ns) noexcept;
   void hold_state(State target) noexcept;            // step_state_machine(): the controlword in the wanted state
   void send_fault_reset(std::int64_t now_ns) noexcept;  // step_state_machine(): transition 15's bit 7 edge
-  void hold_state(State target) noexcept;            // step_state_machine(): the controlword in the wanted state
-  void send_fault_reset(std::int64_t now_ns) noexcept;  // step_state_machine(): transition 15's bit 7 edge
   void send_rpdos(canopen::FrameSink& out) noexcept;
   void follow_actual() noexcept;
   void set_wanted(State s) noexcept;
