@@ -6,6 +6,7 @@
 
 #include <array>
 #include <iterator>
+#include <string_view>
 
 #include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/cia402/drive_proxy.hpp"
@@ -207,11 +208,21 @@ constexpr ObjectNote kExtraNotes[] = {
     {obj::kSlatTimeDelay, kNoSlat},
 };
 
+/// A note's number (NodeEvent::note) holds the row and which of its notes.
+constexpr std::size_t kFallbacks = 3;
+static_assert(std::size(kBootPlan) * kFallbacks < 256, "NodeEvent::note numbers every row's notes in 8 bits");
+
 /// The rules of the plan, checked at compile time.
 constexpr bool plan_is_consistent() {
   const auto n = static_cast<std::ptrdiff_t>(std::size(kBootPlan));
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     const BootRow& r = kBootPlan[i];
+    // The rows of one origin share its hint (Failure::describe finds it by origin).
+    for (std::ptrdiff_t j = 0; j < i; ++j)
+      if (kBootPlan[j].origin == r.origin &&
+          (std::string_view(kBootPlan[j].hint.with_key) != r.hint.with_key ||
+           std::string_view(kBootPlan[j].hint.without_key) != r.hint.without_key))
+        return false;
     const bool fails_as_trigger = r.on_abort.absent == Then::kFailAsTrigger || r.on_abort.read_only == Then::kFailAsTrigger ||
                                   r.on_abort.other == Then::kFailAsTrigger || r.on_abort.timeout == Then::kFailAsTrigger;
     if (r.falls_back_from == 0) {
@@ -230,7 +241,8 @@ constexpr bool plan_is_consistent() {
   }
   return kBootPlan[n - 1].expand == nullptr;
 }
-static_assert(plan_is_consistent(), "kBootPlan: a fallback names an earlier one-object row that falls back");
+static_assert(plan_is_consistent(),
+              "kBootPlan: a fallback names an earlier one-object row that falls back; rows of one origin share a hint");
 
 /// The transfers of one row (several for an expanded row).
 void transfers_of(const BootRow& row, const BootInputs& in, std::vector<SdoWrite>& out) {
@@ -314,19 +326,35 @@ const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) n
   return nullptr;
 }
 
-const char* boot_note(const BootWrite& w, Fallback f) noexcept {
-  if (w.row == nullptr) return nullptr;
-  switch (f) {
+std::uint8_t boot_note_id(const BootWrite& w, Fallback f) noexcept {
+  if (w.row == nullptr) return 0;
+  const auto row = static_cast<std::size_t>(w.row - kBootPlan);  // its place in the plan
+  return static_cast<std::uint8_t>(1 + row * kFallbacks + static_cast<std::size_t>(f));
+}
+
+const char* boot_note_text(std::uint8_t id, std::uint16_t index) noexcept {
+  if (id == 0 || id > std::size(kBootPlan) * kFallbacks) return nullptr;
+  const BootRow& row = kBootPlan[(id - 1u) / kFallbacks];
+  switch (static_cast<Fallback>((id - 1u) % kFallbacks)) {
     case Fallback::kAbsent:
-      if (w.row->notes.absent != nullptr) return w.row->notes.absent;
-      if (w.origin == WriteOrigin::kExtra)
+      if (row.notes.absent != nullptr) return row.notes.absent;
+      if (row.origin == WriteOrigin::kExtra)
         for (const ObjectNote& n : kExtraNotes)
-          if (n.index == w.w.index) return n.absent;
+          if (n.index == index) return n.absent;
       return nullptr;
-    case Fallback::kReadOnly: return w.row->notes.read_only;
-    case Fallback::kHeld: return w.row->notes.held;
+    case Fallback::kReadOnly: return row.notes.read_only;
+    case Fallback::kHeld: return row.notes.held;
   }
   return nullptr;
+}
+
+const char* boot_note(const BootWrite& w, Fallback f) noexcept { return boot_note_text(boot_note_id(w, f), w.w.index); }
+
+const BootHint& boot_hint(WriteOrigin origin) noexcept {
+  for (const BootRow& r : kBootPlan)
+    if (r.origin == origin) return r.hint;
+  static constexpr BootHint kNone{};
+  return kNone;
 }
 
 }  // namespace canmotion::cia402

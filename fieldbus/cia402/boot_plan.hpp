@@ -234,10 +234,21 @@ struct BootWrite {
 /// when none is named (0x6060, unused PDOs, the checking reads). Realtime-safe.
 [[nodiscard]] const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept;
 
-/// The note for a fallback of `w` (BootNotes; for an extra write the one of
-/// its object, e.g. SLAT), or nullptr. Realtime-safe.
+/// Which of a row's BootNotes.
 enum class Fallback : std::uint8_t { kAbsent, kReadOnly, kHeld };
+/// The number of fallback `f` of `w` (its row and `f`; NodeEvent::note), 1..
+/// Realtime-safe.
+[[nodiscard]] std::uint8_t boot_note_id(const BootWrite& w, Fallback f) noexcept;
+/// The note numbered `id` (boot_note_id) for object `index`: the row's
+/// BootNotes, for an extra write the one of its object (e.g. SLAT), or
+/// nullptr (none: "not written; the drive keeps its own setting").
+/// Realtime-safe.
+[[nodiscard]] const char* boot_note_text(std::uint8_t id, std::uint16_t index) noexcept;
+/// boot_note_text(boot_note_id(w, f), w.w.index). Realtime-safe.
 [[nodiscard]] const char* boot_note(const BootWrite& w, Fallback f) noexcept;
+/// The sentence after a refused transfer of `origin` (the rows of one origin
+/// share it: plan_is_consistent). Realtime-safe.
+[[nodiscard]] const BootHint& boot_hint(WriteOrigin origin) noexcept;
 
 // ---- checks ------------------------------------------------------------------
 /// What a check sees of a value read at boot.

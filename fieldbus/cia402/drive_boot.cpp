@@ -35,7 +35,7 @@ void DriveProxy::notice(std::size_t write, std::uint32_t abort, Fallback what, s
   e.sub = writes_[write].w.sub;
   e.abort = abort;
   e.detail = detail;
-  e.note = boot_note(writes_[write], what);
+  e.note = boot_note_id(writes_[write], what);
 }
 
 bool DriveProxy::poll_notice(canopen::NodeEvent& out) noexcept {
@@ -139,7 +139,6 @@ void DriveProxy::fail_transfer(std::size_t i, const canopen::SdoResult& r, bool 
   }
   const BootWrite& bw = writes_[named];
   failure_.sdo_origin = bw.origin;
-  failure_.boot_row = bw.row;
   const std::string* key = write_hint_key(cfg_.hints, bw);
   failure_.hint = key != nullptr && !key->empty() ? key->c_str() : nullptr;
 }

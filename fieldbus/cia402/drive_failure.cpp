@@ -20,7 +20,8 @@ std::string describe_notice(const canopen::NodeEvent& e, const canopen::DeviceDi
       dictionary != nullptr ? dictionary->name_or_standard(e.index, e.sub) : canopen::object_name(e.index, e.sub);
   // The fallback the proxy took, from the boot plan's row (BootNotes).
   char fallback[160] = "not written; the drive keeps its own setting";
-  if (e.note != nullptr) std::snprintf(fallback, sizeof fallback, e.note, static_cast<int>(e.detail));
+  if (const char* note = boot_note_text(e.note, e.index); note != nullptr)
+    std::snprintf(fallback, sizeof fallback, note, static_cast<int>(e.detail));
   char out[512];
   if (e.abort == 0) {  // no transfer: the drive's EDS has it read-only (DriveProxy leaves the write out)
     std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) read-only in the drive's EDS (not written): %s",
@@ -45,12 +46,11 @@ int Failure::describe_sdo_abort(std::span<char> out, double waited_ms) const noe
                                     : canopen::object_name(sdo_index, sdo_sub);
   if (name.empty()) name = "an object canmotion does not know";
   const auto text = canopen::sdo_abort_text(sdo_abort);
-  // What the refused transfer is for and what to do: its boot plan row's sentence.
-  char why[320] = "";
-  if (boot_row != nullptr) {
-    const bool k = hint != nullptr && hint[0] != '\0';
-    std::snprintf(why, sizeof why, k ? boot_row->hint.with_key : boot_row->hint.without_key, hint);
-  }
+  // What the refused transfer is for and what to do: its boot plan rows' sentence.
+  char why[320];
+  const BootHint& h = boot_hint(sdo_origin);
+  const bool k = hint != nullptr && hint[0] != '\0';
+  std::snprintf(why, sizeof why, k ? h.with_key : h.without_key, hint);
   return std::snprintf(out.data(), out.size(),
                        "node %u: configuration %s 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms: %s%s",
                        node, sdo_origin == WriteOrigin::kCheck ? "read of" : "write to", sdo_index, sdo_sub, static_cast<int>(name.size()), name.data(), sdo_abort,

@@ -193,10 +193,9 @@ struct Failure {
   std::int64_t t_ns = 0;                    ///< when it was detected
   std::int8_t mode_requested = 0;           ///< kModeSwitchTimeout: 0x6060 written
   std::int8_t mode_shown = 0;               ///< kModeSwitchTimeout: 0x6061 still shown
-  WriteOrigin sdo_origin = WriteOrigin::kMode;  ///< kSdoAbort: what the write was for
-  /// kSdoAbort: the boot plan's row of the refused transfer (static; null:
-  /// no hint sentence).
-  const BootRow* boot_row = nullptr;
+  /// kSdoAbort: what the write was for; describe() says so with its boot
+  /// plan rows' sentence (boot_hint()).
+  WriteOrigin sdo_origin = WriteOrigin::kMode;
   /// kSdoAbort: the configuration key the write comes from (WriteHints), or
   /// nullptr. Points into the DriveProxy's configuration: valid while it lives.
   const char* hint = nullptr;
