@@ -75,6 +75,12 @@ void pdo_procedure(const canopen::PdoMap& m, std::vector<SdoWrite>& out) {
   out.push_back({m.comm_index(), 1, 4, cob});
 }
 
+/// The PDOs the master uses (RPDOs with `rx`, else TPDOs): their procedures.
+void used_pdos(bool rx, const BootInputs& b, std::vector<SdoWrite>& out) {
+  const std::uint8_t used = rx ? b.pdos.rpdo_count : b.pdos.tpdo_count;
+  for (std::uint8_t n = 0; n < used; ++n) pdo_procedure(rx ? b.pdos.rpdo[n] : b.pdos.tpdo[n], out);
+}
+
 /// The PDOs 1..4 a drive may have and the master does not use: COB-ID invalid.
 void unused_pdos(bool rx, const BootInputs& b, std::vector<SdoWrite>& out) {
   const std::uint8_t used = rx ? b.pdos.rpdo_count : b.pdos.tpdo_count;
@@ -156,17 +162,13 @@ constexpr BootRow kBootPlan[] = {
     // PDOs: the CiA 301 procedure for the used ones, COB-ID invalid for the
     // others of 1..4 (a drive without that PDO is fine).
     {.origin = WriteOrigin::kPdo,
-     .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) {
-       for (std::uint8_t n = 0; n < b.pdos.rpdo_count; ++n) pdo_procedure(b.pdos.rpdo[n], out);
-     },
+     .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) { used_pdos(true, b, out); },
      .key = &WriteHints::pdo, .hint = kPdoHint},
     {.origin = WriteOrigin::kUnusedPdo, .need = Need::kOptional, .on_abort = kAbsentQuiet,
      .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) { unused_pdos(true, b, out); },
      .hint = kUnusedPdoHint},
     {.origin = WriteOrigin::kPdo,
-     .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) {
-       for (std::uint8_t n = 0; n < b.pdos.tpdo_count; ++n) pdo_procedure(b.pdos.tpdo[n], out);
-     },
+     .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) { used_pdos(false, b, out); },
      .key = &WriteHints::pdo, .hint = kPdoHint},
     {.origin = WriteOrigin::kUnusedPdo, .need = Need::kOptional, .on_abort = kAbsentQuiet,
      .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) { unused_pdos(false, b, out); },

@@ -7,7 +7,6 @@
 // build_configuration(), realtime-safe.
 #include <string>
 
-#include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 #include "fieldbus/cia402/drive_proxy.hpp"
 

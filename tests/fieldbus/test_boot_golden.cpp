@@ -23,6 +23,7 @@
 #include "fieldbus/canopen/device_dictionary.hpp"
 #include "fieldbus/cia402/drive_proxy.hpp"
 #include "fieldbus/emulator/sim_rig.hpp"
+#include "test_support.hpp"
 
 #ifndef CANMOTION_BOOT_GOLDEN_MAIN
 #include <gtest/gtest.h>
@@ -55,13 +56,6 @@ std::uint64_t fnv1a(const std::string& s) {
     h *= 0x100000001b3ull;
   }
   return h;
-}
-
-std::string hex(const can::Frame& f) {
-  char s[48];
-  int n = std::snprintf(s, sizeof s, "%03X#", f.id);
-  for (std::size_t i = 0; i < f.len; ++i) n += std::snprintf(s + n, sizeof s - static_cast<std::size_t>(n), "%02X", f.data[i]);
-  return s;
 }
 
 /// One drive (node 2) whose configuration names every key.
@@ -97,7 +91,7 @@ std::string record(const SimRigConfig& c, const std::function<void(SimRig&)>& af
   auto frames = [&] {
     for (std::size_t k; (k = spy.receive(buf)) > 0;)
       for (std::size_t j = 0; j < k; ++j)
-        out.f("%llu %s\n", static_cast<unsigned long long>(rig.cycles()), hex(buf[j].frame).c_str());
+        out.f("%llu %s\n", static_cast<unsigned long long>(rig.cycles()), fbtest::hex(buf[j].frame).c_str());
   };
   auto events = [&] {
     canopen::NodeEvent e;
