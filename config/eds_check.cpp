@@ -28,7 +28,7 @@ std::vector<cia402::BootWrite> proxy_writes(const cia402::DriveConfig& d, const 
 
 /// The boot's write of the master's interpolation time index (0x60C2:2).
 bool is_ip_index_write(const cia402::BootWrite& w) {
-  return w.w.index == cia402::obj::kInterpolationTimePeriod && w.w.sub == 2 && !w.is_read() && !w.ip_fallback;
+  return w.w.index == cia402::obj::kInterpolationTimePeriod && w.w.sub == 2 && !w.is_read() && !w.is_fallback();
 }
 
 /// The EDS has 0x60C2:2 and it is writable.

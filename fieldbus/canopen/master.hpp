@@ -54,6 +54,10 @@ struct NodeEvent {
   std::int64_t t_ns = 0;
   std::uint16_t index = 0;  ///< kObjectAbsent: the object
   std::uint8_t sub = 0;
+  /// kObjectAbsent: the fallback the master took, as its maker numbers it
+  /// (cia402::boot_note_id: the boot plan's row and fallback, worded by
+  /// cia402::describe_notice); 0: none.
+  std::uint8_t note = 0;
   std::uint32_t abort = 0;  ///< kObjectAbsent: the SDO abort code
   std::int32_t detail = 0;  ///< kObjectAbsent: 0x60C2:2, the drive's own index
 };

@@ -1,337 +1,19 @@
+// The DriveProxy once its node is up (drive_proxy.hpp): set-up, TPDOs in,
+// node events, the CiA 402 state machine through its numbered transitions,
+// mode switches, homing, the fault's error code and the RPDOs out. The boot
+// is drive_boot.cpp (the plan: boot_plan.cpp), the failure texts
+// drive_failure.cpp, DriveNetwork drive_network.cpp. Apart from the
+// constructor, realtime-safe.
 #include "fieldbus/cia402/drive_proxy.hpp"
 
-#include <array>
-#include <cinttypes>
-#include <cstdio>
 #include <stdexcept>
+#include <string>
 
-#include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/emcy.hpp"
-#include "fieldbus/canopen/object_names.hpp"
-#include "fieldbus/canopen/receive_filters.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 
 namespace canmotion::cia402 {
 
-namespace {
-
-/// The sentence that follows a refused write in Failure::describe: where its
-/// value comes from (`key`, may be null) and what to do.
-int write_hint(char* out, std::size_t size, WriteOrigin origin, const char* key) noexcept {
-  const bool k = key != nullptr && key[0] != '\0';
-  switch (origin) {
-    case WriteOrigin::kMode:
-      return std::snprintf(out, size, "; canmotiond runs every drive in a cyclic synchronous mode (0x6060 = 8, 9 or 10): "
-                                      "the drive must accept it");
-    case WriteOrigin::kInterpolationPeriod:
-      return std::snprintf(out, size, "; 0x60C2 is the cycle period%s%s: the drive must accept it in cyclic synchronous modes",
-                           k ? ", " : "", k ? key : "");
-    case WriteOrigin::kPdo:
-      return std::snprintf(out, size, "; the PDO mapping comes from %s: the drive must accept it (see fieldbus/README.md, PDO mapping)",
-                           k ? key : "the drive's PDO profile");
-    case WriteOrigin::kUnusedPdo:
-      return std::snprintf(out, size, "; canmotiond writes the PDOs it does not use invalid (a drive without that PDO may "
-                                      "answer 0x06020000 or 0x06090011, which is accepted)");
-    case WriteOrigin::kProducerHeartbeat:
-      return std::snprintf(out, size, "; the drive's heartbeat period comes from %s", k ? key : "the drive configuration");
-    case WriteOrigin::kConsumerHeartbeat:
-      return k ? std::snprintf(out, size, "; to leave this write out (the drive then does not watch the master's heartbeat) set %s: 0", key)
-               : std::snprintf(out, size, "; set the drive's consumer_heartbeat_ms to 0 to leave this write out");
-    case WriteOrigin::kExtra:
-      return std::snprintf(out, size, "; the write comes from %s: correct or remove it", k ? key : "the extra configuration writes");
-    case WriteOrigin::kCheck:
-      return std::snprintf(out, size, "; canmotiond reads it at boot to check the drive (CiA 301 mandatory object)");
-    case WriteOrigin::kSyncPeriod:
-      return std::snprintf(out, size, "; canmotiond writes 0x1006 = 0 before 0x1019 (CiA 301 allows a 0x1019 change only "
-                                      "while 0x1006 is 0), and the SYNC period after it when %s is true (false leaves "
-                                      "that write out)",
-                           k ? key : "the drive's sync_watch");
-    case WriteOrigin::kSyncCounter:
-      return std::snprintf(out, size, "; 0x1019 must match the SYNC the master sends (a drive drops SYNCs of another "
-                                      "length, EMCY 8240h): it comes from %s",
-                           k ? key : "the master's SYNC counter overflow");
-  }
-  return 0;
-}
-
-/// The drive's EDS name of index:sub (`d`: its dictionary, may be null),
-/// else `standard` (CiA 301/402's). Realtime-safe.
-const char* eds_name_or(const canopen::DeviceDictionary* d, std::uint16_t index, std::uint8_t sub,
-                        const char* standard) noexcept {
-  const char* n = d != nullptr ? d->name(index, sub) : nullptr;
-  return n != nullptr ? n : standard;
-}
-}  // namespace
-
-const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept {
-  switch (w.origin) {
-    case WriteOrigin::kInterpolationPeriod: return &hints.interpolation_period;
-    case WriteOrigin::kPdo: return &hints.pdo;
-    case WriteOrigin::kProducerHeartbeat: return &hints.producer_heartbeat;
-    case WriteOrigin::kConsumerHeartbeat: return &hints.consumer_heartbeat;
-    case WriteOrigin::kExtra: return w.extra < hints.extra.size() ? &hints.extra[w.extra] : nullptr;
-    case WriteOrigin::kSyncPeriod: return &hints.sync_watch;
-    case WriteOrigin::kSyncCounter: return &hints.sync_counter;
-    case WriteOrigin::kMode:
-    case WriteOrigin::kUnusedPdo:
-    case WriteOrigin::kCheck: return nullptr;
-  }
-  return nullptr;
-}
-
-std::string describe_notice(const canopen::NodeEvent& e, const canopen::DeviceDictionary* dictionary) {
-  const std::string_view name =
-      dictionary != nullptr ? dictionary->name_or_standard(e.index, e.sub) : canopen::object_name(e.index, e.sub);
-  const char* fallback = "not written; the drive keeps its own setting";
-  char buf[160];
-  if (e.index == 0x1016) {
-    fallback = "the drive does not watch the master's heartbeat (a lost master is not detected by the drive)";
-  } else if (e.index == obj::kInterpolationTimePeriod && e.detail != 0) {
-    std::snprintf(buf, sizeof buf, "0x60C2:1 written in the drive's unit 10^%d s", static_cast<int>(e.detail));
-    fallback = buf;
-  } else if (e.index == obj::kInterpolationTimePeriod) {
-    fallback = "0x60C2:1 written with the master's value; the unit is the drive's own";
-  } else if (e.index == obj::kSupportedDriveModes) {
-    fallback = "the modes the configuration needs are not checked";
-  } else if (e.index == obj::kModesOfOperationDisplay) {
-    fallback = "the mode written to 0x6060 is taken as the one the drive runs";
-  } else if (e.index == obj::kSlatConfiguration || e.index == obj::kSlatSetPoint || e.index == obj::kSlatTimeDelay) {
-    fallback = "the drive has no SLAT: MDS runs without it (direct_control.slat is not set)";
-  } else if (e.index == obj::kCommunicationCyclePeriod) {
-    fallback = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly)
-                   ? "the drive keeps its own SYNC watch period"
-                   : "the drive has no SYNC watch period (0x1006) to set";
-  } else if (e.index == obj::kSyncCounterOverflow &&
-             canopen::object_absent(static_cast<canopen::SdoAbort>(e.abort))) {
-    fallback = "the drive has no SYNC counter setting: it must take the master's SYNC as it is (buses[].sync_counter_overflow)";
-  } else if (e.index == obj::kSyncCounterOverflow) {
-    std::snprintf(buf, sizeof buf, "it already holds %d, the master's SYNC counter overflow value", static_cast<int>(e.detail));
-    fallback = buf;
-  }
-  char out[512];
-  if (e.abort == 0) {  // no transfer: the drive's EDS has it read-only (DriveProxy leaves the write out)
-    std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) read-only in the drive's EDS (not written): %s",
-                  e.node, e.index, e.sub, static_cast<int>(name.size()), name.data(), fallback);
-    return out;
-  }
-  const char* what = e.abort == static_cast<std::uint32_t>(canopen::SdoAbort::kReadOnly) ? "read-only"
-                     : canopen::object_absent(static_cast<canopen::SdoAbort>(e.abort)) || e.abort == 0 ? "absent"
-                                                                                                       : "refused";
-  std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) %s (SDO abort 0x%08" PRIX32 " %.*s): %s",
-                e.node, e.index, e.sub, static_cast<int>(name.size()), name.data(), what, e.abort,
-                static_cast<int>(canopen::sdo_abort_text(e.abort).size()), canopen::sdo_abort_text(e.abort).data(),
-                fallback);
-  return out;
-}
-
-// ============================================================================
-// Failure
-// ============================================================================
-std::size_t Failure::describe(std::span<char> out) const noexcept {
-  if (out.empty()) return 0;
-  char emcy[96] = "";
-  if (has_emcy) {
-    std::snprintf(emcy, sizeof emcy, ", last EMCY 0x%04X (%.*s)", emcy_code,
-                  static_cast<int>(canopen::emcy_code_text(emcy_code).size()), canopen::emcy_code_text(emcy_code).data());
-  }
-  const double waited_ms = static_cast<double>(waited_ns) / 1e6;
-  const auto sn = state_name(reached);
-  int n = 0;
-  switch (kind) {
-    case FailureKind::kNone:
-      n = std::snprintf(out.data(), out.size(), "node %u: no failure", node);
-      break;
-    case FailureKind::kBootTimeout:
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: no boot-up or heartbeat within %.1f ms, even after NMT reset node (timeout %.1f ms)",
-                        node, waited_ms, static_cast<double>(timeout_ns) / 1e6);
-      break;
-    case FailureKind::kSdoAbort: {
-      auto name = dictionary != nullptr ? dictionary->name_or_standard(sdo_index, sdo_sub)
-                                        : canopen::object_name(sdo_index, sdo_sub);
-      if (name.empty()) name = "an object canmotion does not know";
-      const auto text = canopen::sdo_abort_text(sdo_abort);
-      char why[320] = "";
-      write_hint(why, sizeof why, sdo_origin, hint);
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: configuration %s 0x%04X:%u (%.*s) aborted with 0x%08" PRIX32 " (%.*s) after %.1f ms: %s%s",
-                        node, sdo_origin == WriteOrigin::kCheck ? "read of" : "write to", sdo_index, sdo_sub, static_cast<int>(name.size()), name.data(), sdo_abort,
-                        static_cast<int>(text.size()), text.data(), waited_ms,
-                        sdo_abort == static_cast<std::uint32_t>(canopen::SdoAbort::kTimeout) ? "the drive did not answer"
-                                                                                             : "the drive refused it",
-                        why);
-      break;
-    }
-    case FailureKind::kSdoQueueFull:
-      n = std::snprintf(out.data(), out.size(), "node %u: SDO queue full while configuring", node);
-      break;
-    case FailureKind::kStartTimeout:
-      n = std::snprintf(out.data(), out.size(), "node %u: no TPDO within %.1f ms after NMT start%s", node,
-                        static_cast<double>(timeout_ns) / 1e6, emcy);
-      break;
-    case FailureKind::kTransitionTimeout: {
-      const auto wn = state_name(wanted);
-      const auto from = transition < kTransitions.size() ? state_name(kTransitions[transition].from) : "?";
-      const auto to = transition < kTransitions.size() ? state_name(kTransitions[transition].to) : wn;
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: transition %u (%.*s -> %.*s) towards %.*s timed out after %.1f ms: drive is in %.*s, "
-                        "statusword 0x%04X%s%s",
-                        node, transition, static_cast<int>(from.size()), from.data(), static_cast<int>(to.size()),
-                        to.data(), static_cast<int>(wn.size()), wn.data(), waited_ms, static_cast<int>(sn.size()),
-                        sn.data(), statusword, emcy,
-                        // Statusword bit 9 (remote) clear: the drive ignores the controlword.
-                        (statusword & sw::kRemote) == 0 && reached != State::kUnknown && reached != State::kNotReadyToSwitchOn
-                            ? "; the drive is under local control (statusword bit 9 remote = 0: it does not process "
-                              "the controlword): switch it to bus/remote control on the drive"
-                            : "");
-      break;
-    }
-    case FailureKind::kDriveFault:
-      n = std::snprintf(out.data(), out.size(), "node %u: drive entered %.*s (statusword 0x%04X)%s", node,
-                        static_cast<int>(sn.size()), sn.data(), statusword, emcy);
-      break;
-    case FailureKind::kHeartbeatLost:
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: heartbeat lost (none for %.1f ms; drive was in %.*s, statusword 0x%04X)%s", node,
-                        static_cast<double>(timeout_ns) / 1e6, static_cast<int>(sn.size()), sn.data(), statusword, emcy);
-      break;
-    case FailureKind::kModeSwitchTimeout: {
-      const auto rq = mode_name(mode_requested);
-      const auto sh = mode_name(mode_shown);
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: mode switch to %d (%.*s) not shown in 0x6061 within %.1f ms: drive still shows %d "
-                        "(%.*s), statusword 0x%04X%s",
-                        node, mode_requested, static_cast<int>(rq.size()), rq.data(), static_cast<double>(timeout_ns) / 1e6,
-                        mode_shown, static_cast<int>(sh.size()), sh.data(), statusword, emcy);
-      break;
-    }
-    case FailureKind::kUnexpectedBootUp:
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: unexpected boot-up while %.*s (the drive reset itself or was power-cycled; it is "
-                        "configured again)%s",
-                        node, static_cast<int>(phase_name(phase).size()), phase_name(phase).data(), emcy);
-      break;
-    case FailureKind::kBootCheck: {
-      const bool k = hint != nullptr && hint[0] != '\0';
-      switch (check) {
-        case BootCheck::kDeviceType:
-          n = k ? std::snprintf(out.data(), out.size(), "node %u: 0x1000 (%s) is 0x%08" PRIX32 ", %s expects 0x%08" PRIX32,
-                                node, eds_name_or(dictionary, 0x1000, 0, "Device type"), read_value, hint, expected)
-                : std::snprintf(out.data(), out.size(),
-                                "node %u: 0x1000 (%s) is 0x%08" PRIX32 ": device profile %" PRIu32
-                                ", not 402 (CiA 402 drive); canmotiond drives CiA 402 drives only",
-                                node, eds_name_or(dictionary, 0x1000, 0, "Device type"), read_value,
-                                read_value & 0xFFFFu);
-          break;
-        case BootCheck::kVendorId:
-        case BootCheck::kProductCode:
-        case BootCheck::kRevision: {
-          const std::uint8_t si = check == BootCheck::kVendorId ? 1 : check == BootCheck::kProductCode ? 2 : 3;
-          const char* what = eds_name_or(dictionary, obj::kIdentity, si,
-                                         si == 1 ? "Vendor-ID" : si == 2 ? "Product code" : "Revision number");
-          const char* sub = check == BootCheck::kVendorId ? "vendor_id" : check == BootCheck::kProductCode ? "product_code" : "revision";
-          n = std::snprintf(out.data(), out.size(),
-                            "node %u: identity 0x1018:%u (%s) is 0x%08" PRIX32 ", the configuration expects 0x%08" PRIX32
-                            " (%s%s%s): another drive than configured is on this node",
-                            node, si, what, read_value, expected, k ? hint : "drive.identity", ".", sub);
-          break;
-        }
-        case BootCheck::kSupportedModes: {
-          const auto mn = mode_name(static_cast<std::int8_t>(expected));
-          n = std::snprintf(out.data(), out.size(),
-                            "node %u: the drive does not support mode %d (%.*s): 0x6502 (%s) is 0x%08" PRIX32
-                            "; the mode is needed by %s",
-                            node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(mn.size()), mn.data(),
-                            eds_name_or(dictionary, obj::kSupportedDriveModes, 0, "Supported drive modes"), read_value,
-                            k ? hint : "the drive's configured mode");
-          break;
-        }
-        case BootCheck::kModeDisplay: {
-          const auto rq = mode_name(static_cast<std::int8_t>(expected));
-          const auto sh = mode_name(static_cast<std::int8_t>(read_value));
-          n = std::snprintf(out.data(), out.size(),
-                            "node %u: 0x6060 = %d (%.*s) written, but 0x6061 (%s) still shows %d (%.*s) "
-                            "after %.1f ms (%s): the drive does not run the mode it accepted",
-                            node, static_cast<int>(static_cast<std::int8_t>(expected)), static_cast<int>(rq.size()), rq.data(),
-                            eds_name_or(dictionary, obj::kModesOfOperationDisplay, 0, "Modes of operation display"),
-                            static_cast<int>(static_cast<std::int8_t>(read_value)), static_cast<int>(sh.size()), sh.data(),
-                            waited_ms, k ? hint : "mode switch timeout");
-          break;
-        }
-        case BootCheck::kInterpolationIndex: {
-          const auto idx = static_cast<int>(static_cast<std::int8_t>(read_value & 0xFFu));
-          n = std::snprintf(out.data(), out.size(),
-                            "node %u: 0x60C2:2 (%s) is read-only at %d (periods in units of "
-                            "10^%d s) and the cycle period %.6g ms (%s) is not a whole number 1..255 of that unit: "
-                            "choose a period the drive can take",
-                            node, eds_name_or(dictionary, obj::kInterpolationTimePeriod, 2, "Interpolation time index"), idx, idx, static_cast<double>(expected) / 1e6, k ? hint : "the cycle period");
-          break;
-        }
-        case BootCheck::kSyncCounter: {
-          const auto text = canopen::sdo_abort_text(sdo_abort);
-          char why[160];
-          if (expected == 0)
-            std::snprintf(why, sizeof why, "the drive expects SYNCs with a counter (up to %" PRIu32
-                          ") and would drop every SYNC of the master, which has none (EMCY 8240h)", read_value);
-          else if (read_value == 0)
-            std::snprintf(why, sizeof why, "the drive takes SYNCs without a counter and would drop every SYNC of the "
-                          "master, which carries one (EMCY 8240h)");
-          else
-            std::snprintf(why, sizeof why, "the drive counts SYNCs up to %" PRIu32 ", the master up to %" PRIu32,
-                          read_value, expected);
-          n = std::snprintf(out.data(), out.size(),
-                            "node %u: 0x1019:0 (%s) refused the write of %" PRIu32
-                            " (SDO abort 0x%08" PRIX32 " %.*s) and holds %" PRIu32 ": %s; set %s: %" PRIu32
-                            ", or give the drive's 0x1019 the value %" PRIu32,
-                            node, eds_name_or(dictionary, obj::kSyncCounterOverflow, 0, "Synchronous counter overflow value"),
-                            expected, sdo_abort, static_cast<int>(text.size()), text.data(), read_value, why,
-                            k ? hint : "the master's SYNC counter overflow", read_value, expected);
-          break;
-        }
-        case BootCheck::kNone: n = std::snprintf(out.data(), out.size(), "node %u: boot check failed", node); break;
-      }
-      break;
-    }
-    case FailureKind::kNmtState: {
-      const auto st = canopen::nmt_state_name(nmt_state);
-      // What the drive's CiA 402 state is: read over SDO (Pre-operational
-      // answers SDO), or only its last TPDO's from before it left.
-      char drive[192];
-      if (statusword_read) {
-        std::snprintf(drive, sizeof drive, "; the drive is in %.*s (statusword 0x%04X, read over SDO)",
-                      static_cast<int>(sn.size()), sn.data(), statusword);
-      } else if (nmt_state == canopen::NmtState::kStopped) {
-        std::snprintf(drive, sizeof drive,
-                      "; a stopped node answers no SDO: its CiA 402 state is not known (its last TPDO showed %.*s, "
-                      "statusword 0x%04X)",
-                      static_cast<int>(sn.size()), sn.data(), statusword);
-      } else {
-        std::snprintf(drive, sizeof drive, "; its last TPDO showed %.*s (statusword 0x%04X)", static_cast<int>(sn.size()),
-                      sn.data(), statusword);
-      }
-      n = std::snprintf(out.data(), out.size(),
-                        "node %u: left NMT operational: its heartbeat shows %.*s (no PDOs are exchanged; many drives do "
-                        "this on a communication error, CiA 301 0x1029)%s%s",
-                        node, static_cast<int>(st.size()), st.data(), drive, emcy);
-      break;
-    }
-  }
-  if (n < 0) {
-    out[0] = '\0';
-    return 0;
-  }
-  return std::min<std::size_t>(static_cast<std::size_t>(n), out.size() - 1);
-}
-
-std::string Failure::to_string() const {
-  char buf[512];
-  const std::size_t n = describe(buf);
-  return std::string(buf, n);
-}
-
-// ============================================================================
-// DriveProxy
-// ============================================================================
 DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(cfg), master_(master) {
   if (!master_.add_node(cfg_.node, cfg_.sdo_timeout_ns)) {
     throw std::invalid_argument("node-ID " + std::to_string(cfg_.node) +
@@ -621,6 +303,52 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   return true;
 }
 
+// The drive is in the state the proxy steers to: the controlword that keeps
+// it there (in Operation enabled, with the homing start bit when a homing
+// runs). From step_state_machine() only: inlined there.
+[[gnu::always_inline]] inline void DriveProxy::hold_state(State target) noexcept {
+  in_flight_ = false;
+  reset_requested_ = false;
+  switch (target) {
+    case State::kOperationEnabled:
+      cw_ = cia402::controlword(Command::kEnableOperation);
+      if (homing_step_ == HomingStep::kWaitMode && mode_ == Mode::kHoming && !mode_switch_pending_ &&
+          fb_.mode_display == static_cast<std::int8_t>(Mode::kHoming)) {
+        // Bit 4 went out clear in the last RPDO (it is clear in every
+        // other step): this one is the rising edge.
+        homing_step_ = HomingStep::kStarted;
+        homing_sync_ = homing_fresh_ = false;
+      }
+      if (homing_step_ == HomingStep::kStarted) cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
+      break;
+    case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
+    case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
+    case State::kQuickStopActive: cw_ = cia402::controlword(Command::kQuickStop); break;
+    default: cw_ = cia402::controlword(Command::kDisableVoltage); break;
+  }
+}
+
+// Transition 15: the drive acts on the rising edge of bit 7. In Fault the
+// proxy sends it clear, so the reset goes out in this cycle's RPDO; only
+// when the last controlword had it set does one cycle without it come
+// first. A drive refuses the reset while the cause remains: every
+// fault_reset_repeat_ns one RPDO with bit 7 clear, then a new edge, until it
+// leaves Fault or the transition times out. From step_state_machine() only:
+// inlined there.
+[[gnu::always_inline]] inline void DriveProxy::send_fault_reset(std::int64_t now_ns) noexcept {
+  const bool set = (cw_ & cw::kFaultReset) != 0;
+  if (set && (flight_cycles_ == 0 ||
+              (cfg_.fault_reset_repeat_ns > 0 && now_ns - reset_edge_ns_ >= cfg_.fault_reset_repeat_ns))) {
+    cw_ = 0;
+  } else {
+    if (!set) {
+      reset_edge_ns_ = now_ns;
+      ++reset_edges_;
+    }
+    cw_ = cia402::controlword(Command::kFaultReset);
+  }
+}
+
 // Called once per drive per cycle from step() only: inlined there.
 [[gnu::always_inline]] inline void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
   state_ = decode_state(fb_.statusword);
@@ -647,25 +375,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   // transition times out), then the enable climbs from where it is.
   const State target = leaving_enabled() && wanted_ == State::kOperationEnabled ? leave_.expect : wanted_;
   if (state_ == target) {
-    in_flight_ = false;
-    reset_requested_ = false;
-    switch (target) {
-      case State::kOperationEnabled:
-        cw_ = cia402::controlword(Command::kEnableOperation);
-        if (homing_step_ == HomingStep::kWaitMode && mode_ == Mode::kHoming && !mode_switch_pending_ &&
-            fb_.mode_display == static_cast<std::int8_t>(Mode::kHoming)) {
-          // Bit 4 went out clear in the last RPDO (it is clear in every
-          // other step): this one is the rising edge.
-          homing_step_ = HomingStep::kStarted;
-          homing_sync_ = homing_fresh_ = false;
-        }
-        if (homing_step_ == HomingStep::kStarted) cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
-        break;
-      case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
-      case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
-      case State::kQuickStopActive: cw_ = cia402::controlword(Command::kQuickStop); break;
-      default: cw_ = cia402::controlword(Command::kDisableVoltage); break;
-    }
+    hold_state(target);
     return;
   }
   const auto plan = next_step(state_, target);
@@ -707,23 +417,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   }
   if (plan) {
     if (plan->command == Command::kFaultReset) {
-      // The drive acts on the rising edge of bit 7. In Fault the proxy sends
-      // it clear, so the reset goes out in this cycle's RPDO; only when the
-      // last controlword had it set does one cycle without it come first. A
-      // drive refuses the reset while the cause remains: every
-      // fault_reset_repeat_ns one RPDO with bit 7 clear, then a new edge,
-      // until it leaves Fault or the transition times out.
-      const bool set = (cw_ & cw::kFaultReset) != 0;
-      if (set && (flight_cycles_ == 0 ||
-                  (cfg_.fault_reset_repeat_ns > 0 && now_ns - reset_edge_ns_ >= cfg_.fault_reset_repeat_ns))) {
-        cw_ = 0;
-      } else {
-        if (!set) {
-          reset_edge_ns_ = now_ns;
-          ++reset_edges_;
-        }
-        cw_ = cia402::controlword(Command::kFaultReset);
-      }
+      send_fault_reset(now_ns);
     } else {
       cw_ = cia402::controlword(plan->command);
     }
@@ -912,127 +606,6 @@ void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {
 void DriveProxy::on_sync_sent() noexcept {
   expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_ && !nmt_left_;
   if (homing_step_ == HomingStep::kStarted && (cw_ & cw::kHomingStart) != 0) homing_sync_ = true;
-}
-
-// ============================================================================
-// DriveNetwork
-// ============================================================================
-DriveNetwork::DriveNetwork(const NetworkConfig& cfg)
-    : tx_queue_frames_(cfg.tx_queue_frames), master_(cfg.master), events_(kEventCapacity) {
-  index_.fill(-1);
-  tpdo_owner_.fill(-1);
-}
-
-DriveProxy& DriveNetwork::add_drive(const DriveConfig& cfg) {
-  drives_.push_back(std::make_unique<DriveProxy>(cfg, master_));
-  index_[cfg.node] = static_cast<std::int16_t>(drives_.size() - 1);
-  // Only where classify() would route the frame to this drive anyway (at most
-  // 127 drives, so the index fits).
-  const DriveProxy& d = *drives_.back();
-  for (std::uint8_t p = 0; p < d.pdos().tpdo_count; ++p) {
-    const std::uint32_t id = d.pdos().tpdo[p].cob_id & 0x7FFu;
-    const canopen::CobInfo c = canopen::classify(id);
-    if (c.kind == canopen::FrameKind::kTpdo && c.node == cfg.node)
-      tpdo_owner_[id] = static_cast<std::int8_t>(drives_.size() - 1);
-  }
-  return *drives_.back();
-}
-
-DriveProxy* DriveNetwork::drive(std::uint8_t node) noexcept {
-  if (node > 127 || index_[node] < 0) return nullptr;
-  return drives_[static_cast<std::size_t>(index_[node])].get();
-}
-
-void DriveNetwork::on_frame(const can::TimedFrame& f) noexcept {
-  // A TPDO of one of our drives (the master ignores TPDOs): straight to it.
-  if ((f.frame.flags & (can::kExtended | can::kError)) == 0 && f.frame.id < tpdo_owner_.size()) {
-    if (const std::int8_t k = tpdo_owner_[f.frame.id]; k >= 0) {
-      drives_[static_cast<std::size_t>(k)]->on_frame(f);
-      return;
-    }
-  }
-  if (master_.on_frame(f)) return;
-  const canopen::CobInfo c = canopen::classify(f.frame.id);
-  if (c.kind != canopen::FrameKind::kTpdo) return;
-  if (DriveProxy* d = drive(c.node)) d->on_frame(f);
-}
-
-void DriveNetwork::update(std::int64_t now_ns) noexcept {
-  master_.check_heartbeats(now_ns);
-  canopen::NodeEvent e;
-  auto keep = [this](const canopen::NodeEvent& ev) noexcept {
-    if (ev_count_ < kEventCapacity) {
-      events_[(ev_head_ + ev_count_) % kEventCapacity] = ev;
-      ++ev_count_;
-    }
-  };
-  while (master_.poll_event(e)) {
-    if (DriveProxy* d = drive(e.node)) d->on_node_event(e);
-    keep(e);
-  }
-  // The optional objects the drives lacked during their boot (said once each).
-  for (auto& d : drives_)
-    while (d->poll_notice(e)) keep(e);
-}
-
-void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
-  update(now_ns);
-  // The burst: RPDOs, the SYNC, then what may wait or be repeated (SDO,
-  // heartbeat). With a transmit queue shorter than the burst
-  // (tx_queue_frames) one place stays free for the SYNC: a full queue drops
-  // an RPDO or an SDO request, never the SYNC that every drive needs.
-  budget_.out = &out;
-  budget_.left = tx_queue_frames_ == 0 ? 0xFFFFFFFFu : tx_queue_frames_ - 1;
-  // With a budget the drives take turns at the front, so a queue too short
-  // for every RPDO skips each drive's in turn rather than always the last one's.
-  const std::size_t n = drives_.size();
-  const std::size_t first = tx_queue_frames_ != 0 && n > 0 ? static_cast<std::size_t>(turn_++ % n) : 0;
-  for (std::size_t i = 0; i < n; ++i) drives_[(first + i) % n]->step(now_ns, budget_);
-  if (tx_queue_frames_ != 0) ++budget_.left;  // the place kept for the SYNC
-  master_.send_sync(budget_);
-  for (auto& d : drives_) d->on_sync_sent();
-  // After the proxies and the SYNC, so that what they queued this cycle goes out now.
-  master_.step_sdo(now_ns, budget_);
-  master_.produce_heartbeat(now_ns, budget_);
-}
-
-std::vector<can::Filter> DriveNetwork::receive_filters() const {
-  std::vector<std::uint8_t> nodes;
-  for (const auto& d : drives_) nodes.push_back(d->node());
-  return canopen::master_receive_filters(nodes);
-}
-
-bool DriveNetwork::poll_event(canopen::NodeEvent& out) noexcept {
-  if (ev_count_ == 0) return false;
-  out = events_[ev_head_];
-  ev_head_ = (ev_head_ + 1) % kEventCapacity;
-  --ev_count_;
-  return true;
-}
-
-bool DriveNetwork::all_operational() const noexcept {
-  for (const auto& d : drives_)
-    if (d->phase() != Phase::kOperational) return false;
-  return !drives_.empty();
-}
-bool DriveNetwork::all_enabled() const noexcept {
-  for (const auto& d : drives_)
-    if (!d->enabled()) return false;
-  return !drives_.empty();
-}
-bool DriveNetwork::any_failed() const noexcept {
-  for (const auto& d : drives_)
-    if (d->failed()) return true;
-  return false;
-}
-void DriveNetwork::enable_all() noexcept {
-  for (auto& d : drives_) d->enable();
-}
-void DriveNetwork::reboot_all() noexcept {
-  for (auto& d : drives_) d->reboot_node();
-}
-void DriveNetwork::disable_all() noexcept {
-  for (auto& d : drives_) d->disable();
 }
 
 }  // namespace canmotion::cia402

@@ -35,72 +35,11 @@
 #include "fieldbus/canopen/frame_sink.hpp"
 #include "fieldbus/canopen/master.hpp"
 #include "fieldbus/canopen/pdo.hpp"
+#include "fieldbus/cia402/boot_plan.hpp"
 #include "fieldbus/cia402/cia402.hpp"
 #include "fieldbus/cia402/drive_pdos.hpp"
 
 namespace canmotion::cia402 {
-
-/// One expedited SDO write (1, 2 or 4 bytes) from the configuration.
-struct SdoWrite {
-  std::uint16_t index = 0;
-  std::uint8_t sub = 0;
-  std::uint8_t size = 4;  ///< 1, 2, 3 or 4 bytes
-  std::uint32_t value = 0;
-  /// DriveConfig::extra_writes: a drive without the object is fine (abort
-  /// 0x06020000 / 0x06090011 accepted and said once: DriveProxy::poll_notice), e.g. a
-  /// default the configuration did not ask for.
-  bool optional = false;
-};
-
-/// Configuration keys to name when the drive refuses a boot configuration
-/// write (Failure::describe): where the value of each kind of write comes
-/// from, e.g. canmotiond's YAML keys. Empty: nothing is named.
-struct WriteHints {
-  std::string interpolation_period;  ///< 0x60C2, e.g. "controller.period_ms"
-  std::string pdo;                   ///< the PDO mapping, e.g. "axes[0].drive.pdo"
-  std::string producer_heartbeat;    ///< 0x1017, e.g. "axes[0].drive.heartbeat_ms"
-  std::string consumer_heartbeat;    ///< 0x1016:1, e.g. "axes[0].drive.master_heartbeat_timeout_ms" (0 leaves it out)
-  std::vector<std::string> extra;    ///< one per DriveConfig::extra_writes entry, e.g. "axes[0].drive.sdo_writes[1]"
-  std::string identity;              ///< DriveConfig::identity, e.g. "axes[0].drive.identity"
-  std::string mode_switch_timeout;   ///< e.g. "axes[0].drive.timeouts.mode_switch_ms"
-  std::string sync_counter;          ///< 0x1019, e.g. "buses[0].sync_counter_overflow"
-  std::string sync_watch;            ///< 0x1006, e.g. "axes[0].drive.sync_watch"
-};
-
-/// What a boot configuration write is for.
-enum class WriteOrigin : std::uint8_t {
-  kMode,                ///< 0x6060
-  kInterpolationPeriod, ///< 0x60C2:1/2
-  kPdo,                 ///< communication or mapping parameter of a PDO the master uses
-  kUnusedPdo,           ///< COB-ID of a PDO the master does not use, written invalid; a drive
-                        ///< without that PDO (abort 0x06020000 / 0x06090011) is fine
-  kProducerHeartbeat,   ///< 0x1017
-  kConsumerHeartbeat,   ///< 0x1016:1
-  kExtra,               ///< DriveConfig::extra_writes
-  kCheck,               ///< a read at boot that checks the drive (BootCheck)
-  kSyncPeriod,          ///< 0x1006 communication cycle period: 0, then the period (DriveConfig::sync_watch)
-  kSyncCounter,         ///< 0x1019 synchronous counter overflow value (the master's SYNC counter)
-};
-
-/// What a read at boot checks (Failure::check for FailureKind::kBootCheck).
-enum class BootCheck : std::uint8_t {
-  kNone,
-  kDeviceType,      ///< 0x1000: device profile 402 (bits 0..15), or DriveIdentity::device_type
-  kVendorId,        ///< 0x1018:1 against DriveIdentity::vendor_id
-  kProductCode,     ///< 0x1018:2 against DriveIdentity::product_code
-  kRevision,        ///< 0x1018:3 against DriveIdentity::revision
-  kSupportedModes,  ///< 0x6502 has a bit for every DriveConfig::needed_modes entry (absent: not checked)
-  kModeDisplay,     ///< 0x6061 shows the mode written to 0x6060 (absent: assumed)
-  /// 0x60C2:2 read after the drive refused to write it (read-only or
-  /// absent): the period must be expressible in the drive's unit (`read_value`
-  /// the drive's index, `expected` the period in ns).
-  kInterpolationIndex,
-  /// 0x1019 read after the drive refused to write it (read-only, 0x08000022
-  /// while its 0x1006 != 0, ...): it must already hold the master's counter
-  /// overflow value (`read_value` the drive's, `expected` the master's,
-  /// `sdo_abort` the write's abort).
-  kSyncCounter,
-};
 
 /// One sentence for a canopen::NodeEvent::Kind::kObjectAbsent (an optional
 /// boot object the drive lacks or refused as read-only, and the fallback the
@@ -199,29 +138,6 @@ struct DriveConfig {
   bool sync_watch = false;
 };
 
-/// One SDO transfer of the boot configuration, in the order the proxy makes
-/// them: a write (download), or with `check` set a read (upload, origin
-/// WriteOrigin::kCheck) that checks the drive.
-struct BootWrite {
-  SdoWrite w;
-  WriteOrigin origin = WriteOrigin::kMode;
-  std::uint16_t extra = 0;  ///< kExtra: index in DriveConfig::extra_writes
-  bool optional = false;    ///< a drive without the object is fine (abort 0x06020000 / 0x06090011 accepted)
-  /// Runs only after the drive refused 0x60C2:2 (the read of its index and
-  /// 0x60C2:1 written again in its unit), or at once when the drive's EDS
-  /// has 0x60C2:2 read-only (then not written); skipped otherwise.
-  bool ip_fallback = false;
-  BootCheck check = BootCheck::kNone;  ///< not kNone: a read (upload) that checks the drive
-  /// Runs only after the drive refused 0x1019 other than as absent (the read
-  /// of its value, BootCheck::kSyncCounter); skipped otherwise.
-  bool sync_fallback = false;
-  [[nodiscard]] constexpr bool is_read() const noexcept { return check != BootCheck::kNone; }
-};
-
-/// The configuration key behind a boot write (from `hints`), or nullptr when
-/// none is named (0x6060, unused PDOs, the checking reads). Realtime-safe.
-[[nodiscard]] const std::string* write_hint_key(const WriteHints& hints, const BootWrite& w) noexcept;
-
 /// Where the proxy is in bringing its node up.
 enum class Phase : std::uint8_t { kWaitBoot, kResetWait, kConfiguring, kStarting, kOperational, kFailed };
 [[nodiscard]] constexpr std::string_view phase_name(Phase p) noexcept {
@@ -277,7 +193,9 @@ struct Failure {
   std::int64_t t_ns = 0;                    ///< when it was detected
   std::int8_t mode_requested = 0;           ///< kModeSwitchTimeout: 0x6060 written
   std::int8_t mode_shown = 0;               ///< kModeSwitchTimeout: 0x6061 still shown
-  WriteOrigin sdo_origin = WriteOrigin::kMode;  ///< kSdoAbort: what the write was for
+  /// kSdoAbort: what the write was for; describe() says so with its boot
+  /// plan rows' sentence (boot_hint()).
+  WriteOrigin sdo_origin = WriteOrigin::kMode;
   /// kSdoAbort: the configuration key the write comes from (WriteHints), or
   /// nullptr. Points into the DriveProxy's configuration: valid while it lives.
   const char* hint = nullptr;
@@ -303,6 +221,12 @@ struct Failure {
   /// non-RT thread.
   std::size_t describe(std::span<char> out) const noexcept;
   [[nodiscard]] std::string to_string() const;
+
+ private:
+  // describe()'s longer cases (drive_failure.cpp); snprintf's result.
+  int describe_sdo_abort(std::span<char> out, double waited_ms) const noexcept;
+  int describe_transition(std::span<char> out, double waited_ms, const char* emcy) const noexcept;
+  int describe_nmt_state(std::span<char> out, const char* emcy) const noexcept;
 };
 
 /// Feedback from the TPDOs, in drive units (counts).
@@ -476,7 +400,17 @@ class DriveProxy {
   void reboot(std::int64_t now_ns) noexcept;        ///< the node booted (again): configure it from the first write
   void fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept;
   void step_boot(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  // The configuring phase (drive_boot.cpp): the boot transfers' results, then
+  // the next transfers queued; true when the boot failed.
+  enum class Taken : std::uint8_t { kDone, kAgain, kFailed };
+  bool step_configuring(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  Taken take_result(const canopen::SdoResult& r, std::int64_t now_ns) noexcept;
+  Taken check_read(std::size_t i, std::uint32_t v, std::int64_t now_ns) noexcept;
+  void fail_transfer(std::size_t i, const canopen::SdoResult& r, bool as_trigger, std::int64_t now_ns) noexcept;
+  void queue_transfers(canopen::SdoClient& sdo) noexcept;
   void step_state_machine(std::int64_t now_ns) noexcept;
+  void hold_state(State target) noexcept;            // step_state_machine(): the controlword in the wanted state
+  void send_fault_reset(std::int64_t now_ns) noexcept;  // step_state_machine(): transition 15's bit 7 edge
   void send_rpdos(canopen::FrameSink& out) noexcept;
   void follow_actual() noexcept;
   void set_wanted(State s) noexcept;
@@ -485,22 +419,23 @@ class DriveProxy {
   canopen::Master& master_;
   DrivePdoSet pdos_;
   std::size_t leading_reads_ = 0;      // the checks that run before any write
-  std::int64_t mode_shown_since_ns_ = -1;  // boot: first 0x6061 read that did not show the mode yet
-  /// A boot read's value: true when the boot goes on (`again`: read it again).
-  bool check_read(const BootWrite& bw, std::uint32_t v, std::int64_t now_ns, bool& again) noexcept;
-  std::vector<BootWrite> writes_;  // the whole boot configuration, built at set-up
+  std::int64_t again_since_ns_ = -1;   // boot: the first read whose check answered kAgain (0x6061)
+  std::vector<BootWrite> writes_;      // the whole boot configuration, built at set-up (boot_plan.hpp)
+  /// Per writes_ entry, what its answer was in this boot (fallbacks run on
+  /// it), and whether its notice was made (said once per proxy).
+  struct TransferState {
+    bool fell_back = false;   // answered with an abort its row falls back on
+    bool noticed = false;
+    std::uint32_t abort = 0;  // that abort
+  };
+  std::vector<TransferState> transfer_;
   std::size_t next_write_ = 0;
   std::size_t done_writes_ = 0;
   std::size_t tolerated_ = 0;
-  bool ip_fallback_ = false;  // 0x60C2:2 refused: the BootWrite::ip_fallback entries run
-  std::uint32_t ip_abort_ = 0;  // the abort 0x60C2:2's write got
-  bool sync_fallback_ = false;  // 0x1019 refused: the BootWrite::sync_fallback read runs
-  std::uint32_t sync_abort_ = 0;  // the abort 0x1019's write got
-  bool ip_index_read_only_ = false;  // the EDS has 0x60C2:2 ro/const: not written, the fallback runs at once
-  std::vector<std::uint8_t> noticed_;  // per writes_ entry: its notice was made (said once)
+  std::int32_t reread_ = -1;  // a read to queue again (its check answered kAgain), or -1
   std::array<canopen::NodeEvent, 16> notices_{};  // bound: at most one per optional boot object, 16 is ample
   std::size_t notice_head_ = 0, notice_count_ = 0;
-  void notice(std::size_t write, std::uint32_t abort, std::int32_t detail = 0) noexcept;
+  void notice(std::size_t write, std::uint32_t abort, Fallback what, std::int32_t detail = 0) noexcept;
   std::uint32_t reboots_ = 0;
   bool nmt_left_ = false;  // heartbeat showed pre-operational / stopped while operational
 

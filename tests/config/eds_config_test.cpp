@@ -145,9 +145,9 @@ TEST(EdsConfig, BootWritesLeaveOutOptionalObjectsTheEdsLacks) {
   EXPECT_EQ(all.size(), w.size() + 8);
   // The boot's optional reads (0x6502, 0x6061) stay: the minimal drive has
   // both; so does the read of 0x60C2:2 made only if the drive refuses it.
-  const auto optional_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.optional && b.is_read() && !b.ip_fallback; });
+  const auto optional_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.optional && b.is_read() && !b.is_fallback(); });
   EXPECT_EQ(optional_reads, 2);
-  const auto fallback_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.ip_fallback && b.is_read(); });
+  const auto fallback_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.is_fallback() && b.is_read(); });
   EXPECT_EQ(fallback_reads, 1);
 }
 

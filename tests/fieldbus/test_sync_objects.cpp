@@ -58,13 +58,6 @@ std::size_t notices_of(const std::vector<canopen::NodeEvent>& v, std::uint16_t i
   return n;
 }
 
-std::string hex(const can::Frame& f) {
-  char s[40];
-  int n = std::snprintf(s, sizeof s, "%03X#", f.id);
-  for (std::size_t i = 0; i < f.len; ++i) n += std::snprintf(s + n, sizeof s - static_cast<std::size_t>(n), "%02X", f.data[i]);
-  return s;
-}
-
 /// The boot's SDO frames (requests and responses) of 0x1006 and 0x1019, in bus order.
 std::vector<std::string> sync_object_sdo(SimRig& rig, can::SimBus::Endpoint& spy, int cycles) {
   std::vector<std::string> sdo;
@@ -77,7 +70,7 @@ std::vector<std::string> sync_object_sdo(SimRig& rig, can::SimBus::Endpoint& spy
         if ((f.id != 0x600u + kNode && f.id != 0x580u + kNode) || f.len != 8 || f.data[2] != 0x10 ||
             (f.data[1] != 0x06 && f.data[1] != 0x19))
           continue;
-        sdo.push_back(hex(f));
+        sdo.push_back(fbtest::hex(f));
       }
   }
   return sdo;
