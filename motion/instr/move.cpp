@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "motion/instr/coord.hpp"
 #include "motion/instr/ctx.hpp"
 #include "motion/instr/mdac.hpp"
 #include "motion/instr/position_cam.hpp"
