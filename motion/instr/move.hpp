@@ -12,13 +12,13 @@
 
 namespace canmotion::motion {
 
-/// Speed .. LockDirection, laid out identically in MAM and MAJ.
+/// Speed .. LockDirection of MAM and MAJ: the rate operands (converted by
+/// units::convert_rates) and the merge and lock operands.
 struct Dynamics : RateOperands {
   Merge merge = Merge::Disabled;
   MergeSpeed merge_speed = MergeSpeed::Programmed;
   double lock_position = 0.0;
   LockDirection lock_direction = LockDirection::None;
-  int first_operand = 0;         ///< ST index of Speed (EXERR base)
 };
 
 struct MajParams {

@@ -252,7 +252,9 @@ TEST(Decode, TypedParamsFromTheBoundRequest) {
   EXPECT_EQ(m.dyn.jerk_units, 2);
   EXPECT_EQ(m.dyn.merge, Merge::Enabled);
   EXPECT_EQ(m.dyn.merge_speed, MergeSpeed::Current);
-  EXPECT_EQ(m.dyn.first_operand, 4);
+  EXPECT_EQ(m.dyn.at.speed, 4);  // the rate operands' positions (EXERR) come with them
+  EXPECT_EQ(m.dyn.at.accel, 6);
+  EXPECT_EQ(m.dyn.at.jerk_units, 13);
   EXPECT_EQ(m.event_distance, 1);
   EXPECT_EQ(m.calculated_data, 0xFFFF);
   ASSERT_FALSE(parse_and_bind("MAG(ax1, Ax2, ctl, reverse, 0.5, 1, 3, command, fraction_slave_master_counts, enabled, 20, %ofmaximum);", sym, q));
