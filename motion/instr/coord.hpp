@@ -23,22 +23,22 @@ namespace canmotion::motion {
 struct CoordMoveParams {
   CoordSystemId cs = 0;
   bool circle = false;
-  bool incremental = false;
-  std::uint16_t position = 0xFFFF;  ///< REAL[] id of Position
+  MoveType move_type = MoveType::Absolute;  ///< Absolute or Incremental
+  std::uint16_t position = 0xFFFF;          ///< REAL[] id of Position
   double position_start = 0.0;
-  std::uint8_t circle_type = 0, direction = 0;
+  coord::CircleType circle_type = coord::CircleType::Via;                ///< MCCM
+  coord::CircleDirection direction = coord::CircleDirection::Clockwise;  ///< MCCM
   std::uint16_t aux = 0xFFFF;  ///< REAL[] id of Via/Center/Radius
   double aux_start = 0.0;
   RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
-  std::uint8_t termination = 1;
-  std::uint8_t merge = 0;
+  coord::Termination termination = coord::Termination::NoSettle;
+  coord::CoordMerge merge = coord::CoordMerge::Disabled;
   MergeSpeed merge_speed = MergeSpeed::Programmed;
   double command_tolerance = 0.0;
   double lock_position = 0.0;
   LockDirection lock_direction = LockDirection::None;
   std::uint16_t event_distance = 0xFFFF, calculated_data = 0xFFFF;
   double event_distance_start = 0.0, calculated_data_start = 0.0;
-  int first_dyn_operand = 0;  ///< ST index of Speed (EXERR base)
 };
 struct MclmParams : CoordMoveParams {
   static constexpr Instr kInstr = Instr::MCLM;
@@ -49,10 +49,13 @@ struct MccmParams : CoordMoveParams {
   static MccmParams decode(const Operands& q) noexcept;
 };
 
+/// MCS StopType [RM002H]: the Logix numbers (1 is not used).
+enum class CoordStopType : std::uint8_t { All = 0, CoordinatedMove = 2, CoordinatedTransform = 3 };
+
 struct McsParams {
   static constexpr Instr kInstr = Instr::MCS;
   CoordSystemId cs = 0;
-  std::uint8_t stop_type = 0;  ///< 0 all, 2 coordinated move, 3 coordinated transform
+  CoordStopType stop_type = CoordStopType::All;
   bool change_decel = false, change_decel_jerk = false;
   double decel = 0.0, decel_jerk = 0.0;
   AccelUnits decel_units = AccelUnits::UnitsPerSec2;
@@ -71,8 +74,8 @@ struct MccdParams {
   CoordSystemId cs = 0;
   bool change_speed = false, change_accel = false, change_decel = false;
   bool change_accel_jerk = false, change_decel_jerk = false;
-  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
-  bool active_and_pending = false;
+  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp); MotionType has one value (coordinated move)
+  coord::ChangeScope scope = coord::ChangeScope::ActiveMotion;
   static MccdParams decode(const Operands& q) noexcept;
 };
 
