@@ -7,6 +7,7 @@
 /// that fails returns the error with the index of the operand at fault (EXERR
 /// for ERR 13). Pure; realtime-safe.
 
+#include <cstdint>
 #include <optional>
 
 #include "motion/operands.hpp"
@@ -18,8 +19,8 @@ namespace canmotion::motion {
 /// Where a move's rate operands are in its instruction (ST indices, EXERR
 /// for ERR 13), from the signature table.
 struct RateIndex {
-  int speed = 0, speed_units = 0, accel = 0, accel_units = 0, decel = 0, decel_units = 0;
-  int accel_jerk = 0, decel_jerk = 0, jerk_units = 0;
+  std::int8_t speed = 0, speed_units = 0, accel = 0, accel_units = 0, decel = 0, decel_units = 0;
+  std::int8_t accel_jerk = 0, decel_jerk = 0, jerk_units = 0;
 };
 
 /// Speed .. JerkUnits as a program writes them: the rate operands of MAM and
