@@ -162,6 +162,22 @@ struct RateRule {
   std::optional<JerkRamp> ramp{};
 };
 
+/// A RateRule whose %ofMaximum refers to the maxima of `m` (an AxisConfig or
+/// a CoordSystemConfig: max_speed, max_accel, max_decel, max_accel_jerk,
+/// max_decel_jerk), `axis` as RateRule::axis; every value selected, the
+/// jerks not (set `jerks` for an S-curve).
+template <class Maxima>
+constexpr RateRule rule_for(const Maxima& m, bool axis) noexcept {
+  RateRule r;
+  r.max_speed = m.max_speed;
+  r.max_accel = m.max_accel;
+  r.max_decel = m.max_decel;
+  r.max_accel_jerk = m.max_accel_jerk;
+  r.max_decel_jerk = m.max_decel_jerk;
+  r.axis = axis;
+  return r;
+}
+
 /// Step 1 of convert_rates() alone: the units of the values `r` selects all
 /// of one mode (ERR 94), `md`: master driven. MAM and MAJ check it first
 /// (their Lock Direction and extent rules depend on the mode).

@@ -100,19 +100,6 @@ Err member_checks(const Core& c, const CoordSystemRt& s) noexcept {
   return Err::None;
 }
 
-/// What the rate operands of a move or an MCCD refer to: the coordinate
-/// system's maxima (coordination units per second, or per master unit when
-/// master driven).
-units::RateRule system_rates(const CoordSystemConfig& cfg) noexcept {
-  units::RateRule r;
-  r.max_speed = cfg.max_speed;
-  r.max_accel = cfg.max_accel;
-  r.max_decel = cfg.max_decel;
-  r.max_accel_jerk = cfg.max_accel_jerk;
-  r.max_decel_jerk = cfg.max_decel_jerk;
-  return r;
-}
-
 /// Seed 001, master change: the pending MDCC's master takes over when this
 /// move goes IP. ERR 97 when the system moves and the new master is idle,
 /// 103 when the new effective speed is below 10 % of the present one.
@@ -145,7 +132,7 @@ Err build_request(Ctx& x, const CoordMoveParams& p, const CoordSystemRt& s, coor
   }
   // Speed .. JerkUnits in coordination units (the jerks with an S-curve; a
   // %ofTime jerk of a zero-speed move refers to the system's max speed)
-  units::RateRule rates = system_rates(s.cfg);
+  units::RateRule rates = units::rule_for(s.cfg, false);  // the system's maxima
   rates.jerks = p.dyn.profile == ProfileType::SCurve;
   rates.idle_speed = s.cfg.max_speed;
   bool md = false;
@@ -289,7 +276,7 @@ static Err run(Ctx& x, CoordSystemRt& s, const MccdParams& p) noexcept {
   // mode than the move's: 105, seed 001); a %ofTime jerk refers to the
   // system's max accel / decel to the larger of the path's and its max speed
   const CoordSystemConfig& cfg = s.cfg;
-  units::RateRule rates = system_rates(cfg);
+  units::RateRule rates = units::rule_for(cfg, false);
   rates.speed = p.change_speed;
   rates.accel = p.change_accel;
   rates.decel = p.change_decel;

@@ -71,13 +71,7 @@ Err decode_dynamics(Ctx& x, const Dynamics& y, const AxisConfig& cfg, double las
   d.scurve = y.profile == ProfileType::SCurve;
   d.merge = y.merge == Merge::Enabled;
   d.merge_current = y.merge_speed == MergeSpeed::Current;
-  units::RateRule rule;
-  rule.max_speed = cfg.max_speed;
-  rule.max_accel = cfg.max_accel;
-  rule.max_decel = cfg.max_decel;
-  rule.max_accel_jerk = cfg.max_accel_jerk;
-  rule.max_decel_jerk = cfg.max_decel_jerk;
-  rule.axis = true;
+  units::RateRule rule = units::rule_for(cfg, true);  // the axis' (or the cam master's) maxima
   rule.jerks = d.scurve;
   rule.idle_speed = last_speed;  // [RM002H p.447]: a zero-speed S-curve uses the previous non-zero speed (% of time)
   bool md = false;

@@ -28,15 +28,12 @@ RateOperands mam(double speed, double accel, double decel, double aj = 0, double
   return y;
 }
 
+/// Maxima as an AxisConfig or a CoordSystemConfig name them (units::rule_for).
+struct Maxima {
+  double max_speed, max_accel, max_decel, max_accel_jerk, max_decel_jerk;
+};
 units::RateRule maxima(double v, double a, double d, double ja, double jd, bool axis) {
-  units::RateRule r;
-  r.max_speed = v;
-  r.max_accel = a;
-  r.max_decel = d;
-  r.max_accel_jerk = ja;
-  r.max_decel_jerk = jd;
-  r.axis = axis;
-  return r;
+  return units::rule_for(Maxima{v, a, d, ja, jd}, axis);
 }
 
 TEST(Rates, RatesAndPercentOfMaximum) {

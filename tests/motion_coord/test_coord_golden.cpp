@@ -22,6 +22,7 @@
 
 #include "motion/planner.hpp"
 #include "motion/st_parser.hpp"
+#include "tests/motion/golden_util.hpp"
 
 namespace canmotion::motion::test {
 namespace {
@@ -32,34 +33,9 @@ constexpr int kRuns = 30;
 constexpr int kOpsPerRun = 70;
 constexpr int kControls = 24;
 
-struct Rng {
-  std::uint64_t s;
-  std::uint64_t next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uni(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
-  int pick(int n) { return static_cast<int>(next() % static_cast<std::uint64_t>(n)); }
-  bool coin(double p = 0.5) { return uni(0, 1) < p; }
-  template <std::size_t N>
-  const char* of(const std::array<const char*, N>& a) { return a[static_cast<std::size_t>(pick(static_cast<int>(N)))]; }
-};
-
-struct Hash {
-  std::uint64_t h = 1469598103934665603ull;
-  void byte(std::uint8_t b) { h = (h ^ b) * 1099511628211ull; }
-  void u64(std::uint64_t v) { for (int i = 0; i < 8; ++i) byte(static_cast<std::uint8_t>(v >> (8 * i))); }
-  void f64(double d) { std::uint64_t v; std::memcpy(&v, &d, 8); u64(v); }
-  void i(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
-};
-
-std::string num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
+using golden::Hash;
+using golden::num;
+using golden::Rng;
 
 constexpr std::array<const char*, 5> kAxes{"X", "Y", "Z", "M", "W"};  // cs {X, Y}, cs3 {X, Z, W}; M the master
 
