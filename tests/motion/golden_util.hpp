@@ -11,6 +11,9 @@
 #include <cstring>
 #include <string>
 
+#include "motion/planner.hpp"
+#include "motion/st_parser.hpp"
+
 namespace canmotion::motion::golden {
 
 /// SplitMix64: a fixed, portable sequence.
@@ -43,6 +46,20 @@ inline std::string num(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.17g", v);
   return b;
+}
+
+/// MASR then MSO on one of `axes`, each with one of the `controls` control
+/// tags c0, c1, ... (a run gets back to servo on: fewer refusals for servo
+/// off and shutdown); their results hashed.
+template <std::size_t N>
+void servo_on_again(Rng& g, Hash& h, Planner& p, const Symbols& sym, const std::array<const char*, N>& axes,
+                    int controls) {
+  const std::string ax = g.of(axes);
+  for (const char* ins : {"MASR", "MSO"}) {
+    Request q;
+    if (!parse_and_bind(std::string(ins) + "(" + ax + ",c" + std::to_string(g.pick(controls)) + ");", sym, q))
+      h.i(static_cast<int>(p.execute(q)));
+  }
 }
 
 }  // namespace canmotion::motion::golden

@@ -241,14 +241,7 @@ TEST(CoordGolden, RandomCoordinatedSequencesHashAsRecorded) {
     for (int op = 0; op < kOpsPerRun; ++op) {
       std::vector<Request> reqs;
       w.redraw(g);
-      if (g.coin(0.35)) {  // back to servo on: fewer refusals for servo off / shutdown
-        const std::string ax = g.of(kAxes);
-        for (const char* ins : {"MASR", "MSO"}) {
-          Request q;
-          if (!parse_and_bind(std::string(ins) + "(" + ax + ",c" + std::to_string(g.pick(kControls)) + ");", w.sym, q))
-            h.i(static_cast<int>(w.p->execute(q)));
-        }
-      }
+      if (g.coin(0.35)) golden::servo_on_again(g, h, *w.p, w.sym, kAxes, kControls);
       const int n = g.coin(0.3) ? 2 : 1;
       for (int k = 0; k < n; ++k) {
         const std::string text = random_call(g);
