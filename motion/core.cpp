@@ -7,11 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "motion/instr/direct.hpp"
-#include "motion/instr/home.hpp"
-#include "motion/instr/mdac.hpp"
-#include "motion/instr/position_cam.hpp"
-#include "motion/instr/time_cam.hpp"
+#include "motion/hooks.hpp"
 
 namespace canmotion::motion {
 Core::Core(double cycle_period) noexcept : T(cycle_period > 0 ? cycle_period : 0.001) {}
@@ -64,8 +60,11 @@ void Core::fold(AxisRt& a, Slot s, bool clear_owner_ip) noexcept {
   Generator& slot = a.gen[index(s)];
   with_generator(slot, [&](auto& g) noexcept {
     g.on_fold(*this, a);  // cam profile released, MDAC AC cleared, a cam's offset move ended
-    if (s == Slot::MasterOffset) position_cam::add_master_offset(a, g.k.p);  // shifts the cam's master, not the slave
-    else a.base += g.k.p;
+    if (s == Slot::MasterOffset) {  // a master offset move shifts the position cam's master for good, not the slave
+      if (auto* pc = std::get_if<PosCamGen>(&a.gen[index(Slot::PositionCam)])) pc->offset_base += g.k.p;
+    } else {
+      a.base += g.k.p;
+    }
     if (clear_owner_ip) {
       if (ControlTag* c = tag(g.owner)) {
         c->set(flag::IP, false);
@@ -90,20 +89,15 @@ void Core::abort_all(AxisRt& a) noexcept {
 
 void Core::servo_off(AxisRt& a) noexcept {
   abort_all(a);
-  time_cam::drop_pending(*this, a);
-  position_cam::drop_pending(*this, a);
-  direct::end(*this, a, false);
+  hooks::servo_off(*this, a);  // pending cams, direct control, drive homing
   a.servo.on = false;
   a.servo.enable_req = false;
-  if (a.hs.homing) home::cancel(*this, a);
 }
 
 void Core::do_shutdown(AxisRt& a) noexcept {
   servo_off(a);
   a.servo.shutdown = true;
-  mdac::break_links(*this, a);                 // MASD/MGSD on a slave ...
-  mdac::break_links_of_master(*this, id_of(a));  // ... and on a master
-  coordsys::on_shutdown(*this, id_of(a));        // MDCC links: as a member and as a master
+  hooks::shutdown(*this, a);  // MDAC links as slave and master, MDCC links
 }
 
 bool Core::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, ControlId owner,
@@ -121,7 +115,7 @@ bool Core::stop_slots(AxisRt& a, std::uint32_t mask, double d, double jd, Contro
   // off after the ramp (FastDisable/FastShutdown): then the servo-off stops
   // the path for the other members (CoordGen::on_fold).
   bool path = false;
-  if ((mask & slot_bit(Slot::Coord)) && post_stop == 0) path = coordsys::stop_member_path(*this, a, own);
+  if ((mask & slot_bit(Slot::Coord)) && post_stop == 0) path = hooks::stop_path(*this, a, own);
   if ((mask & kAllSlots) == kAllSlots) {
     // one ramp of the whole motion in Slot::StopAll; the master offset move
     // (master units) is not part of the axis' motion

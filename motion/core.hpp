@@ -8,8 +8,14 @@
 /// Where things are:
 ///   core.cpp          shared operations: fold, set_slot, stops, servo off, shutdown, checks
 ///   cycle.cpp         one cycle: feedback, exceptions, step every axis in order, outputs, status
-///   instr/<family>    one file per instruction family: params, start, generator, hooks
+///   generator.hpp     the generators in the slots and their interface (step, on_fold)
+///   hooks.hpp         the other events of an axis the families answer (drive feedback, servo off, ...)
+///   instr/<family>    one file per instruction family: params, start, generator steps, hooks
 ///   planner.cpp       the public API, execute(): checks, decode, one std::visit to start()
+///
+/// The core knows no family: it reaches them only through the generator
+/// interface and the hooks (instr/hooks.cpp answers those); the families
+/// include the core, never the other way.
 
 #include <array>
 #include <bit>
@@ -20,8 +26,9 @@
 
 #include "motion/axis.hpp"
 #include "motion/control_tag.hpp"
+#include "motion/cam/cam_motion.hpp"
+#include "motion/coord_system.hpp"
 #include "motion/generator.hpp"
-#include "motion/instr/mdac.hpp"
 #include "motion/io.hpp"
 #include "motion/types.hpp"
 
@@ -79,6 +86,26 @@ struct DirectControl {
   OwnerRef stop{};       ///< MAS stopping direct motion (PC at standstill)
 };
 
+/// A pending MATC waiting for the end of the current pass (or for an immediate cam).
+struct PendingCam {
+  cam::CamProfile* profile = nullptr;
+  cam::CamMotionConfig cfg{};
+  OwnerRef owner{};
+  bool master_driven = false;  ///< its InstructionMode: must match the cam it follows [seed 004]
+  constexpr bool valid() const noexcept { return profile != nullptr; }
+};
+
+/// A pending MAPC waiting for the end of the current pass (or for a non-pending cam).
+struct PendingPosCam {
+  cam::CamProfile* profile = nullptr;
+  cam::CamMotionConfig cfg{};
+  AxisId master = kNoAxis;
+  bool use_actual = false;
+  std::uint8_t master_dir = 0;
+  OwnerRef owner{};
+  constexpr bool valid() const noexcept { return profile != nullptr; }
+};
+
 /// Cams waiting to take over (pending MATC / MAPC) and the last cam directions.
 struct PendingCams {
   PendingCam time{};          ///< TimeCamPendingStatus
@@ -86,6 +113,20 @@ struct PendingCams {
   PendingPosCam position{};   ///< PositionCamPendingStatus (MAPC)
   int position_dir = 0;       ///< last position-cam direction (+1/-1, 0 never cammed)
 };
+
+/// One MDAC link of a slave (per motion type).
+struct MdacLink {
+  AxisId master = kNoAxis;
+  bool use_actual = false;
+  bool all = false;            ///< set by MDAC MotionType All
+  OwnerRef owner{};            ///< the MDAC execution
+  constexpr bool valid() const noexcept { return master != kNoAxis; }
+};
+
+/// Index of a motion type's link in MdacLinks (AxisRt::links).
+namespace link {
+inline constexpr std::size_t Move = 0, Jog = 1, TimeCam = 2, MasterOffsetMove = 3, Count = 4;
+}
 
 /// MDAC links of a slave per motion type (index: link::Move, Jog, TimeCam,
 /// MasterOffsetMove) and the queued masters.
@@ -140,7 +181,7 @@ struct Core {
   std::array<cam::CamProfile*, kMaxCamProfiles> cam_profiles{};
   std::array<std::span<cam::CamPoint>, kMaxCamArrays> cam_arrays{};
   std::array<std::span<double>, kMaxRealArrays> real_arrays{};
-  std::array<CoordSystemRt, kMaxCoordSystems> systems{};  ///< coordinate systems (motion/instr/coord.hpp)
+  std::array<CoordSystemRt, kMaxCoordSystems> systems{};  ///< coordinate systems (motion/coord_system.hpp)
   std::array<AxisId, kMaxAxes> order{};  ///< step order: masters before slaves
   std::size_t order_n = 0;
   bool order_dirty = true;  ///< a slot or an axis changed since `order` was computed

@@ -7,12 +7,8 @@
 #include <limits>
 
 #include "motion/core.hpp"
-#include "motion/instr/direct.hpp"
-#include "motion/instr/home.hpp"
-#include "motion/instr/mdac.hpp"
-#include "motion/instr/move_step.hpp"
-#include "motion/instr/position_cam.hpp"
-#include "motion/instr/servo.hpp"
+#include "motion/hooks.hpp"
+#include "motion/profile_step.hpp"
 
 namespace canmotion::motion {
 
@@ -24,11 +20,7 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
     a.fb_pos = fb->position;
     a.fb_vel = fb->velocity;
   }
-  // instructions waiting for the drive, in this order
-  if (a.servo.reset.valid() && !a.servo.fault_reset_pulse) servo::reset_feedback(*this, a);
-  if (a.hs.mso.valid() || a.hs.msf.valid()) servo::feedback(*this, a);
-  if (a.direct.waiting || a.direct.stop.valid()) direct::feedback(*this, a);
-  if (a.hs.homing) home::feedback(*this, a);
+  hooks::drive_feedback(*this, a);  // the instructions waiting for the drive
   // servo off or homing (or a homing just cancelled): the command follows the actual position
   if (!a.servo.on || a.hs.homing || a.direct.status || a.hs.resync) {
     a.hs.resync = false;
@@ -104,14 +96,13 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
       // "an axis fault also breaks the MDAC link" [seed 000]: the slave's (a
       // stop of all its planned motion, as MAS All); not the slaves' of a
       // master (MAS on a master keeps them)
-      mdac::break_links(*this, a);
+      hooks::break_links(*this, a, false);
       break;
     }
     case ExceptionAction::StopDrive:
       servo_off(a);
       a.servo.faulted = true;
-      mdac::break_links(*this, a);              // an axis fault breaks the MDAC link [seed 000] ...
-      mdac::break_links_of_master(*this, id_of(a));  // ... on the slave and on the master (faulted, as MASD)
+      hooks::break_links(*this, a, true);  // an axis fault breaks the MDAC link [seed 000]: on the slave and on the master (faulted, as MASD)
       break;
     case ExceptionAction::Shutdown:
       do_shutdown(a);
@@ -175,9 +166,8 @@ void Core::read_feedback(const Input& in) noexcept {
     out->shutdown = a.servo.shutdown;
     out->fault_reset = a.servo.fault_reset_pulse;
     out->mode = a.hs.homing ? DriveMode::Homing : DriveMode::CyclicPosition;
-    if (a.direct.status) direct::output(a, *out);  // MDS: CSV or CST
     out->homing_start = a.hs.homing;
-    if (a.hs.homing) home::output(a, *out);
+    if (a.direct.status || a.hs.homing) hooks::drive_output(a, *out);  // MDS: CSV or CST; MAH: the homing objects
   }
   a.servo.fault_reset_pulse = false;
 }
@@ -194,7 +184,7 @@ void Core::step(std::uint64_t new_cycle, Output& out) noexcept {
     step_axis(a, i < out.axes.size() ? &out.axes[i] : nullptr);
     update_status(a);
   }
-  coordsys::update_tags(*this);
+  hooks::cycle_end(*this);  // the coordinate systems' tags
 }
 
 // ------------------------------------------------------------------ status
@@ -223,7 +213,13 @@ void Core::update_status(AxisRt& a) noexcept {
   setb(DecelStatus, a.cmd.v * a.cmd.a < 0);
   setb(TimeCamStatus, std::holds_alternative<CamGen>(a.gen[index(Slot::TimeCam)]));
   setb(TimeCamPendingStatus, a.cams.time.valid());
-  position_cam::status(a, ms);
+  const auto* pc = std::get_if<PosCamGen>(&a.gen[index(Slot::PositionCam)]);
+  setb(PositionCamStatus, pc != nullptr);
+  setb(PositionCamLockStatus, pc && pc->locked && pc->inside && !pc->slipping);
+  setb(PositionCamPendingStatus, a.cams.position.valid());
+  const auto* mo = std::get_if<ProfileGen>(&a.gen[index(Slot::MasterOffset)]);
+  setb(MasterOffsetMoveStatus, mo != nullptr);
+  setb(MasterOffsetMoveLockStatus, mo && mo->master_driven && mo->md.locked && mo->md.following);
   const auto* tc = std::get_if<CamGen>(&a.gen[index(Slot::TimeCam)]);
   setb(TimeCamLockStatus, tc && tc->master_driven && tc->md.lock_status());
   const bool torque_mode = a.cfg.direct_mode == AxisConfig::DirectMode::Torque;

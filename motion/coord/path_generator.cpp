@@ -559,8 +559,8 @@ Err PathGenerator::submit(const MoveRequest& rq, const Present& now, Events& ev)
   const bool contour = rq.termination == Termination::FollowContourVelocityConstrained ||
                        rq.termination == Termination::FollowContourVelocityUnconstrained;
   if (rq.master_driven && contour) return Err::ParameterOutOfRange;  // master-driven blends: TT2, 3, 6
-  if (static_cast<std::uint8_t>(rq.termination) > 6 || (rq.termination == Termination::CommandToleranceProgrammed &&
-                                                        !(rq.command_tolerance >= 0)))
+  if (rq.termination > Termination::CommandToleranceProgrammed ||
+      (rq.termination == Termination::CommandToleranceProgrammed && !(rq.command_tolerance >= 0)))
     return Err::ParameterOutOfRange;
   if (stopping_) return Err::NotAllowedWhileStopping;
   const bool merge = rq.merge != CoordMerge::Disabled && (has_head_ || has_pending_);
@@ -681,7 +681,7 @@ Err PathGenerator::change_dynamics(const DynamicsChange& ch, Events& /*ev*/) noe
   // The active move, also past its PC while it still moves as the head (a
   // TT2/3/6 move paused inside its tolerance must be able to resume).
   const bool head_ok = has_head_;
-  const bool pend_ok = ch.active_and_pending && has_pending_;
+  const bool pend_ok = ch.scope == ChangeScope::ActiveAndPendingMotion && has_pending_;
   auto apply = [&ch](Limits l) noexcept {
     if (ch.change_speed) l.v = ch.values.v;
     if (ch.change_accel) l.a = ch.values.a;

@@ -38,6 +38,9 @@ enum class Termination : std::uint8_t {
 /// MCLM/MCCM Merge (reference 1.3: 0 disabled, 1 coordinated motion, 2 all motion).
 enum class CoordMerge : std::uint8_t { Disabled = 0, CoordinatedMotion = 1, AllMotion = 2 };
 
+/// MCCD Scope: the active move, or the active and the pending one.
+enum class ChangeScope : std::uint8_t { ActiveMotion = 0, ActiveAndPendingMotion = 1 };
+
 /// Configuration of one coordinate system (from the COORDINATE_SYSTEM tag).
 struct SystemConfig {
   int dim = 2;                                     ///< 1..3 member axes
@@ -113,7 +116,7 @@ struct DynamicsChange {
   bool change_accel_jerk = false, change_decel_jerk = false;
   Limits values;               ///< v, a, d, ja, jd for the flagged fields
   bool master_driven = false;  ///< the units' mode (ERR 105 when it differs from the move's)
-  bool active_and_pending = false;  ///< Scope 1
+  ChangeScope scope = ChangeScope::ActiveMotion;
 };
 
 /// Outputs of one cycle.

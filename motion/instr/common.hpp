@@ -1,8 +1,8 @@
 #pragma once
 /// \file motion/instr/common.hpp
-/// What every instruction family header uses: the operand reader, the
-/// planner state types it names (defined in motion/core.hpp), and GenBase,
-/// the part every generator shares.
+/// What every instruction family header uses: the operand reader and the
+/// planner state types it names (defined in motion/core.hpp and
+/// motion/generator.hpp, below the families).
 
 #include "motion/control_tag.hpp"
 #include "motion/operands.hpp"
@@ -14,12 +14,6 @@ namespace canmotion::motion {
 struct Ctx;     // motion/instr/ctx.hpp: one execution of an instruction
 struct Core;    // motion/core.hpp: the planner's state
 struct AxisRt;  // motion/core.hpp: one axis in the planner
-
-/// What every generator has (motion/generator.hpp): its output, an offset
-/// added to the axis command, and the execution that owns it.
-struct GenBase {
-  Kin k{};           ///< position (offset), velocity, acceleration after the last step
-  OwnerRef owner{};  ///< the control tag it writes (IP, PC, ACCEL, DECEL, ...)
-};
+struct ProfileGen;  // motion/generator.hpp: moves, jogs and stop ramps
 
 }  // namespace canmotion::motion

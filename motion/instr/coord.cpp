@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <span>
+#include <string_view>
 
 #include "motion/instr/coord.hpp"
 #include "motion/instr/ctx.hpp"
@@ -18,6 +19,44 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// its speed is refused (ERR 103).
 constexpr double kMinSpeedRatioOnMasterChange = 0.10;
 
+/// True when the signature table numbers `keyword` of operand `operand` of
+/// `I` as `value`: the typed operands below keep the Logix numbers.
+template <Instr I, class E>
+consteval bool numbered(std::string_view operand, std::string_view keyword, E value) {
+  for (const EnumEntry& e : signature(I).operands[static_cast<std::size_t>(op<I>(operand))].enums)
+    if (e.keyword == keyword) return e.value == static_cast<int>(value);
+  return false;
+}
+// MCCM's MoveType, TerminationType and Merge are the same enumerations as MCLM's.
+static_assert(numbered<Instr::MCLM>("MoveType", "absolute", MoveType::Absolute) &&
+              numbered<Instr::MCLM>("MoveType", "incremental", MoveType::Incremental));
+static_assert(numbered<Instr::MCLM>("TerminationType", "actualtolerance", coord::Termination::ActualTolerance) &&
+              numbered<Instr::MCLM>("TerminationType", "nosettle", coord::Termination::NoSettle) &&
+              numbered<Instr::MCLM>("TerminationType", "commandtolerance", coord::Termination::CommandTolerance) &&
+              numbered<Instr::MCLM>("TerminationType", "nodecel", coord::Termination::NoDecel) &&
+              numbered<Instr::MCLM>("TerminationType", "followcontourvelocityconstrained",
+                                    coord::Termination::FollowContourVelocityConstrained) &&
+              numbered<Instr::MCLM>("TerminationType", "followcontourvelocityunconstrained",
+                                    coord::Termination::FollowContourVelocityUnconstrained) &&
+              numbered<Instr::MCLM>("TerminationType", "commandtoleranceprogrammed",
+                                    coord::Termination::CommandToleranceProgrammed));
+static_assert(numbered<Instr::MCLM>("Merge", "disabled", coord::CoordMerge::Disabled) &&
+              numbered<Instr::MCLM>("Merge", "coordinatedmotion", coord::CoordMerge::CoordinatedMotion) &&
+              numbered<Instr::MCLM>("Merge", "allmotion", coord::CoordMerge::AllMotion));
+static_assert(numbered<Instr::MCCM>("CircleType", "via", coord::CircleType::Via) &&
+              numbered<Instr::MCCM>("CircleType", "center", coord::CircleType::Center) &&
+              numbered<Instr::MCCM>("CircleType", "radius", coord::CircleType::Radius) &&
+              numbered<Instr::MCCM>("CircleType", "centerincremental", coord::CircleType::CenterIncremental));
+static_assert(numbered<Instr::MCCM>("Direction", "clockwise", coord::CircleDirection::Clockwise) &&
+              numbered<Instr::MCCM>("Direction", "counterclockwise", coord::CircleDirection::CounterClockwise) &&
+              numbered<Instr::MCCM>("Direction", "clockwisefull", coord::CircleDirection::ClockwiseFull) &&
+              numbered<Instr::MCCM>("Direction", "counterclockwisefull", coord::CircleDirection::CounterClockwiseFull));
+static_assert(numbered<Instr::MCS>("StopType", "all", CoordStopType::All) &&
+              numbered<Instr::MCS>("StopType", "coordinatedmove", CoordStopType::CoordinatedMove) &&
+              numbered<Instr::MCS>("StopType", "coordinatedtransform", CoordStopType::CoordinatedTransform));
+static_assert(numbered<Instr::MCCD>("Scope", "activemotion", coord::ChangeScope::ActiveMotion) &&
+              numbered<Instr::MCCD>("Scope", "activeandpendingmotion", coord::ChangeScope::ActiveAndPendingMotion));
+
 /// Elements of a REAL array operand from its start index to the array's end
 /// (empty for "none" or an index past the end).
 std::span<const double> array_from(const Core& c, std::uint16_t ref, double start) noexcept {
@@ -27,33 +66,16 @@ std::span<const double> array_from(const Core& c, std::uint16_t ref, double star
   return a.subspan(static_cast<std::size_t>(start));
 }
 
-// Speed .. JerkUnits, the same positions in MCLM/MCCM and MCCD's value operands.
-template <Instr I>
-RateOperands decode_dynamics(const Operands& q) noexcept {
-  RateOperands y;
-  y.speed = q.real(op<I>("Speed"));
-  y.speed_units = q.enumeration<SpeedUnits>(op<I>("SpeedUnits"));
-  y.accel = q.real(op<I>("AccelRate"));
-  y.accel_units = q.enumeration<AccelUnits>(op<I>("AccelUnits"));
-  y.decel = q.real(op<I>("DecelRate"));
-  y.decel_units = q.enumeration<AccelUnits>(op<I>("DecelUnits"));
-  y.accel_jerk = q.real(op<I>("AccelJerk"));
-  y.decel_jerk = q.real(op<I>("DecelJerk"));
-  y.jerk_units = q.enumeration<JerkUnits>(op<I>("JerkUnits"));
-  return y;
-}
-
 template <Instr I, class P>
 P decode_move(const Operands& q) noexcept {
   P p;
   p.cs = q.ref(op<I>("CoordinateSystem"));
-  p.incremental = q.number(op<I>("MoveType")) == 1;
+  p.move_type = q.enumeration<MoveType>(op<I>("MoveType"));
   p.position = q.ref(op<I>("Position"));
   p.position_start = q.real(op<I>("Position"));
-  p.dyn = decode_dynamics<I>(q);
-  p.dyn.profile = q.enumeration<ProfileType>(op<I>("Profile"));
-  p.termination = q.number(op<I>("TerminationType"));
-  p.merge = q.number(op<I>("Merge"));
+  p.dyn = read_rates<I>(q);
+  p.termination = q.enumeration<coord::Termination>(op<I>("TerminationType"));
+  p.merge = q.enumeration<coord::CoordMerge>(op<I>("Merge"));
   p.merge_speed = q.enumeration<MergeSpeed>(op<I>("MergeSpeed"));
   p.command_tolerance = q.real(op<I>("CommandTolerance"));
   p.lock_position = q.real(op<I>("LockPosition"));
@@ -62,7 +84,6 @@ P decode_move(const Operands& q) noexcept {
   p.event_distance_start = q.real(op<I>("EventDistance"));
   p.calculated_data = q.ref(op<I>("CalculatedData"));
   p.calculated_data_start = q.real(op<I>("CalculatedData"));
-  p.first_dyn_operand = op<I>("Speed");
   return p;
 }
 
@@ -77,29 +98,6 @@ Err member_checks(const Core& c, const CoordSystemRt& s) noexcept {
     if (g && &c.systems[g->cs] != &s) return Err::ProcessConflict;
   }
   return Err::None;
-}
-
-/// Vector limits of a move or MCCD in coordination units (per second, or
-/// per master unit when master-driven). ERR 94 mixed modes, 13 out of range.
-Err convert_dynamics(Ctx& x, const RateOperands& y, const CoordSystemConfig& cfg, bool scurve, int first,
-                     Limits& lim, bool& md) noexcept {
-  md = is_master_driven(y.speed_units);
-  if (is_master_driven(y.accel_units) != md || is_master_driven(y.decel_units) != md ||
-      (scurve && is_master_driven(y.jerk_units) != md))
-    return Err::MdscUnitsConflict;  // seed 001: Accel, Decel and Jerk in the Speed's units
-  lim.v = units::rate(y.speed, y.speed_units, cfg.max_speed);
-  if (Err e = x.take(units::positive_rate(y.accel, y.accel_units, cfg.max_accel, first + 2), lim.a); e != Err::None)
-    return e;
-  if (Err e = x.take(units::positive_rate(y.decel, y.decel_units, cfg.max_decel, first + 4), lim.d); e != Err::None)
-    return e;
-  lim.ja = lim.jd = kInf;
-  if (!scurve) return Err::None;
-  if (!units::is_jerk_rate(y.jerk_units)) return x.reject_operand(first + 9);
-  const double v = lim.v > 0 ? lim.v : cfg.max_speed;
-  if (Err e = x.take(units::jerk(y.accel_jerk, y.jerk_units, lim.a, v, cfg.max_accel_jerk, first + 7), lim.ja);
-      e != Err::None)
-    return e;
-  return x.take(units::jerk(y.decel_jerk, y.jerk_units, lim.d, v, cfg.max_decel_jerk, first + 8), lim.jd);
 }
 
 /// Seed 001, master change: the pending MDCC's master takes over when this
@@ -122,26 +120,30 @@ Err build_request(Ctx& x, const CoordMoveParams& p, const CoordSystemRt& s, coor
   const std::span<const double> pos = array_from(x.c, p.position, p.position_start);
   if (pos.size() < dim) return x.reject_operand(operand_index(in, "Position"));
   rq.path.kind = p.circle ? coord::PathKind::Circle : coord::PathKind::Line;
-  rq.path.incremental = p.incremental;
+  rq.path.incremental = p.move_type == MoveType::Incremental;
   for (std::size_t i = 0; i < dim; ++i) rq.path.position.c[i] = pos[i];
   if (p.circle) {
     const std::span<const double> aux = array_from(x.c, p.aux, p.aux_start);
-    const std::size_t need = p.circle_type == 2 ? 1 : dim;
+    const std::size_t need = p.circle_type == coord::CircleType::Radius ? 1 : dim;
     if (aux.size() < need) return x.reject_operand(operand_index(in, "Via/Center/Radius"));
     for (std::size_t i = 0; i < need; ++i) rq.path.aux.c[i] = aux[i];
-    rq.path.circle_type = static_cast<coord::CircleType>(p.circle_type);
-    rq.path.direction = static_cast<coord::CircleDirection>(p.direction);
+    rq.path.circle_type = p.circle_type;
+    rq.path.direction = p.direction;
   }
+  // Speed .. JerkUnits in coordination units (the jerks with an S-curve; a
+  // %ofTime jerk of a zero-speed move refers to the system's max speed)
+  units::RateRule rates = units::rule_for(s.cfg, false);  // the system's maxima
+  rates.jerks = p.dyn.profile == ProfileType::SCurve;
+  rates.idle_speed = s.cfg.max_speed;
   bool md = false;
-  const bool scurve = p.dyn.profile == ProfileType::SCurve;
-  if (Err e = convert_dynamics(x, p.dyn, s.cfg, scurve, p.first_dyn_operand, rq.limits, md); e != Err::None) return e;
+  if (Err e = x.check(units::convert_rates(p.dyn, rates, rq.limits, md)); e != Err::None) return e;
   if (md == (p.lock_direction == LockDirection::None)) return Err::MdscLockDirConflict;
   if (md && !s.link.valid() && !s.pending.valid()) return Err::MdscNotActivated;
-  if (p.termination == 6 && !(p.command_tolerance >= 0))
+  if (p.termination == coord::Termination::CommandToleranceProgrammed && !(p.command_tolerance >= 0))
     return x.reject_operand(operand_index(in, "CommandTolerance"));
-  rq.termination = static_cast<coord::Termination>(p.termination);
+  rq.termination = p.termination;
   rq.command_tolerance = p.command_tolerance;
-  rq.merge = static_cast<coord::CoordMerge>(p.merge);
+  rq.merge = p.merge;
   rq.merge_speed = p.merge_speed;
   rq.master_driven = md;
   rq.lock_direction = p.lock_direction;
@@ -187,10 +189,10 @@ MccmParams MccmParams::decode(const Operands& q) noexcept {
   MccmParams p;
   static_cast<CoordMoveParams&>(p) = decode_move<kInstr, CoordMoveParams>(q);
   p.circle = true;
-  p.circle_type = q.number(op<kInstr>("CircleType"));
+  p.circle_type = q.enumeration<coord::CircleType>(op<kInstr>("CircleType"));
   p.aux = q.ref(op<kInstr>("Via/Center/Radius"));
   p.aux_start = q.real(op<kInstr>("Via/Center/Radius"));
-  p.direction = q.number(op<kInstr>("Direction"));
+  p.direction = q.enumeration<coord::CircleDirection>(op<kInstr>("Direction"));
   return p;
 }
 
@@ -199,7 +201,7 @@ McsParams McsParams::decode(const Operands& q) noexcept {
   constexpr Instr I = kInstr;
   McsParams p;
   p.cs = q.ref(op<I>("CoordinateSystem"));
-  p.stop_type = q.number(op<I>("StopType"));
+  p.stop_type = q.enumeration<CoordStopType>(op<I>("StopType"));
   p.change_decel = q.yes(op<I>("ChangeDecel"));
   p.decel = q.real(op<I>("DecelRate"));
   p.decel_units = q.enumeration<AccelUnits>(op<I>("DecelUnits"));
@@ -221,11 +223,11 @@ static Err run(Ctx& x, CoordSystemRt& s, const McsParams& p) noexcept {
                          op<I>("DecelJerk")), jd) != Err::None)
     return Err::ParameterOutOfRange;
   x.tag.set(flag::DN, true);
-  if (p.stop_type == 3) {  // coordinated transform: this project has no transforms
+  if (p.stop_type == CoordStopType::CoordinatedTransform) {  // this project has no transforms
     x.tag.set(flag::PC, true);
     return Err::None;
   }
-  if (p.stop_type == 0) {  // All: the members' single-axis motion too, and the MDCC links
+  if (p.stop_type == CoordStopType::All) {  // the members' single-axis motion too, and the MDCC links
     coordsys::break_links(x.c, s);
     for (int i = 0; i < s.cfg.dim; ++i) {
       AxisRt& a = x.c.axes[s.cfg.axes[static_cast<std::size_t>(i)]];
@@ -264,47 +266,32 @@ MccdParams MccdParams::decode(const Operands& q) noexcept {
   p.change_decel = q.yes(op<I>("ChangeDecel"));
   p.change_accel_jerk = q.yes(op<I>("ChangeAccelJerk"));
   p.change_decel_jerk = q.yes(op<I>("ChangeDecelJerk"));
-  p.dyn = decode_dynamics<I>(q);
-  p.active_and_pending = q.number(op<I>("Scope")) == 1;
+  p.dyn = read_rates<I>(q);
+  p.scope = q.enumeration<coord::ChangeScope>(op<I>("Scope"));
   return p;
 }
 
 static Err run(Ctx& x, CoordSystemRt& s, const MccdParams& p) noexcept {
-  constexpr Instr I = Instr::MCCD;
-  // the units of the changed values: all of one mode (94); the other mode than the move's: 105 (seed 001)
-  bool md = false;
-  if (Err e = units::changed_units_mode(p.change_speed, p.dyn.speed_units, p.change_accel, p.dyn.accel_units,
-                                        p.change_decel, p.dyn.decel_units, p.change_accel_jerk || p.change_decel_jerk,
-                                        p.dyn.jerk_units, md);
-      e != Err::None)
-    return e;
+  // the changed values in coordination units: all of one mode (94; the other
+  // mode than the move's: 105, seed 001); a %ofTime jerk refers to the
+  // system's max accel / decel to the larger of the path's and its max speed
+  const CoordSystemConfig& cfg = s.cfg;
+  units::RateRule rates = units::rule_for(cfg, false);
+  rates.speed = p.change_speed;
+  rates.accel = p.change_accel;
+  rates.decel = p.change_decel;
+  rates.jerks = p.change_accel_jerk || p.change_decel_jerk;
+  rates.accel_jerk = p.change_accel_jerk;
+  rates.decel_jerk = p.change_decel_jerk;
+  rates.ramp = units::JerkRamp{cfg.max_accel, cfg.max_decel, std::max(s.path.speed(), cfg.max_speed)};
   coord::DynamicsChange ch;
+  if (Err e = x.check(units::convert_rates(p.dyn, rates, ch.values, ch.master_driven)); e != Err::None) return e;
   ch.change_speed = p.change_speed;
   ch.change_accel = p.change_accel;
   ch.change_decel = p.change_decel;
   ch.change_accel_jerk = p.change_accel_jerk;
   ch.change_decel_jerk = p.change_decel_jerk;
-  ch.master_driven = md;
-  ch.active_and_pending = p.active_and_pending;
-  const CoordSystemConfig& cfg = s.cfg;
-  const int first = op<I>("Speed");
-  if (p.change_speed) {
-    if (!(p.dyn.speed >= 0)) return x.reject_operand(first);
-    ch.values.v = units::rate(p.dyn.speed, p.dyn.speed_units, cfg.max_speed);
-  }
-  if (p.change_accel && x.take(units::positive_rate(p.dyn.accel, p.dyn.accel_units, cfg.max_accel,
-                                                    op<I>("AccelRate")), ch.values.a) != Err::None)
-    return Err::ParameterOutOfRange;
-  if (p.change_decel && x.take(units::positive_rate(p.dyn.decel, p.dyn.decel_units, cfg.max_decel,
-                                                    op<I>("DecelRate")), ch.values.d) != Err::None)
-    return Err::ParameterOutOfRange;
-  const double v = std::max(s.path.speed(), cfg.max_speed);
-  if (p.change_accel_jerk && x.take(units::jerk(p.dyn.accel_jerk, p.dyn.jerk_units, cfg.max_accel, v,
-                                                cfg.max_accel_jerk, op<I>("AccelJerk")), ch.values.ja) != Err::None)
-    return Err::ParameterOutOfRange;
-  if (p.change_decel_jerk && x.take(units::jerk(p.dyn.decel_jerk, p.dyn.jerk_units, cfg.max_decel, v,
-                                                cfg.max_decel_jerk, op<I>("DecelJerk")), ch.values.jd) != Err::None)
-    return Err::ParameterOutOfRange;
+  ch.scope = p.scope;
   coord::Events ev;
   if (Err e = s.path.change_dynamics(ch, ev); e != Err::None) return e;
   x.tag.set(flag::DN, true);

@@ -1,9 +1,10 @@
 #pragma once
 /// \file motion/instr/coord.hpp
-/// Coordinated family (issue 14, seed 001): the COORDINATE_SYSTEM objects of
-/// the planner, the instructions MCLM, MCCM, MCS, MCSD, MCCD, MDCC
-/// (motion/instr/coord.cpp) and CoordGen, the generator of a member axis's
-/// coordinated slot (motion/instr/coord_system.cpp). The path maths are in
+/// Coordinated family (issue 14, seed 001): the instructions MCLM, MCCM,
+/// MCS, MCSD, MCCD, MDCC on a COORDINATE_SYSTEM (motion/instr/coord.cpp), and
+/// the operations on coordinate systems (motion/instr/coord_system.cpp, with
+/// the step of CoordGen, the generator of a member axis's coordinated slot).
+/// The coordinate system's state is motion/coord_system.hpp, the path maths
 /// motion/coord/ (geometry, PathGenerator). Everything here is noexcept and
 /// allocation-free; all but configure are realtime-safe.
 
@@ -12,111 +13,32 @@
 #include <cstdint>
 
 #include "motion/coord/path_generator.hpp"
+#include "motion/coord_system.hpp"
 #include "motion/instr/common.hpp"
 #include "motion/units.hpp"
 
 namespace canmotion::motion {
 
-enum class Slot : std::uint8_t;
-
-/// Capacity of coordinate systems. Bound: a Logix motion group holds a few
-/// coordinate systems (one per machine section); 8 leaves room, and each is
-/// ~3.5 KB of fixed state.
-inline constexpr std::size_t kMaxCoordSystems = 8;
-/// Index of a coordinate system in the planner (the binder's coordinate_systems id).
-using CoordSystemId = std::uint16_t;
-
-/// Configuration of one COORDINATE_SYSTEM (config `coordinate_systems:`).
-struct CoordSystemConfig {
-  int dim = 0;                                          ///< 1..3 member axes
-  std::array<AxisId, coord::kMaxDim> axes{kNoAxis, kNoAxis, kNoAxis};  ///< members in order
-  std::array<double, coord::kMaxDim> ratio{1.0, 1.0, 1.0};  ///< coordination units per axis unit
-  double max_speed = 0.0, max_accel = 0.0, max_decel = 0.0;  ///< coordination units/s, /s^2 (> 0)
-  double max_accel_jerk = 0.0, max_decel_jerk = 0.0;       ///< /s^3 (0: %ofMaximum jerk refused)
-  double actual_tolerance = 0.0;   ///< Actual Position Tolerance (TT0)
-  double command_tolerance = 0.0;  ///< Command Position Tolerance (TT2)
-};
-
-/// What a program reads of a coordinate system (`CS.*` tags).
-struct CoordSystemTag {
-  std::uint32_t system_status = 0;  ///< CoordinateSystemStatus (coordinate_system_status bits)
-  std::uint32_t motion_status = 0;  ///< CoordinateMotionStatus (coordinate_motion_status bits)
-  std::array<double, coord::kMaxDim> actual_position{};   ///< members' actual positions x ratio
-  std::array<double, coord::kMaxDim> command_position{};  ///< members' command positions x ratio
-  double speed = 0.0;  ///< vector speed of the path (coordination units/s)
-};
-
-/// The MDCC link of a coordinate system (master-driven coordinated control).
-struct MdccLink {
-  AxisId master = kNoAxis;
-  bool use_actual = false;
-  OwnerRef owner{};  ///< the MDCC execution (IP while the link holds)
-  constexpr bool valid() const noexcept { return master != kNoAxis; }
-};
-
-/// One coordinate system in the planner: its path generator, the control
-/// tags of the moves it runs, its MDCC links and its tag.
-struct CoordSystemRt {
-  /// A path move id and the execution it reports to. Bound: the path holds
-  /// an active and a pending move and a stop; 4 leaves one spare.
-  struct Owner {
-    std::uint32_t id = 0;
-    OwnerRef owner{};
-    bool mdcc_ac = false;       ///< master-driven: the MDCC's AC follows this move's AC
-    std::uint16_t cd = 0xFFFF;  ///< CalculatedData REAL[] id (0xFFFF none)
-    std::uint16_t ed = 0xFFFF;  ///< EventDistance REAL[] id
-    double cd_start = 0.0, ed_start = 0.0;
-    bool stop = false;  ///< a path stop (MCS, MAS All, MGS, a member that left), not a move
-  };
-  CoordSystemConfig cfg{};
-  bool present = false;
-  coord::PathGenerator path{};
-  coord::Output out{};
-  CoordSystemTag tag{};
-  std::array<Owner, 4> owners{};
-  std::uint32_t next_id = 1;
-  std::uint64_t stepped = ~std::uint64_t{0};  ///< cycle of the last step (the first member steps it)
-  bool fold_due = false;  ///< the path went idle: fold the generator once the members folded their slots
-  bool dropping = false;  ///< drop() runs (a member's fold must not re-enter it)
-  MdccLink link{};        ///< the master the path follows
-  MdccLink pending{};     ///< an MDCC naming another master: taken at the next MCLM/MCCM (seed 001)
-  bool md_last = false;   ///< the last move that went active was master-driven (mode of the system)
-  double md_speed = 0.0;  ///< its programmed speed (units per master unit; the 10 % rule)
-};
-
-/// Generator of a member axis's coordinated slot: the axis's share of its
-/// coordinate system's path (offset / ratio), stepped once per cycle by the
-/// first member that steps.
-struct CoordGen : GenBase {
-  CoordSystemId cs = 0;
-  std::uint8_t member = 0;
-  AxisId link_master = kNoAxis;  ///< the MDCC master (steps before the members)
-
-  AxisId master() const noexcept { return link_master; }
-  void step(Core& c, AxisRt& a, Slot s) noexcept;
-  void on_fold(Core& c, AxisRt& a) noexcept;
-};
-
 /// MCLM and MCCM (one params type each; `circle` tells them apart).
 struct CoordMoveParams {
   CoordSystemId cs = 0;
   bool circle = false;
-  bool incremental = false;
-  std::uint16_t position = 0xFFFF;  ///< REAL[] id of Position
+  MoveType move_type = MoveType::Absolute;  ///< Absolute or Incremental
+  std::uint16_t position = 0xFFFF;          ///< REAL[] id of Position
   double position_start = 0.0;
-  std::uint8_t circle_type = 0, direction = 0;
+  coord::CircleType circle_type = coord::CircleType::Via;                ///< MCCM
+  coord::CircleDirection direction = coord::CircleDirection::Clockwise;  ///< MCCM
   std::uint16_t aux = 0xFFFF;  ///< REAL[] id of Via/Center/Radius
   double aux_start = 0.0;
   RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
-  std::uint8_t termination = 1;
-  std::uint8_t merge = 0;
+  coord::Termination termination = coord::Termination::NoSettle;
+  coord::CoordMerge merge = coord::CoordMerge::Disabled;
   MergeSpeed merge_speed = MergeSpeed::Programmed;
   double command_tolerance = 0.0;
   double lock_position = 0.0;
   LockDirection lock_direction = LockDirection::None;
   std::uint16_t event_distance = 0xFFFF, calculated_data = 0xFFFF;
   double event_distance_start = 0.0, calculated_data_start = 0.0;
-  int first_dyn_operand = 0;  ///< ST index of Speed (EXERR base)
 };
 struct MclmParams : CoordMoveParams {
   static constexpr Instr kInstr = Instr::MCLM;
@@ -127,10 +49,13 @@ struct MccmParams : CoordMoveParams {
   static MccmParams decode(const Operands& q) noexcept;
 };
 
+/// MCS StopType [RM002H]: the Logix numbers (1 is not used).
+enum class CoordStopType : std::uint8_t { All = 0, CoordinatedMove = 2, CoordinatedTransform = 3 };
+
 struct McsParams {
   static constexpr Instr kInstr = Instr::MCS;
   CoordSystemId cs = 0;
-  std::uint8_t stop_type = 0;  ///< 0 all, 2 coordinated move, 3 coordinated transform
+  CoordStopType stop_type = CoordStopType::All;
   bool change_decel = false, change_decel_jerk = false;
   double decel = 0.0, decel_jerk = 0.0;
   AccelUnits decel_units = AccelUnits::UnitsPerSec2;
@@ -149,8 +74,8 @@ struct MccdParams {
   CoordSystemId cs = 0;
   bool change_speed = false, change_accel = false, change_decel = false;
   bool change_accel_jerk = false, change_decel_jerk = false;
-  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp)
-  bool active_and_pending = false;
+  RateOperands dyn{};  ///< Speed .. JerkUnits (motion/units.hpp); MotionType has one value (coordinated move)
+  coord::ChangeScope scope = coord::ChangeScope::ActiveMotion;
   static MccdParams decode(const Operands& q) noexcept;
 };
 

@@ -24,13 +24,15 @@ struct Ctx {
     exerr = static_cast<std::int8_t>(operand);
     return Err::ParameterOutOfRange;
   }
+  /// The error of a check, or Err::None (EXERR = its operand for ERR 13).
+  Err check(const units::Checked& result) noexcept {
+    if (result.err == Err::ParameterOutOfRange) exerr = static_cast<std::int8_t>(result.operand);
+    return result.err;
+  }
   /// The value of a converted operand into `out`, or its error (EXERR = its
   /// operand for ERR 13).
   Err take(const units::Converted& v, double& out) noexcept {
-    if (!v.ok()) {
-      if (v.err == Err::ParameterOutOfRange) exerr = static_cast<std::int8_t>(v.operand);
-      return v.err;
-    }
+    if (!v.ok()) return check(units::Checked{v.err, v.operand});
     out = v.value;
     return Err::None;
   }

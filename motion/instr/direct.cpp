@@ -9,6 +9,7 @@
 #include <cmath>
 #include <variant>
 
+#include "motion/instr/coord.hpp"
 #include "motion/instr/ctx.hpp"
 
 namespace canmotion::motion {

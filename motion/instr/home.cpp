@@ -1,6 +1,7 @@
 // Home family (motion/instr/home.hpp): MAH and MRP. Realtime-safe.
 #include "motion/instr/home.hpp"
 
+#include "motion/instr/coord.hpp"
 #include "motion/instr/ctx.hpp"
 
 namespace canmotion::motion {

@@ -10,22 +10,6 @@
 
 namespace canmotion::motion {
 
-struct ProfileGen;
-
-/// One MDAC link of a slave (per motion type).
-struct MdacLink {
-  AxisId master = kNoAxis;
-  bool use_actual = false;
-  bool all = false;            ///< set by MDAC MotionType All
-  OwnerRef owner{};            ///< the MDAC execution
-  constexpr bool valid() const noexcept { return master != kNoAxis; }
-};
-
-/// Index of a motion type's link in MdacLinks (AxisRt::links).
-namespace link {
-inline constexpr std::size_t Move = 0, Jog = 1, TimeCam = 2, MasterOffsetMove = 3, Count = 4;
-}
-
 struct MdacParams {
   static constexpr Instr kInstr = Instr::MDAC;
   AxisId slave = kNoAxis, master = kNoAxis;

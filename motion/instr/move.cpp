@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "motion/instr/coord.hpp"
 #include "motion/instr/ctx.hpp"
 #include "motion/instr/mdac.hpp"
 #include "motion/instr/position_cam.hpp"
@@ -16,40 +17,15 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// Positions in the Speed .. LockDirection block relative to Speed, the same
-/// in MAM and MAJ (checked against the signature table below).
-enum DynOperand : int {
-  kSpeed = 0, kSpeedUnits, kAccel, kAccelUnits, kDecel, kDecelUnits, kProfile, kAccelJerk, kDecelJerk,
-  kJerkUnits, kMerge, kMergeSpeed, kLockPosition, kLockDirection
-};
+/// Speed .. LockDirection of MAM or MAJ.
 template <Instr I>
-constexpr bool dynamics_layout() {
-  constexpr const char* kNames[] = {"Speed", "SpeedUnits", "AccelRate", "AccelUnits", "DecelRate", "DecelUnits",
-                                    "Profile", "AccelJerk", "DecelJerk", "JerkUnits", "Merge", "MergeSpeed",
-                                    "LockPosition", "LockDirection"};
-  for (int k = 0; k <= kLockDirection; ++k)
-    if (operand_index(I, kNames[k]) != operand_index(I, "Speed") + k) return false;
-  return true;
-}
-static_assert(dynamics_layout<Instr::MAM>() && dynamics_layout<Instr::MAJ>(), "MAM and MAJ share the dynamics block");
-
-Dynamics read_dynamics(const Operands& q, int s) noexcept {
+Dynamics read_dynamics(const Operands& q) noexcept {
   Dynamics y;
-  y.first_operand = s;
-  y.speed = q.real(s + kSpeed);
-  y.speed_units = q.enumeration<SpeedUnits>(s + kSpeedUnits);
-  y.accel = q.real(s + kAccel);
-  y.accel_units = q.enumeration<AccelUnits>(s + kAccelUnits);
-  y.decel = q.real(s + kDecel);
-  y.decel_units = q.enumeration<AccelUnits>(s + kDecelUnits);
-  y.profile = q.enumeration<ProfileType>(s + kProfile);
-  y.accel_jerk = q.real(s + kAccelJerk);
-  y.decel_jerk = q.real(s + kDecelJerk);
-  y.jerk_units = q.enumeration<JerkUnits>(s + kJerkUnits);
-  y.merge = q.enumeration<Merge>(s + kMerge);
-  y.merge_speed = q.enumeration<MergeSpeed>(s + kMergeSpeed);
-  y.lock_position = q.real(s + kLockPosition);
-  y.lock_direction = q.enumeration<LockDirection>(s + kLockDirection);
+  static_cast<RateOperands&>(y) = read_rates<I>(q);
+  y.merge = q.enumeration<Merge>(op<I>("Merge"));
+  y.merge_speed = q.enumeration<MergeSpeed>(op<I>("MergeSpeed"));
+  y.lock_position = q.real(op<I>("LockPosition"));
+  y.lock_direction = q.enumeration<LockDirection>(op<I>("LockDirection"));
   return y;
 }
 
@@ -72,20 +48,19 @@ struct Dyn {
 /// Seconds (master units, master driven) for Speed, Accel, Decel and (S-curve)
 /// Jerk: all or nothing [RM002H p.447].
 Err decode_extent(Ctx& x, const Dynamics& y, bool md, Dyn& d) noexcept {
-  const int is = y.first_operand;
-  if (!is_extent(y.speed_units, md)) return x.reject_operand(is + kSpeedUnits);
-  if (!is_extent(y.accel_units, md)) return x.reject_operand(is + kAccelUnits);
-  if (!is_extent(y.decel_units, md)) return x.reject_operand(is + kDecelUnits);
-  if (d.scurve && !is_extent(y.jerk_units, md)) return x.reject_operand(is + kJerkUnits);
+  if (!is_extent(y.speed_units, md)) return x.reject_operand(y.at.speed_units);
+  if (!is_extent(y.accel_units, md)) return x.reject_operand(y.at.accel_units);
+  if (!is_extent(y.decel_units, md)) return x.reject_operand(y.at.decel_units);
+  if (d.scurve && !is_extent(y.jerk_units, md)) return x.reject_operand(y.at.jerk_units);
   d.seconds = true;
   d.t_total = y.speed;
   d.t_acc = y.accel;
   d.t_dec = y.decel;
-  if (!(y.speed > 0)) return x.reject_operand(is + kSpeed);
-  if (y.accel + y.decel > y.speed) return x.reject_operand(is + kAccel);
+  if (!(y.speed > 0)) return x.reject_operand(y.at.speed);
+  if (y.accel + y.decel > y.speed) return x.reject_operand(y.at.accel);
   if (d.scurve) {
-    if (!(y.accel_jerk >= 0) || y.accel_jerk > y.accel / 2) return x.reject_operand(is + kAccelJerk);
-    if (!(y.decel_jerk >= 0) || y.decel_jerk > y.decel / 2) return x.reject_operand(is + kDecelJerk);
+    if (!(y.accel_jerk >= 0) || y.accel_jerk > y.accel / 2) return x.reject_operand(y.at.accel_jerk);
+    if (!(y.decel_jerk >= 0) || y.decel_jerk > y.decel / 2) return x.reject_operand(y.at.decel_jerk);
     d.tj_acc = y.accel_jerk;
     d.tj_dec = y.decel_jerk;
   }
@@ -93,47 +68,26 @@ Err decode_extent(Ctx& x, const Dynamics& y, bool md, Dyn& d) noexcept {
 }
 
 Err decode_dynamics(Ctx& x, const Dynamics& y, const AxisConfig& cfg, double last_speed, Dyn& d) noexcept {
-  const int is = y.first_operand;
-  const JerkUnits ju = y.jerk_units;
   d.scurve = y.profile == ProfileType::SCurve;
   d.merge = y.merge == Merge::Enabled;
   d.merge_current = y.merge_speed == MergeSpeed::Current;
-  const bool md = is_master_driven(y.speed_units);
-  if (is_master_driven(y.accel_units) != md || is_master_driven(y.decel_units) != md ||
-      (d.scurve && is_master_driven(ju) != md))
-    return Err::MdscUnitsConflict;
+  units::RateRule rule = units::rule_for(cfg, true);  // the axis' (or the cam master's) maxima
+  rule.jerks = d.scurve;
+  rule.idle_speed = last_speed;  // [RM002H p.447]: a zero-speed S-curve uses the previous non-zero speed (% of time)
+  bool md = false;
+  if (Err e = units::rates_mode(y, rule, md); e != Err::None) return e;
   // LockDirection: none in time-driven mode, not none in master-driven mode [RM002H p.512]
   if (md == (y.lock_direction == LockDirection::None)) return Err::MdscLockDirConflict;
   d.master_driven = md;
   d.lock = y.lock_direction;
   d.lock_pos = y.lock_position;
   if (is_extent(y.speed_units, md) || is_extent(y.accel_units, md) || is_extent(y.decel_units, md) ||
-      (d.scurve && is_extent(ju, md)))
+      (d.scurve && is_extent(y.jerk_units, md)))
     return decode_extent(x, y, md, d);
-  d.speed = units::rate(y.speed, y.speed_units, cfg.max_speed);
-  d.lim.a = units::rate(y.accel, y.accel_units, cfg.max_accel);
-  if (y.decel_units == AccelUnits::PercentOfMaximum && !(cfg.max_decel > 0)) return Err::ZeroMaxDecel;
-  d.lim.d = units::rate(y.decel, y.decel_units, cfg.max_decel);
-  if (!(d.lim.a > 0)) return x.reject_operand(is + kAccel);
-  if (!(d.lim.d > 0)) return x.reject_operand(is + kDecel);
-  d.lim.v = d.speed;
-  d.lim.ja = d.lim.jd = kInf;
-  d.jerk_units = ju;
-  if (!d.scurve) return Err::None;
-  if (!units::is_jerk_rate(ju)) return x.reject_operand(is + kJerkUnits);
-  // [RM002H p.447]: a zero-speed S-curve uses the previous non-zero speed (% of time).
-  const double v = d.speed > 0 ? d.speed : last_speed;
-  if (Err e = x.take(units::jerk(y.accel_jerk, ju, d.lim.a, v, cfg.max_accel_jerk, is + kAccelJerk), d.lim.ja);
-      e != Err::None)
-    return e;
-  if (Err e = x.take(units::jerk(y.decel_jerk, ju, d.lim.d, v, cfg.max_decel_jerk, is + kDecelJerk), d.lim.jd);
-      e != Err::None)
-    return e;
-  if (ju == JerkUnits::PercentOfMaximum) {
-    if (!(cfg.max_decel_jerk > 0)) return Err::ZeroMaxDecelJerk;
-    if (!(cfg.max_accel_jerk > 0)) return x.reject_operand(is + kAccelJerk);
-  }
-  if (is_percent_of_time(ju)) {
+  if (Err e = x.check(units::convert_rates(y, rule, d.lim, md)); e != Err::None) return e;
+  d.speed = d.lim.v;
+  d.jerk_units = y.jerk_units;
+  if (d.scurve && is_percent_of_time(y.jerk_units)) {  // applied again once the start speed is known
     d.jerk_pct_a = y.accel_jerk;
     d.jerk_pct_d = y.decel_jerk;
   }
@@ -252,7 +206,7 @@ void rate_limits(const Dyn& dy, const Kin& start, ProfileGen& g) noexcept {
 
 // ------------------------------------------------------------------ decode
 MajParams MajParams::decode(const Operands& q) noexcept {
-  return {q.ref(op<kInstr>("Axis")), q.yes(op<kInstr>("Direction")), read_dynamics(q, op<kInstr>("Speed"))};
+  return {q.ref(op<kInstr>("Axis")), q.yes(op<kInstr>("Direction")), read_dynamics<kInstr>(q)};
 }
 
 MamParams MamParams::decode(const Operands& q) noexcept {
@@ -260,7 +214,7 @@ MamParams MamParams::decode(const Operands& q) noexcept {
   m.axis = q.ref(op<kInstr>("Axis"));
   m.move_type = q.enumeration<MoveType>(op<kInstr>("MoveType"));
   m.position = q.real(op<kInstr>("Position"));
-  m.dyn = read_dynamics(q, op<kInstr>("Speed"));
+  m.dyn = read_dynamics<kInstr>(q);
   m.event_distance = q.ref(op<kInstr>("EventDistance"));
   m.calculated_data = q.ref(op<kInstr>("CalculatedData"));
   m.event_distance_start = q.real(op<kInstr>("EventDistance"));

@@ -1,62 +1,24 @@
 #pragma once
 /// \file motion/instr/move.hpp
 /// Move family: MAM, MAJ, MCD and the MAM EventDistance / CalculatedData
-/// operands (motion/instr/move.cpp, move_events.cpp), and ProfileGen, the
-/// generator of moves, jogs, master offset moves and stop ramps.
+/// operands (motion/instr/move.cpp, move_events.cpp). Their motion runs in a
+/// ProfileGen (motion/generator.hpp; its end in move.cpp, its step inline in
+/// motion/profile_step.hpp), as do master offset moves and stop ramps.
 
 #include <cstdint>
 
 #include "motion/instr/common.hpp"
-#include "motion/master_follow.hpp"
 #include "motion/units.hpp"
 
 namespace canmotion::motion {
 
-enum class Slot : std::uint8_t;
-
-/// What a profile generator is doing.
-enum class GenRole : std::uint8_t { Move, Jog, Stop };
-
-/// Generator of a profile-driven motion: MAM, MAJ, and the stop ramps of MAS,
-/// MGS and exceptions. O(1) step: one Profile::sample, at time or (master
-/// driven) at master travel.
-struct ProfileGen : GenBase {
-  GenRole role = GenRole::Move;
-  Profile prof{};
-  int hint = 0;
-  std::uint64_t t0_cycle = 0;  ///< profile time = (cycle - t0_cycle) * period
-  double total = 0.0;          ///< move: distance from the generator origin to the target
-  double target_user = 0.0;    ///< move: programmed absolute target (user frame)
-  bool exact_target = false;   ///< move: absolute linear target can be set exactly at the end
-  MoveType move_type = MoveType::Absolute;
-  Limits lim{};
-  bool scurve = false;
-  bool seconds = false;        ///< programmed in seconds (MCD not allowed: ERR 23)
-  double speed = 0.0;          ///< programmed speed (0 = paused until MCD)
-  double jog_velocity = 0.0;   ///< jog: signed programmed velocity
-  std::uint8_t post_stop = 0;  ///< stop ramps of MGS: 0 none, 1 disable, 2 shutdown
-  // master driven (MDSC): the profile's abscissa is master travel md.u, not
-  // time; md as for a master-driven MATC (motion/master_follow.hpp)
-  bool master_driven = false;
-  MasterFollow md{};
-
-  // generator interface (motion/generator.hpp)
-  AxisId master() const noexcept { return master_driven ? md.master : kNoAxis; }
-  /// Defined in motion/instr/move_step.hpp: inline in the cycle.
-  inline void step(Core& c, AxisRt& a, Slot s) noexcept;
-  void on_fold(Core& c, AxisRt& a) noexcept;
-  /// The profile ended (step): PC, folded; a ramp of MGS FastDisable /
-  /// FastShutdown then switches the servo off / shuts the axis down.
-  void finish(Core& c, AxisRt& a, Slot s, ControlTag* t) noexcept;
-};
-
-/// Speed .. LockDirection, laid out identically in MAM and MAJ.
+/// Speed .. LockDirection of MAM and MAJ: the rate operands (converted by
+/// units::convert_rates) and the merge and lock operands.
 struct Dynamics : RateOperands {
   Merge merge = Merge::Disabled;
   MergeSpeed merge_speed = MergeSpeed::Programmed;
   double lock_position = 0.0;
   LockDirection lock_direction = LockDirection::None;
-  int first_operand = 0;         ///< ST index of Speed (EXERR base)
 };
 
 struct MajParams {

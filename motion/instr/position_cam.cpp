@@ -190,26 +190,10 @@ double master_offset(const AxisRt& a) noexcept {
   return pc->offset_base + (o ? o->k : Kin{}).p;
 }
 
-void add_master_offset(AxisRt& a, double d) noexcept {
-  if (auto* pc = std::get_if<PosCamGen>(&a.gen[index(Slot::PositionCam)])) pc->offset_base += d;
-}
-
 void drop_pending(Core& c, AxisRt& a) noexcept {
   if (!a.cams.position.valid()) return;
   if (ControlTag* t = c.tag(a.cams.position.owner)) t->set(flag::IP, false);
   a.cams.position = PendingPosCam{};
-}
-
-void status(const AxisRt& a, std::uint32_t& ms) noexcept {
-  using namespace motion_status;
-  auto setb = [&](unsigned b, bool on) { if (on) ms |= 1u << b; };
-  const auto* pc = std::get_if<PosCamGen>(&a.gen[index(Slot::PositionCam)]);
-  setb(PositionCamStatus, pc != nullptr);
-  setb(PositionCamLockStatus, pc && pc->locked && pc->inside && !pc->slipping);
-  setb(PositionCamPendingStatus, a.cams.position.valid());
-  const auto* o = std::get_if<ProfileGen>(&a.gen[index(Slot::MasterOffset)]);
-  setb(MasterOffsetMoveStatus, o != nullptr);
-  setb(MasterOffsetMoveLockStatus, o && o->master_driven && o->md.locked && o->md.following);
 }
 
 }  // namespace position_cam

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "motion/instr/coord.hpp"
 #include "motion/instr/ctx.hpp"
 #include "motion/instr/direct.hpp"
 #include "motion/instr/home.hpp"

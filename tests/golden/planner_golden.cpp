@@ -30,6 +30,7 @@
 #include "motion/cam/cam_profile.hpp"
 #include "motion/planner.hpp"
 #include "motion/st_parser.hpp"
+#include "tests/motion/golden_util.hpp"
 
 using namespace canmotion::motion;
 
@@ -51,36 +52,9 @@ constexpr std::uint64_t kSeed = 13;
 constexpr int kRuns = 40;
 constexpr int kOpsPerRun = 90;
 
-/// SplitMix64: a fixed, portable sequence.
-struct Rng {
-  std::uint64_t s;
-  std::uint64_t next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uni(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
-  int pick(int n) { return static_cast<int>(next() % static_cast<std::uint64_t>(n)); }
-  bool coin(double p = 0.5) { return uni(0, 1) < p; }
-  template <std::size_t N>
-  const char* of(const std::array<const char*, N>& a) { return a[static_cast<std::size_t>(pick(static_cast<int>(N)))]; }
-};
-
-/// FNV-1a, 64 bit.
-struct Hash {
-  std::uint64_t h = 1469598103934665603ull;
-  void byte(std::uint8_t b) { h = (h ^ b) * 1099511628211ull; }
-  void u64(std::uint64_t v) { for (int i = 0; i < 8; ++i) byte(static_cast<std::uint8_t>(v >> (8 * i))); }
-  void f64(double d) { std::uint64_t v; std::memcpy(&v, &d, 8); u64(v); }
-  void i(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
-};
-
-std::string num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
+using golden::Hash;
+using golden::num;
+using golden::Rng;
 
 /// A drive for the CIP axes: enables after 3 cycles, follows the target with
 /// a one-cycle delay and a first-order lag, runs CSV/CST, homes in 40 cycles,
@@ -489,14 +463,7 @@ TEST(PlannerGolden, RandomSequencesHashAsOnMainBeforeTheRefactor) {
     World w;
     for (int op = 0; op < kOpsPerRun; ++op) {
       std::vector<Request> reqs;
-      if (g.coin(0.25)) {  // back to servo on: fewer refusals for servo off / shutdown
-        const std::string ax = g.of(kAxes);
-        for (const char* ins : {"MASR", "MSO"}) {
-          Request q;
-          if (!parse_and_bind(std::string(ins) + "(" + ax + ",c" + std::to_string(g.pick(kControls)) + ");", w.sym, q))
-            h.i(static_cast<int>(w.p->execute(q)));
-        }
-      }
+      if (g.coin(0.25)) golden::servo_on_again(g, h, *w.p, w.sym, kAxes, kControls);
       const int n = g.coin(0.3) ? 2 : 1;
       for (int k = 0; k < n; ++k) {
         const std::string text = random_call(g, st);

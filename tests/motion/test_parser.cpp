@@ -252,7 +252,9 @@ TEST(Decode, TypedParamsFromTheBoundRequest) {
   EXPECT_EQ(m.dyn.jerk_units, 2);
   EXPECT_EQ(m.dyn.merge, Merge::Enabled);
   EXPECT_EQ(m.dyn.merge_speed, MergeSpeed::Current);
-  EXPECT_EQ(m.dyn.first_operand, 4);
+  EXPECT_EQ(m.dyn.at.speed, 4);  // the rate operands' positions (EXERR) come with them
+  EXPECT_EQ(m.dyn.at.accel, 6);
+  EXPECT_EQ(m.dyn.at.jerk_units, 13);
   EXPECT_EQ(m.event_distance, 1);
   EXPECT_EQ(m.calculated_data, 0xFFFF);
   ASSERT_FALSE(parse_and_bind("MAG(ax1, Ax2, ctl, reverse, 0.5, 1, 3, command, fraction_slave_master_counts, enabled, 20, %ofmaximum);", sym, q));
@@ -274,4 +276,51 @@ TEST(Decode, TypedParamsFromTheBoundRequest) {
   EXPECT_EQ(t.execution_schedule, 1);
   EXPECT_EQ(t.lock_direction, LockDirection::ImmediateForwardOnly);
   EXPECT_TRUE(t.master_driven);
+}
+
+TEST(Decode, CoordinatedOperandsAreTyped) {
+  const Symbols sym = syms();
+  Request q;
+  ASSERT_FALSE(parse_and_bind("MCCM(cs1, ctl, incremental, arr[1], radius, arr[0], counterclockwisefull, 20, "
+                              "%ofmaximum, 30, %ofmaximum, 40, unitspersec2, scurve, 50, 60, %oftime, "
+                              "commandtoleranceprogrammed, allmotion, current, 0.5, 0, none, 0, 0);",
+                              sym, q));
+  const auto c = std::get<MccmParams>(decode(q));
+  EXPECT_TRUE(c.circle);
+  EXPECT_EQ(c.move_type, MoveType::Incremental);
+  EXPECT_EQ(c.circle_type, coord::CircleType::Radius);
+  EXPECT_EQ(c.direction, coord::CircleDirection::CounterClockwiseFull);
+  EXPECT_EQ(c.termination, coord::Termination::CommandToleranceProgrammed);
+  EXPECT_EQ(c.merge, coord::CoordMerge::AllMotion);
+  EXPECT_EQ(c.merge_speed, MergeSpeed::Current);
+  EXPECT_EQ(c.position_start, 1);
+  EXPECT_EQ(c.dyn.speed_units, SpeedUnits::PercentOfMaximum);
+  EXPECT_EQ(c.dyn.decel_units, AccelUnits::UnitsPerSec2);
+  EXPECT_EQ(c.dyn.profile, ProfileType::SCurve);
+  EXPECT_EQ(c.dyn.jerk_units, JerkUnits::PercentOfTime);
+  EXPECT_EQ(c.dyn.at.speed, 7);
+  EXPECT_EQ(c.dyn.at.jerk_units, 16);
+  ASSERT_FALSE(parse_and_bind("MCLM(cs1, ctl, 0, arr, 10, unitspersec, 5, unitspersec2, 5, unitspersec2, trapezoidal, "
+                              "0, 0, unitspersec3, 4, 1, programmed, 0, 0, none, 0, 0);",
+                              sym, q));
+  const auto l = std::get<MclmParams>(decode(q));
+  EXPECT_FALSE(l.circle);
+  EXPECT_EQ(l.move_type, MoveType::Absolute);
+  EXPECT_EQ(l.termination, coord::Termination::FollowContourVelocityConstrained);  // by number
+  EXPECT_EQ(l.merge, coord::CoordMerge::CoordinatedMotion);
+  EXPECT_EQ(l.dyn.at.speed, 4);
+  ASSERT_FALSE(parse_and_bind("MCS(cs1, ctl, coordinatedtransform, yes, 10, %ofmaximum, no, 0, %oftime);", sym, q));
+  EXPECT_EQ(std::get<McsParams>(decode(q)).stop_type, CoordStopType::CoordinatedTransform);
+  ASSERT_FALSE(parse_and_bind("MCCD(cs1, ctl, coordinatedmove, yes, 5, unitspermasterunit, no, 0, unitspersec2, yes, 8, "
+                              "unitspermasterunit2, no, 0, no, 0, unitspersec3, activeandpendingmotion);",
+                              sym, q));
+  const auto d = std::get<MccdParams>(decode(q));
+  EXPECT_TRUE(d.change_speed);
+  EXPECT_FALSE(d.change_accel);
+  EXPECT_TRUE(d.change_decel);
+  EXPECT_EQ(d.scope, coord::ChangeScope::ActiveAndPendingMotion);
+  EXPECT_EQ(d.dyn.speed_units, SpeedUnits::UnitsPerMasterUnit);
+  EXPECT_EQ(d.dyn.decel, 8);
+  EXPECT_EQ(d.dyn.at.accel, 7);  // MCCD's own positions (Change operands between)
+  EXPECT_EQ(d.dyn.at.decel_jerk, 15);
 }

@@ -1,14 +1,15 @@
 #pragma once
-/// \file motion/instr/move_step.hpp
-/// ProfileGen::step, inline: the cycle (motion/cycle.cpp) steps every moving
-/// axis through it, and so builds without link-time optimisation (the tests
-/// and motion_bench) inline it as the product does. Its end (finish) is in
-/// motion/instr/move.cpp. Realtime-safe.
+/// \file motion/profile_step.hpp
+/// ProfileGen::step (motion/generator.hpp), inline: the cycle
+/// (motion/cycle.cpp) steps every moving axis through it, and so builds
+/// without link-time optimisation (the tests and motion_bench) inline it as
+/// the product does. Its end (finish) is in motion/instr/move.cpp, the move
+/// family that starts it. Realtime-safe.
 
 #include <cmath>
 
 #include "motion/core.hpp"
-#include "motion/instr/move.hpp"
+#include "motion/generator.hpp"
 
 namespace canmotion::motion {
 
