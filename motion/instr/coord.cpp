@@ -23,7 +23,11 @@ constexpr double kMinSpeedRatioOnMasterChange = 0.10;
 /// `I` as `value`: the typed operands below keep the Logix numbers.
 template <Instr I, class E>
 consteval bool numbered(std::string_view operand, std::string_view keyword, E value) {
-  for (const EnumEntry& e : signature(I).operands[static_cast<std::size_t>(op<I>(operand))].enums)
+  // operand_index, not op<I>: clang 14 refuses a consteval call on a
+  // parameter of this consteval function (gcc accepts it).
+  const int k = operand_index(I, operand);
+  if (k < 0) return false;
+  for (const EnumEntry& e : signature(I).operands[static_cast<std::size_t>(k)].enums)
     if (e.keyword == keyword) return e.value == static_cast<int>(value);
   return false;
 }
