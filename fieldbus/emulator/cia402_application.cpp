@@ -61,11 +61,6 @@ std::uint16_t Emulator::statusword() const noexcept {
   return sw;
 }
 
-std::int32_t Emulator::position() const noexcept {
-  const double p = round_half_away(pos_);
-  return static_cast<std::int32_t>(std::clamp(p, -2147483648.0, 2147483647.0));
-}
-
 void Emulator::enter_fault(std::uint16_t code, canopen::FrameSink& out) noexcept {
   active_fault_ = code;
   set(obj::kErrorCode, 0, code);

@@ -296,16 +296,6 @@ void Emulator::resolve_hot() noexcept {
   h.slat_delay = mds(cia402::MdsObject::kSlatTimeDelay);
 }
 
-std::int64_t Emulator::sval(const Entry* e) noexcept {
-  if (!e) return 0;
-  // canopen::sign_extend(value, 8 * size) for a signed type, with the sign bit cached (0 otherwise).
-  return static_cast<std::int64_t>((e->value ^ e->sign) - e->sign);
-}
-
-void Emulator::put(Entry* e, std::uint64_t v) noexcept {
-  if (!e) return;
-  e->value = v & e->mask;  // the low `size` bytes (all of v for 0 or 8)
-}
 
 Emulator::Entry* Emulator::find(std::uint16_t index, std::uint8_t sub) noexcept {
   const std::uint32_t k = key(index, sub);

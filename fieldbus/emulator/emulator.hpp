@@ -22,6 +22,7 @@
 /// Not used on the master's RT path; its member functions do not allocate
 /// after construction.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -286,7 +287,9 @@ class Emulator final : public canopen::SdoServerBackend {
   [[nodiscard]] canopen::NmtState nmt_state() const noexcept { return nmt_; }
   [[nodiscard]] cia402::State state() const noexcept { return state_; }
   [[nodiscard]] std::uint16_t statusword() const noexcept;
-  [[nodiscard]] std::int32_t position() const noexcept;
+  [[nodiscard]] std::int32_t position() const noexcept {
+    return static_cast<std::int32_t>(std::clamp(cia402::round_half_away(pos_), -2147483648.0, 2147483647.0));
+  }
   [[nodiscard]] double position_exact() const noexcept { return pos_; }
   [[nodiscard]] double velocity() const noexcept { return vel_; }
   [[nodiscard]] std::int8_t mode_display() const noexcept { return mode_display_; }
@@ -450,8 +453,15 @@ class Emulator final : public canopen::SdoServerBackend {
   Entry* find(std::uint16_t index, std::uint8_t sub) noexcept;
   void resolve_hot() noexcept;  // after build_dictionary(): fills hot_
   static std::uint64_t val(const Entry* e) noexcept { return e ? e->value : 0; }
-  static std::int64_t sval(const Entry* e) noexcept;
-  static void put(Entry* e, std::uint64_t v) noexcept;
+  /// canopen::sign_extend(value, 8 * size) for a signed type, with the sign
+  /// bit cached (0 otherwise); 0 for an absent object.
+  static std::int64_t sval(const Entry* e) noexcept {
+    return e ? static_cast<std::int64_t>((e->value ^ e->sign) - e->sign) : 0;
+  }
+  /// The low `size` bytes of v (all of v for 0 or 8); nothing for an absent object.
+  static void put(Entry* e, std::uint64_t v) noexcept {
+    if (e) e->value = v & e->mask;
+  }
   const Entry* find(std::uint16_t index, std::uint8_t sub) const noexcept;
   bool index_exists(std::uint16_t index) const noexcept;
   std::uint64_t get(std::uint16_t index, std::uint8_t sub = 0) const noexcept;

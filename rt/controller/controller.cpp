@@ -171,23 +171,28 @@ void Controller::record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noe
 
 void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
 
-void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
+// A bus's event (rare): out of line, so that receive() builds no Event in
+// the cycles that have none.
+[[gnu::cold, gnu::noinline]] void Controller::emit_bus_event(std::size_t b, Event::Kind k, std::uint64_t value,
+                                                             can::BusState state) noexcept {
+  Event e;
+  e.kind = k;
+  e.bus = static_cast<std::uint8_t>(b);
+  e.cycle = cycle_index_;
+  e.value = value;
+  e.bus_state = state;
+  emit(e);
+}
+
+// Called once per bus per cycle from cycle() only: inlined there.
+[[gnu::always_inline]] inline void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
   BusRt& bus = buses_[b];
-  auto bus_event = [&](Event::Kind k) noexcept {
-    Event e;
-    e.kind = k;
-    e.bus = static_cast<std::uint8_t>(b);
-    e.cycle = cycle_index_;
-    return e;
-  };
   // Bus events first: a bus-off reported now applies to this cycle's feedback.
   std::array<can::BusEvent, 16>& ev = bus_ev_;
   for (std::size_t n; (n = bus.transport->poll_events(ev)) > 0;) {
     for (std::size_t i = 0; i < n; ++i) {
       if (ev[i].kind == can::BusEvent::Kind::kStateChanged || ev[i].kind == can::BusEvent::Kind::kRestarted) {
-        Event e = bus_event(Event::Kind::kBusState);
-        e.bus_state = ev[i].state;
-        emit(e);
+        emit_bus_event(b, Event::Kind::kBusState, 0, ev[i].state);
       } else if (ev[i].kind == can::BusEvent::Kind::kErrorFrame) {
         // Reported when the classes change, else at most once a second (a
         // bus without ACK sends one error frame per frame sent).
@@ -195,9 +200,7 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
         if (cls != bus.err_classes || now_ns - bus.err_reported_ns >= 1'000'000'000) {
           bus.err_classes = cls;
           bus.err_reported_ns = now_ns;
-          Event e = bus_event(Event::Kind::kBusError);
-          e.value = cls;
-          emit(e);
+          emit_bus_event(b, Event::Kind::kBusError, cls);
         }
       }
     }
@@ -209,7 +212,7 @@ void Controller::receive(std::size_t b, std::int64_t now_ns) noexcept {
     // Back from bus-off: the drives may have faulted or rebooted meanwhile
     // (their watch of the master expired): boot and configure them again.
     bus.network->reboot_all();
-    emit(bus_event(Event::Kind::kBusRecovered));
+    emit_bus_event(b, Event::Kind::kBusRecovered);
   }
   for (std::size_t n; (n = bus.transport->receive(rx_)) > 0;) {
     const bool tracing = trace_on_.load(std::memory_order_relaxed);

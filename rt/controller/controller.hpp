@@ -412,6 +412,8 @@ class Controller {
   void finish_publish() const noexcept;  ///< the copies of publish() that read_status() may defer
   void record(std::uint8_t bus, const can::TimedFrame& f, bool tx) noexcept;
   void emit(const Event& e) noexcept;
+  void emit_bus_event(std::size_t b, Event::Kind k, std::uint64_t value = 0,
+                      can::BusState state = can::BusState::kErrorActive) noexcept;
   void build_arrays();                              ///< controller_arrays.cpp (constructor)
 
   ControllerSpec spec_;

@@ -33,30 +33,45 @@ TEST(RtWatchdog, LogicPingsOnlyWhileTheCounterAdvances) {
 }
 
 TEST(RtWatchdog, ThreadStopsPingingWhenTheCycleStalls) {
+  // The "cycle" advances in the watchdog's own reads while `moving` is set,
+  // so that every check before the stall sees progress and every check
+  // after it sees none, however the test thread is scheduled (the former
+  // version advanced the counter from this thread every 500 us: descheduled
+  // for 2 ms, it caused a stall of its own, and the wait for "the" stall
+  // could then hang).
+  std::atomic<bool> moving{true};
   std::atomic<std::uint64_t> counter{0};
+  std::atomic<std::uint64_t> checks{0};
   std::mutex m;
   std::vector<std::string> sent;
-  WatchdogThread wd([&] { return counter.load(); }, Nanos{2'000'000}, [&](std::string_view s) {
-    std::lock_guard lock(m);
-    sent.emplace_back(s);
-    return 1;
-  });
+  WatchdogThread wd(
+      [&] {
+        checks.fetch_add(1);
+        return moving.load() ? counter.fetch_add(1) + 1 : counter.load();
+      },
+      Nanos{2'000'000}, [&](std::string_view s) {
+        std::lock_guard lock(m);
+        sent.emplace_back(s);
+        return 1;
+      });
+  // Waits on the watchdog thread's progress, polled: the thread runs on the
+  // real clock (its decision logic is tested without one above).
+  auto wait_for = [](auto done) {
+    while (!done()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
   wd.start();
-  // Advance the "cycle" until a few pings went out.
-  while (wd.pings() < 5) {
-    counter.fetch_add(1);
-    std::this_thread::sleep_for(std::chrono::microseconds(500));
-  }
-  // Stall: wait until the watchdog notices, then for a few more checks. (A
-  // descheduled test thread may already have caused a stall: count from here.)
-  const std::uint64_t stalls_before = wd.stalls();
-  while (wd.stalls() == stalls_before) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
+  wait_for([&] { return wd.pings() >= 5; });
+  EXPECT_EQ(wd.stalls(), 0u) << "no stall while the cycle advances";
+  moving = false;
+  wait_for([&] { return wd.stalls() == 1; });
   const std::uint64_t pings_at_stall = wd.pings();
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::uint64_t checks_at_stall = checks.load();
+  wait_for([&] { return checks.load() >= checks_at_stall + 5; });  // five more checks, still stalled
   EXPECT_EQ(wd.pings(), pings_at_stall) << "no ping while stalled";
-  EXPECT_EQ(wd.stalls(), stalls_before + 1);
+  EXPECT_EQ(wd.stalls(), 1u) << "one stall reported once";
+  // The cycle advances again: pings resume.
+  moving = true;
+  wait_for([&] { return wd.pings() > pings_at_stall; });
   wd.stop();
   std::lock_guard lock(m);
   std::size_t status_lines = 0;
@@ -68,7 +83,7 @@ TEST(RtWatchdog, ThreadStopsPingingWhenTheCycleStalls) {
       EXPECT_EQ(s, "WATCHDOG=1");
     }
   }
-  EXPECT_EQ(status_lines, wd.stalls()) << "one STATUS line per stall";
+  EXPECT_EQ(status_lines, 1u) << "one STATUS line per stall";
 }
 
 namespace {
