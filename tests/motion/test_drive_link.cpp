@@ -303,4 +303,25 @@ TEST(DriveWait, PendingMsoEndsWhenTheAxisFaults) {
   EXPECT_FALSE(r.out[0].enable);
 }
 
+// MASD waits on nothing (issue 26 lists it among the drive instructions): on
+// a drive that is still booting it ends with DN in the scan that issues it,
+// ends a pending MSO with ER, and the drive is not enabled.
+TEST(DriveWait, MasdEndsAtOnceWhateverTheDriveDoes) {
+  Rig r;
+  r.add_axis("D", cip());
+  r.fb[0].drive = DriveState::NotReady;
+  r.fb[0].link = DriveLink::Configuring;  // the drive is booting
+  ASSERT_EQ(r.exec("MSO(D, mso);"), Err::None);
+  r.step(3);
+  ASSERT_FALSE(r.tag("mso").dn());
+  ASSERT_EQ(r.exec("MASD(D, sd);"), Err::None);
+  EXPECT_TRUE(r.tag("sd").dn()) << "DN in the scan that issues it";
+  EXPECT_FALSE(r.tag("sd").er());
+  r.step(2);
+  EXPECT_TRUE(r.tag("mso").er()) << "the pending MSO ends with the shutdown";
+  EXPECT_EQ(r.tag("mso").err, 12);
+  EXPECT_EQ(r.axis("D").state, AxisState::Shutdown);
+  EXPECT_FALSE(r.out[0].enable);
+}
+
 }  // namespace
