@@ -128,6 +128,7 @@ void Emulator::power_on(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   fault_cause_syncs_left_ = 0;
   rpdo_short_error_ = rpdo_long_error_ = sync_length_error_ = sync_timeout_error_ = false;
   last_sync_ns_ = -1;
+  last_sync_counter_ = 0;
   rpdo_short_mask_ = rpdo_long_mask_ = 0;
   homing_active_ = homing_done_ = homing_error_ = false;
   homing_phase_ = HomingPhase::kIdle;
@@ -157,6 +158,7 @@ void Emulator::handle_nmt(const can::Frame& f, std::int64_t now_ns, canopen::Fra
     case 0x82:
       reset_dictionary(true);
       last_sync_ns_ = -1;  // 0x1006 back to its default: the SYNC watch starts again
+      last_sync_counter_ = 0;
       sync_timeout_error_ = false;
       sdo_.reset();
       sdo_queue_size_ = 0;
@@ -200,6 +202,16 @@ void Emulator::on_sync_frame(const can::Frame& f, canopen::FrameSink& out) noexc
   if (bad) {
     ++counters_.sync_length_errors;  // not processed
   } else {
+    if (f.len == 1) {
+      // CiA 301 7.2.5: the counter runs 1 .. 0x1019, then starts again at 1.
+      const auto overflow = static_cast<std::uint8_t>(get(0x1019));
+      const std::uint8_t c = f.data[0];
+      const std::uint8_t next = last_sync_counter_ >= overflow ? 1 : static_cast<std::uint8_t>(last_sync_counter_ + 1);
+      if (c == 0 || c > overflow || (last_sync_counter_ != 0 && c != next)) ++counters_.sync_counter_errors;
+      last_sync_counter_ = c;
+    } else {
+      last_sync_counter_ = 0;
+    }
     last_sync_ns_ = now_ns_;
     comm_error(sync_timeout_error_, false, canopen::emcy_code::kCommunication, out);
     handle_sync(now_ns_, out);

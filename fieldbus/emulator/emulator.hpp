@@ -228,6 +228,10 @@ struct EmulatorCounters {
   std::uint64_t boot_ups = 0;
   std::uint64_t rpdo_length_errors = 0;
   std::uint64_t sync_length_errors = 0;     ///< SYNCs dropped for their length (0x1019)
+  /// SYNCs whose counter byte was not the one CiA 301 says comes next: the
+  /// previous + 1, and 1 after the overflow value 0x1019 (or outside 1..0x1019).
+  /// Counted only, the SYNC is processed; the first after a reset is taken as it is.
+  std::uint64_t sync_counter_errors = 0;
   std::uint64_t sync_timeouts = 0;          ///< SYNC watch (0x1006) timeouts, EMCY 8100h
   std::uint64_t refused_fault_resets = 0;   ///< fault resets refused while the cause remained
   std::uint64_t sdo_replies_dropped = 0;    ///< delayed SDO replies lost to a full queue
@@ -611,6 +615,7 @@ class Emulator final : public canopen::SdoServerBackend {
   bool sync_length_error_ = false;          // EMCY 8240h sent, not yet cleared
   bool sync_timeout_error_ = false;         // EMCY 8100h sent (no SYNC for 1.5 x 0x1006), not yet cleared
   std::int64_t last_sync_ns_ = -1;          // the last SYNC processed (-1: none since power-on / reset)
+  std::uint8_t last_sync_counter_ = 0;      // the last SYNC's counter byte (0: none since power-on / reset / 0x1019 change)
   std::uint8_t rpdo_short_mask_ = 0;        // bit p: RPDO p + 1's last frame was short
   std::uint8_t rpdo_long_mask_ = 0;         // bit p: RPDO p + 1's last frame was long
   // TPDO event state (types 0, 254, 255).

@@ -57,7 +57,19 @@ struct Raw {
   int column = 1;
 };
 
-/// Split into statements at `;` outside parentheses, dropping comments.
+/// Does `text` start with the keyword WHILE (any case)?
+bool starts_while(std::string_view text) {
+  std::size_t b = 0;
+  while (b < text.size() && std::isspace(static_cast<unsigned char>(text[b]))) ++b;
+  static constexpr std::string_view kw = "WHILE";
+  if (text.size() < b + kw.size() + 1) return false;
+  for (std::size_t k = 0; k < kw.size(); ++k)
+    if (std::toupper(static_cast<unsigned char>(text[b + k])) != kw[k]) return false;
+  return std::isspace(static_cast<unsigned char>(text[b + kw.size()])) != 0;
+}
+
+/// Split into statements at `;` outside parentheses (and after the DO of a
+/// WHILE), dropping comments.
 std::vector<Raw> split(std::string_view src, const std::string& file) {
   std::vector<Raw> out;
   Raw cur;
@@ -105,6 +117,20 @@ std::vector<Raw> split(std::string_view src, const std::string& file) {
     if (c == ')') {
       if (depth == 0) throw ScriptError(file, line, col, "')' without a matching '('");
       --depth;
+    }
+    // `WHILE cond DO` ends at its DO (ST puts no ';' there): the body's
+    // first statement starts after it.
+    if (started && depth == 0 && (c == 'D' || c == 'd') && i + 1 < src.size() && (src[i + 1] == 'O' || src[i + 1] == 'o') &&
+        (i + 2 == src.size() || std::isspace(static_cast<unsigned char>(src[i + 2])) || src[i + 2] == '/' ||
+         src[i + 2] == '(') &&
+        !cur.text.empty() && std::isspace(static_cast<unsigned char>(cur.text.back())) && starts_while(cur.text)) {
+      cur.text += "DO";
+      out.push_back(cur);
+      cur = Raw{};
+      started = false;
+      advance(c);
+      advance(src[++i]);
+      continue;
     }
     if (c == ';' && depth == 0) {
       if (!started) throw ScriptError(file, line, col, "empty statement (a lone ';')");
@@ -165,7 +191,7 @@ bool keyword(const std::string& u, std::string_view kw) {
          (u.size() == kw.size() || std::isspace(static_cast<unsigned char>(u[kw.size()])));
 }
 
-Condition parse_condition(const std::string& text, const std::string& file, const Raw& r) {
+Condition parse_condition(const std::string& text, const std::string& file, const Raw& r, std::string_view what) {
   Condition c;
   const std::string u = upper(text);
   if (keyword(u, "NOT")) {
@@ -192,16 +218,16 @@ Condition parse_condition(const std::string& text, const std::string& file, cons
       const auto v = number(text.substr(best + len));
       if (!v)
         throw ScriptError(file, r.line, r.column,
-                          fmt::format("WAIT UNTIL: '{}' is not a number (compare a tag with a number: tag >= 5)",
+                          fmt::format("{}: '{}' is not a number (compare a tag with a number: tag >= 5)", what,
                                       trim(text.substr(best + len))));
       c.value = *v;
     }
   }
   if (!is_tag(c.tag))
     throw ScriptError(file, r.line, r.column,
-                      fmt::format("WAIT UNTIL: '{}' is not a tag name (conditions are: tag, NOT tag, or tag "
+                      fmt::format("{}: '{}' is not a tag name (conditions are: tag, NOT tag, or tag "
                                   "<op> number with op one of = <> < <= > >=)",
-                                  c.tag));
+                                  what, c.tag));
   return c;
 }
 
@@ -230,7 +256,7 @@ Statement parse_statement(const Raw& r, const std::string& file) {
         rest = rest.substr(0, to);
       }
       if (trim(rest).empty()) throw ScriptError(file, r.line, r.column, "WAIT UNTIL needs a condition");
-      s.cond = parse_condition(rest, file, r);
+      s.cond = parse_condition(rest, file, r, "WAIT UNTIL");
       return s;
     }
     s.kind = Statement::Kind::kWait;
@@ -241,6 +267,22 @@ Statement parse_statement(const Raw& r, const std::string& file) {
     s.seconds = *t;
     return s;
   }
+  if (keyword(u, "WHILE")) {
+    s.kind = Statement::Kind::kWhile;
+    const std::string ur = upper(s.text);
+    if (ur.size() < 8 || ur.compare(ur.size() - 3, 3, " DO") != 0)
+      throw ScriptError(file, r.line, r.column, "WHILE needs DO after its condition: WHILE cond DO ... END_WHILE;");
+    const std::string cond = trim(s.text.substr(5, s.text.size() - 5 - 3));
+    if (cond.empty()) throw ScriptError(file, r.line, r.column, "WHILE needs a condition: WHILE cond DO ... END_WHILE;");
+    s.cond = parse_condition(cond, file, r, "WHILE");
+    return s;
+  }
+  if (u == "END_WHILE") {
+    s.kind = Statement::Kind::kEndWhile;
+    return s;
+  }
+  if (keyword(u, "DO") || u == "DO")
+    throw ScriptError(file, r.line, r.column, "DO without a WHILE (WHILE cond DO ... END_WHILE;)");
   if (keyword(u, "PRINT")) {
     s.kind = Statement::Kind::kPrint;
     std::string rest = s.text.substr(5);
@@ -284,7 +326,24 @@ Statement parse_statement(const Raw& r, const std::string& file) {
 Script parse(std::string_view text, const std::string& file) {
   Script sc;
   sc.file = file;
-  for (const Raw& r : split(text, file)) sc.statements.push_back(parse_statement(r, file));
+  std::vector<std::size_t> open;  // the WHILEs not yet closed, innermost last
+  for (const Raw& r : split(text, file)) {
+    sc.statements.push_back(parse_statement(r, file));
+    Statement& s = sc.statements.back();
+    const std::size_t at = sc.statements.size() - 1;
+    if (s.kind == Statement::Kind::kWhile) {
+      open.push_back(at);
+    } else if (s.kind == Statement::Kind::kEndWhile) {
+      if (open.empty()) throw ScriptError(file, s.line, s.column, "END_WHILE without a WHILE before it");
+      s.jump = open.back();
+      sc.statements[open.back()].jump = at + 1;
+      open.pop_back();
+    }
+  }
+  if (!open.empty()) {
+    const Statement& w = sc.statements[open.back()];
+    throw ScriptError(file, w.line, w.column, "WHILE is never closed: END_WHILE; is missing");
+  }
   return sc;
 }
 
@@ -294,7 +353,9 @@ Script load(std::string_view text, const std::string& file, ScriptHost& host) {
     std::optional<std::string> err;
     switch (s.kind) {
       case Statement::Kind::kCall: err = host.check_call(s.text); break;
-      case Statement::Kind::kWaitUntil: err = host.check_tag(s.cond.tag, false); break;
+      case Statement::Kind::kWaitUntil:
+      case Statement::Kind::kWhile: err = host.check_tag(s.cond.tag, false); break;
+      case Statement::Kind::kEndWhile: break;
       case Statement::Kind::kPrint:
         for (const auto& t : s.tags)
           if ((err = host.check_tag(t, false))) break;
@@ -416,6 +477,16 @@ Runner::Status Runner::step(double now_s) {
         ++pc_;
         break;
       }
+      case Statement::Kind::kWhile: {
+        std::string e;
+        const auto v = host_.read(s.cond.tag, &e);
+        if (!v) return fail(s, e);
+        pc_ = s.cond.holds(*v) ? pc_ + 1 : s.jump;
+        break;
+      }
+      case Statement::Kind::kEndWhile:
+        pc_ = s.jump;
+        return status_;  // one pass per cycle at most: a loop that waits on nothing cannot hang the step
       case Statement::Kind::kAssign:
         if (auto e = host_.write(s.tags[0], s.value)) return fail(s, *e);
         ++pc_;

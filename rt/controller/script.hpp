@@ -10,6 +10,10 @@
 ///     WAIT 0.5;                              // seconds
 ///     PRINT X.ActualPosition, X.CommandVelocity;
 ///     X.SomeWritableTag := 3;
+///     WHILE Controller.Time < 3600 DO       // same conditions as WAIT UNTIL; nests
+///       MAM(X, mam2, 1, 10, 50, ...);       // (each pass takes at least one cycle)
+///       WAIT UNTIL mam2.PC;
+///     END_WHILE;
 ///
 /// Parsing is not realtime (it allocates). The Runner is stepped once per
 /// cycle by whoever owns the controller's non-RT side (inline in --sim, so
@@ -48,13 +52,14 @@ struct Condition {
 
 /// One statement.
 struct Statement {
-  enum class Kind : std::uint8_t { kCall, kWait, kWaitUntil, kPrint, kAssign };
+  enum class Kind : std::uint8_t { kCall, kWait, kWaitUntil, kPrint, kAssign, kWhile, kEndWhile };
   Kind kind = Kind::kCall;
   int line = 0;
   int column = 0;
   std::string text;                  ///< kCall: the whole call `MAM(...)`; others: the statement as written
   double seconds = 0.0;              ///< kWait; kWaitUntil timeout (0 = none)
-  Condition cond;                    ///< kWaitUntil
+  Condition cond;                    ///< kWaitUntil, kWhile
+  std::size_t jump = 0;              ///< kWhile: the statement after its END_WHILE; kEndWhile: its WHILE
   std::vector<std::string> tags;     ///< kPrint: tags; kAssign: the one tag
   double value = 0.0;                ///< kAssign
 };

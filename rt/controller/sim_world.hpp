@@ -42,6 +42,8 @@ class SimWorld {
   [[nodiscard]] can::SimBus& bus(std::size_t i) noexcept { return *buses_[i].bus; }
   [[nodiscard]] std::size_t drive_count() const noexcept { return drives_.size(); }
   [[nodiscard]] emulator::Emulator& drive(std::size_t i) noexcept { return *drives_[i].emu; }
+  /// The bus (index in add order) drive `i` is attached to.
+  [[nodiscard]] std::size_t drive_bus(std::size_t i) const noexcept { return drives_[i].bus; }
   /// The emulator of `node` on `bus`, or nullptr.
   [[nodiscard]] emulator::Emulator* find_drive(std::size_t bus, std::uint8_t node) noexcept;
   /// Detach a drive (a dead node: it neither receives nor sends any more).

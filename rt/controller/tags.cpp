@@ -4,6 +4,8 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -147,11 +149,25 @@ const Named* find(const std::array<Named, N>& a, std::string_view name) {
   return nullptr;
 }
 
+/// The process's resident set in KiB (/proc/self/statm), 0 when unreadable.
+/// Read on the thread that reads the tag (the script's or the socket's, never
+/// the cycle's).
+double resident_kib() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return 0;
+  unsigned long size = 0, resident = 0;
+  const int n = std::fscanf(f, "%lu %lu", &size, &resident);
+  std::fclose(f);
+  if (n != 2) return 0;
+  return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1024.0;
+}
+
 }  // namespace
 
 TagTable::TagTable(Controller& c) : c_(c) {
   add_statistic("Cycle", [&c] { return static_cast<double>(c.cycles()); });
   add_statistic("Time", [&c] { return static_cast<double>(c.cycles()) * c.period_s(); });
+  add_statistic("RssKiB", [] { return resident_kib(); });
 }
 
 void TagTable::add_statistic(const std::string& name, std::function<double()> get) {

@@ -308,6 +308,37 @@ TEST(EmulatorStrict, SyncLengthCheckedAgainst1019) {
   EXPECT_TRUE(p.sent(0x082).empty());
 }
 
+// The soak (issue 28) checks the master's SYNC counter through this count:
+// 1 .. 0x1019 then 1 again, every step +1; a jump, 0 or a value past 0x1019
+// is counted (the SYNC is still processed); the first after a reset is taken
+// as it is.
+TEST(EmulatorStrict, SyncCounterSequenceChecked) {
+  Drive s(Drive::strict());
+  ASSERT_EQ(s.write(0x1019, 0, 3, 1), 0u);
+  s.start();
+  const auto syncs = s.emu.counters().syncs;
+  for (const char* f : {"080#02", "080#03", "080#01", "080#02", "080#03", "080#01"}) s.sync(f);
+  EXPECT_EQ(s.emu.counters().sync_counter_errors, 0u) << "starts anywhere, wraps after 3";
+  EXPECT_EQ(s.emu.counters().syncs, syncs + 6);
+  s.sync("080#03");  // 2 skipped
+  EXPECT_EQ(s.emu.counters().sync_counter_errors, 1u);
+  s.sync("080#01");  // after 3: 1, fine
+  s.sync("080#01");  // repeated
+  EXPECT_EQ(s.emu.counters().sync_counter_errors, 2u);
+  s.sync("080#04");  // past 0x1019
+  s.sync("080#00");  // 0 is never a counter value
+  EXPECT_EQ(s.emu.counters().sync_counter_errors, 4u);
+  EXPECT_EQ(s.emu.counters().syncs, syncs + 11) << "counted, still processed";
+  s.feed(fbtest::frame("000#8202"));  // reset communication: 0x1019 back to 0, the sequence starts again
+  ASSERT_EQ(s.write(0x1019, 0, 3, 1), 0u);
+  s.start();
+  const auto before = s.emu.counters().syncs;
+  s.sync("080#02");
+  s.sync("080#03");
+  EXPECT_EQ(s.emu.counters().syncs, before + 2);
+  EXPECT_EQ(s.emu.counters().sync_counter_errors, 4u);
+}
+
 TEST(EmulatorStrict, ErrorBehaviour1029OnLostMasterHeartbeat) {
   for (const int behaviour : {0, 1, 2}) {
     SCOPED_TRACE(behaviour);

@@ -108,6 +108,7 @@ TEST(SyncObjects, CounterOnAStrictDriveEverySyncTakenAndMotionFollows) {
   for (const std::uint8_t n : {std::uint8_t{2}, std::uint8_t{3}}) {
     const emulator::EmulatorCounters& k = rig.emulator(n).counters();
     EXPECT_EQ(k.sync_length_errors, dropped[n - 2u]) << int{n};
+    EXPECT_EQ(k.sync_counter_errors, 0u) << "the counter ran 1..10 and wrapped, node " << int{n};
     EXPECT_EQ(k.syncs - taken[n - 2u], rig.cycles() - booted) << "every SYNC since the boot, node " << int{n};
   }
   for (const canopen::NodeEvent& e : events(rig)) {

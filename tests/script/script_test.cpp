@@ -210,6 +210,82 @@ TEST(ScriptLoad, AssignedTagsMayBeReadLater) {
   EXPECT_EQ(r.lines, (std::vector<std::string>{"t=0.001 Target=5"}));
 }
 
+// WHILE cond DO ... END_WHILE; (ST): the condition as in WAIT UNTIL, tested
+// before each pass; loops nest; each pass takes at least one cycle, so a
+// loop that waits on nothing cannot hang a step.
+TEST(ScriptParse, WhileLoopsNestAndJump) {
+  const Script s = parse(
+      "WHILE Speed < 3 DO\n  MSO(X, mso1);\n  while X.ActualPosition do PRINT Speed; END_WHILE;\nEND_WHILE;\nPRINT Speed;",
+      "f");
+  ASSERT_EQ(s.statements.size(), 7u);
+  EXPECT_EQ(s.statements[0].kind, Statement::Kind::kWhile);
+  EXPECT_EQ(s.statements[0].cond.tag, "Speed");
+  EXPECT_EQ(s.statements[0].cond.op, Condition::Op::kLt);
+  EXPECT_EQ(s.statements[0].jump, 6u);  // past its END_WHILE
+  EXPECT_EQ(s.statements[1].line, 2);
+  EXPECT_EQ(s.statements[2].kind, Statement::Kind::kWhile);
+  EXPECT_EQ(s.statements[2].cond.tag, "X.ActualPosition");
+  EXPECT_EQ(s.statements[2].jump, 5u);
+  EXPECT_EQ(s.statements[3].kind, Statement::Kind::kPrint);
+  EXPECT_EQ(s.statements[3].line, 3);
+  EXPECT_EQ(s.statements[3].column, 29);
+  EXPECT_EQ(s.statements[4].kind, Statement::Kind::kEndWhile);
+  EXPECT_EQ(s.statements[4].jump, 2u);
+  EXPECT_EQ(s.statements[5].kind, Statement::Kind::kEndWhile);
+  EXPECT_EQ(s.statements[5].jump, 0u);
+  EXPECT_EQ(s.statements[5].line, 4);
+}
+
+TEST(ScriptParse, WhileErrorsNameLineAndColumn) {
+  auto msg = [](const std::string& text) -> std::string {
+    try {
+      (void)parse(text, "w.script");
+    } catch (const ScriptError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(msg("WAIT 1;\n WHILE Speed DO\nPRINT Speed;"), "w.script:2:2: WHILE is never closed: END_WHILE; is missing");
+  EXPECT_EQ(msg("PRINT Speed;\n  END_WHILE;"), "w.script:2:3: END_WHILE without a WHILE before it");
+  EXPECT_EQ(msg("WHILE Speed;"), "w.script:1:1: WHILE needs DO after its condition: WHILE cond DO ... END_WHILE;");
+  EXPECT_EQ(msg("WHILE DO END_WHILE;"), "w.script:1:1: WHILE needs a condition: WHILE cond DO ... END_WHILE;");
+  EXPECT_NE(msg("WHILE Speed > slow DO END_WHILE;").find("WHILE: 'slow' is not a number"), std::string::npos);
+  // A tag that merely starts with DO does not end the condition.
+  EXPECT_EQ(msg("WHILE DONE DO END_WHILE;"), "accepted");
+}
+
+TEST(ScriptLoad, WhileConditionTagIsChecked) {
+  FakeHost h;
+  try {
+    (void)load("WHILE Nope DO\nEND_WHILE;", "s", h);
+    FAIL();
+  } catch (const ScriptError& e) {
+    EXPECT_STREQ(e.what(), "s:1:1: no tag named 'Nope'");
+  }
+}
+
+TEST(ScriptRunner, WhileRepeatsUntilTheConditionFails) {
+  // Three passes of a body that waits 10 ms; the host's Speed counts passes.
+  ScriptRun r("WHILE Speed < 3 DO WAIT 0.01; PRINT Speed; END_WHILE; PRINT X.ActualPosition;");
+  const auto end = r.until_end(1000, [&](std::uint64_t) {
+    if (!r.lines.empty()) r.host.tags["Speed"] = static_cast<double>(r.lines.size());
+  });
+  EXPECT_EQ(r.runner->status(), Runner::Status::kDone);
+  EXPECT_EQ(r.lines, (std::vector<std::string>{"t=0.010 Speed=0", "t=0.021 Speed=1", "t=0.032 Speed=2",
+                                               "t=0.033 X.ActualPosition=0"}));
+  EXPECT_EQ(end, 33u);
+}
+
+TEST(ScriptRunner, AWhileThatWaitsOnNothingTakesOneCyclePerPass) {
+  ScriptRun r("WHILE NOT mso1.DN DO PRINT Speed; END_WHILE;");
+  const auto end = r.until_end(1000, [&](std::uint64_t c) {
+    if (c == 5) r.host.tags["mso1.DN"] = 1;
+  });
+  EXPECT_EQ(end, 5u);
+  EXPECT_EQ(r.lines.size(), 5u);  // cycles 0..4, one pass each
+  EXPECT_EQ(r.runner->status(), Runner::Status::kDone);
+}
+
 TEST(ScriptFormat, Values) {
   EXPECT_EQ(format_value(3), "3");
   EXPECT_EQ(format_value(-0.5), "-0.5");

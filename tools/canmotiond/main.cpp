@@ -56,6 +56,7 @@ struct Options {
   std::string socket_group;
   bool quiet = false;
   double sim_rate = -1;  // --sim-rate; < 0 = default (1 with --socket, else 0 = flat out)
+  double sim_clock_start = 0;  // --sim-clock-start: the virtual clock's reading at the first cycle, seconds
   bool check_args = false;  // --check-args: parse and validate, then exit (tests/docs)
   std::string write_dcf;    // --write-dcf DIR: one DCF per node of the boot writes, then exit
   std::string histogram;    // --histogram FILE: the wake-up latency histogram at the end (real time)
@@ -287,17 +288,26 @@ void print_summary(const Options& o, config::Runtime& rt, rt::ControllerHost& ho
   const double sim_s = static_cast<double>(s.cycle) * c.period_s();
   fmt::print("summary: {} cycles, {:.3f} s of controller time in {:.3f} s wall ({:.0f}x real time)\n", s.cycle, sim_s,
              wall_s, wall_s > 0 ? sim_s / wall_s : 0.0);
-  if (real_time) {
+  if (real_time)
     fmt::print("summary: wake-up latency max {:.1f} us, p99 {:.1f} us; overruns {}\n", static_cast<double>(st.latency_max_ns) / 1e3,
                static_cast<double>(st.latency_p99_ns) / 1e3, st.overruns);
-    // A SYNC the transport refused is a cycle every drive on that bus missed.
-    for (std::size_t b = 0; b < c.spec().buses.size() && b < s.buses.size(); ++b) {
-      const rt::BusSnapshot& bs = s.buses[b];
-      fmt::print("summary: bus {}: {} SYNCs sent, {} refused by the transport (transmit queue full or bus-off); "
-                 "{} frames refused in all\n",
-                 c.spec().buses[b].name, bs.syncs_sent, bs.syncs_refused, bs.send_rejected);
-    }
+  // A SYNC the transport refused is a cycle every drive on that bus missed.
+  for (std::size_t b = 0; b < c.spec().buses.size() && b < s.buses.size(); ++b) {
+    const rt::BusSnapshot& bs = s.buses[b];
+    fmt::print("summary: bus {}: {} SYNCs sent, {} refused by the transport (transmit queue full or bus-off); "
+               "{} frames refused in all\n",
+               c.spec().buses[b].name, bs.syncs_sent, bs.syncs_refused, bs.send_rejected);
   }
+  // The emulated drives' side (--sim, `interface: sim`): what they received.
+  if (rt.sim)
+    for (std::size_t d = 0; d < rt.sim->drive_count(); ++d) {
+      const emulator::Emulator& e = rt.sim->drive(d);
+      const emulator::EmulatorCounters& k = e.counters();
+      fmt::print("summary: emulated drive node {:>3} on bus {}: {} SYNCs taken ({} counter errors, {} of the wrong length), "
+                 "{} RPDOs, {} TPDOs, {} boot-ups, {} EMCYs\n",
+                 e.node(), c.spec().buses[rt.sim->drive_bus(d)].name, k.syncs, k.sync_counter_errors, k.sync_length_errors,
+                 k.rpdos, k.tpdos, k.boot_ups, k.emcys);
+    }
   for (std::size_t a = 0; a < c.axis_count(); ++a) {
     const rt::AxisSnapshot& x = s.axes[a];
     const auto& cfg = c.axis_spec(static_cast<motion::AxisId>(a)).config;
@@ -506,11 +516,12 @@ class Housekeeping {
 /// between cycles so that runs are deterministic. Every status read (script,
 /// socket, progress) runs on this thread between cycles, so the controller
 /// copies its snapshot only for cycles that are read.
-int run_simulated(config::Runtime& rt, rt::CyclicExecutive& exec, Housekeeping& hk, std::chrono::nanoseconds period) {
+int run_simulated(config::Runtime& rt, rt::CyclicExecutive& exec, Housekeeping& hk, std::chrono::nanoseconds period,
+                  std::int64_t start_ns) {
   rt::Controller& ctl = *rt.controller;
   ctl.set_deferred_publish(true);
   exec.set_cycle([&](const rt::CycleInfo& info) noexcept {
-    const auto t = static_cast<std::int64_t>(info.cycle) * period.count();
+    const auto t = start_ns + static_cast<std::int64_t>(info.cycle) * period.count();
     if (rt.sim) rt.sim->begin_cycle(t);  // null when the configuration has no buses (virtual axes only)
     ctl.cycle(t);
     if (rt.sim) rt.sim->end_cycle(t);
@@ -622,8 +633,10 @@ int run(const Options& o) {
              o.sim ? "simulated, virtual time" : "real time", config::period_ms(ctl.period_s()),
              script ? ", script " + o.script : std::string());
   Housekeeping hk(o, host, exec, *out, server.get(), runner.get());
-  if (rt.sim) rt.sim->power_on(o.sim ? 0 : clock.now().count());  // boot-up frames at the run's start time
-  if (const int e = o.sim ? run_simulated(rt, exec, hk, period) : run_real_time(o, rt, exec, hk, period); e != 0) return e;
+  const auto sim_start_ns = static_cast<std::int64_t>(std::llround(o.sim_clock_start * 1e9));
+  if (rt.sim) rt.sim->power_on(o.sim ? sim_start_ns : clock.now().count());  // boot-up frames at the run's start time
+  if (const int e = o.sim ? run_simulated(rt, exec, hk, period, sim_start_ns) : run_real_time(o, rt, exec, hk, period); e != 0)
+    return e;
 
   // The end: the rest of the outputs, the summary, a script that did not finish.
   int status = hk.status();
@@ -684,6 +697,12 @@ int main(int argc, char** argv) {
                  "with --sim: run at most this many times real time (0 = as fast as possible; default 0, or 1 "
                  "with --socket so that canmotionctl users see motion at its real speed)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--sim-clock-start", o.sim_clock_start,
+                 "with --sim: the virtual clock's reading at the first cycle, in seconds (default 0). The clock the "
+                 "master and the drives see, like CLOCK_MONOTONIC on a machine up that long; the script's and "
+                 "--duration's controller time still start at 0. E.g. 4292000 crosses 2^32 ms after 2967 s")
+      ->check(CLI::Range(0.0, 4.0e9))
+      ->needs(sim);
   app.add_flag("-q,--quiet", o.quiet, "no progress lines or summary");
   app.add_flag("--check-args", o.check_args,
                "parse the arguments, load and check the configuration and the --script, then exit (0 = valid); "
