@@ -72,6 +72,16 @@ struct ScriptRun {
   }
 };
 
+/// parse()'s error message for `text`, or "accepted".
+std::string parse_message(const std::string& text, const std::string& file) {
+  try {
+    (void)parse(text, file);
+  } catch (const ScriptError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 TEST(ScriptParse, StatementsCommentsAndKeywords) {
   const Script s = parse(
       "// header\nMSO(X, mso1);  (* block\n comment *) wait until MSO1.dn timeout 2;\n"
@@ -96,14 +106,7 @@ TEST(ScriptParse, StatementsCommentsAndKeywords) {
 }
 
 TEST(ScriptParse, ErrorsNameLineAndColumn) {
-  auto msg = [](const std::string& text) -> std::string {
-    try {
-      (void)parse(text, "bad.script");
-    } catch (const ScriptError& e) {
-      return e.what();
-    }
-    return "accepted";
-  };
+  auto msg = [](const std::string& text) { return parse_message(text, "bad.script"); };
   EXPECT_EQ(msg("MSO(X, mso1)\n"), "bad.script:1:1: statement 'MSO(X, mso1)' does not end with ';'");
   EXPECT_EQ(msg("WAIT 1;\n  WAIT soon;"), "bad.script:2:3: WAIT needs a number of seconds >= 0 or UNTIL <condition>, got 'soon'");
   EXPECT_EQ(msg("(* open"), "bad.script:1:1: comment '(*' is never closed with '*)'");
@@ -237,14 +240,7 @@ TEST(ScriptParse, WhileLoopsNestAndJump) {
 }
 
 TEST(ScriptParse, WhileErrorsNameLineAndColumn) {
-  auto msg = [](const std::string& text) -> std::string {
-    try {
-      (void)parse(text, "w.script");
-    } catch (const ScriptError& e) {
-      return e.what();
-    }
-    return "accepted";
-  };
+  auto msg = [](const std::string& text) { return parse_message(text, "w.script"); };
   EXPECT_EQ(msg("WAIT 1;\n WHILE Speed DO\nPRINT Speed;"), "w.script:2:2: WHILE is never closed: END_WHILE; is missing");
   EXPECT_EQ(msg("PRINT Speed;\n  END_WHILE;"), "w.script:2:3: END_WHILE without a WHILE before it");
   EXPECT_EQ(msg("WHILE Speed;"), "w.script:1:1: WHILE needs DO after its condition: WHILE cond DO ... END_WHILE;");
