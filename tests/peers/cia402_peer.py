@@ -1121,6 +1121,7 @@ class Runner:
             print(f'cia402_peer: bus: {what} failed: {e}', file=sys.stderr, flush=True)
 
     def bus_ok(self):
+        """A frame went out: the interface is up (again)."""
         if self.bus_error is not None:
             self.bus_error = None
             self.drive.log('bus: frames flow again')
@@ -1134,9 +1135,7 @@ class Runner:
         except can.CanError as e:
             self.bus_failed('recv', e)
             return None
-        if msg is not None:
-            self.bus_ok()
-        return msg
+        return msg    # a frame read is no sign that the interface is up: it may have waited since before it went down
 
     def start(self, now=None):
         if not self.powered:
