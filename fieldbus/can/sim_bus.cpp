@@ -1,6 +1,7 @@
 #include "fieldbus/can/sim_bus.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 
 namespace canmotion::can {
@@ -62,10 +63,26 @@ SimBus::Endpoint::Endpoint(SimBus& bus, std::string name, std::size_t capacity)
   }
 }
 
+[[gnu::cold, gnu::noinline]] void SimBus::Endpoint::link_refused() noexcept {
+  ++counters_.tx_errors;
+  if (!link_down_) {
+    link_down_ = true;
+    push_event(BusEvent{BusEvent::Kind::kLinkDown, bus_.state_, ENETDOWN, bus_.now_ns_});
+  }
+}
+
 SendResult SimBus::Endpoint::send(const Frame& frame) noexcept {
+  if (cut_) [[unlikely]] {
+    link_refused();
+    return SendResult::kError;
+  }
   const SendResult r = bus_.transmit(*this, frame);
   if (r == SendResult::kOk) {
     ++counters_.tx_frames;
+    if (link_down_) [[unlikely]] {
+      link_down_ = false;
+      push_event(BusEvent{BusEvent::Kind::kLinkUp, bus_.state_, 0, bus_.now_ns_});
+    }
   } else {
     ++counters_.tx_errors;
   }

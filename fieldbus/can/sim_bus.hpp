@@ -106,6 +106,16 @@ class SimBus {
       filtered_ = open_ = false;
       update_gate();
     }
+    /// Take this endpoint's interface down or up, as `ip link set can0
+    /// down|up` does to a SocketCAN socket's: while down nothing reaches it
+    /// and send() fails (kError, counted in tx_errors); the first refused
+    /// send reports kLinkDown (detail ENETDOWN) and link_down(), the first
+    /// send that gets out after it is up again kLinkUp. Realtime-safe.
+    void set_link(bool up) noexcept {
+      cut_ = !up;
+      update_gate();
+    }
+    [[nodiscard]] bool link_down() const noexcept override { return link_down_; }
 
    private:
     friend class SimBus;
@@ -115,7 +125,11 @@ class SimBus {
     void push_event(const BusEvent& e) noexcept;
     /// gate_: the set a standard data frame's id must be in to reach the
     /// ring now: accept_ while filtered and not opened, else every id.
-    void update_gate() noexcept { gate_ = filtered_ && !open_ ? accept_.data() : kAllIds.data(); }
+    void update_gate() noexcept {
+      gate_ = cut_ ? kNoIds.data() : (filtered_ && !open_ ? accept_.data() : kAllIds.data());
+    }
+    void link_refused() noexcept;  ///< send() while cut_: out of line (rare)
+    static constexpr IdSet kNoIds{};
     static constexpr IdSet kAllIds = [] {
       IdSet a{};
       for (auto& w : a) w = ~std::uint64_t{0};
@@ -133,6 +147,8 @@ class SimBus {
     BusCounters counters_{};
     bool filtered_ = false;
     bool open_ = false;  ///< an opener was pushed and the ring has not been emptied since
+    bool cut_ = false;        ///< set_link(false): the interface is down
+    bool link_down_ = false;  ///< reported: a send was refused while down, none got out since
     IdSet accept_{};
     IdSet openers_{};
     const std::uint64_t* gate_ = kAllIds.data();

@@ -125,6 +125,7 @@ SendResult SocketCanBus::send(const Frame& frame) noexcept {
   const ssize_t n = ::write(fd_, &kf, sizeof kf);
   if (n == static_cast<ssize_t>(sizeof kf)) {
     ++counters_.tx_frames;
+    if (link_down_) [[unlikely]] set_link_down(false, 0);
     return SendResult::kOk;
   }
   last_errno_ = n < 0 ? errno : EIO;
@@ -133,8 +134,18 @@ SendResult SocketCanBus::send(const Frame& frame) noexcept {
     push_event(BusEvent{BusEvent::Kind::kTxQueueFull, state_, 0, 0});
     return SendResult::kQueueFull;
   }
+  // The interface is down (the kernel's can_send(), or the socket error it
+  // left at NETDEV_DOWN): every send fails the same way until it is up.
+  if (last_errno_ == ENETDOWN) set_link_down(true, ENETDOWN);
   ++counters_.tx_errors;
   return SendResult::kError;
+}
+
+void SocketCanBus::set_link_down(bool down, int err) noexcept {
+  if (down == link_down_) return;
+  link_down_ = down;
+  push_event(BusEvent{down ? BusEvent::Kind::kLinkDown : BusEvent::Kind::kLinkUp, state_,
+                      static_cast<std::uint32_t>(err), 0});
 }
 
 namespace {
@@ -175,7 +186,11 @@ std::size_t SocketCanBus::receive(std::span<TimedFrame> out) noexcept {
     msg.msg_control = ctrl;
     msg.msg_controllen = sizeof ctrl;
     const ssize_t n = ::recvmsg(fd_, &msg, MSG_DONTWAIT);
-    if (n < 0) break;  // EAGAIN: nothing more; other errors are retried next cycle
+    if (n < 0) {  // EAGAIN: nothing more; other errors are retried next cycle
+      // ENETDOWN: the interface went down (the socket's pending error, reported once).
+      if (errno == ENETDOWN) set_link_down(true, ENETDOWN);
+      break;
+    }
     if (static_cast<std::size_t>(n) < sizeof kf) continue;  // CAN FD frame on an FD-enabled socket: not ours
     std::int64_t t_ns = -1;
     std::uint32_t drops = last_kernel_drops_;

@@ -8,6 +8,11 @@
 ///   warning, error passive, bus-off, restarted, other error classes;
 /// - a full transmit queue (ENOBUFS/EAGAIN) is counted and reported as an
 ///   event, never fatal;
+/// - an interface that goes down (`ip link set can0 down`: ENETDOWN on a
+///   write, or once on a read) is reported as kLinkDown and link_down();
+///   the socket stays bound to it, every send still tries it (and fails,
+///   counted in tx_errors), and the first one that gets out after
+///   `ip link set can0 up` reports kLinkUp;
 /// - kernel receive timestamps (SO_TIMESTAMPNS) in TimedFrame::t_ns, on
 ///   CLOCK_MONOTONIC by default: the kernel stamps CAN frames with
 ///   CLOCK_REALTIME, and receive() converts each stamp with the offset
@@ -66,6 +71,7 @@ class SocketCanBus final : public Transport {
   [[nodiscard]] BusState state() const noexcept override { return state_; }
   [[nodiscard]] BusCounters counters() const noexcept override { return counters_; }
   [[nodiscard]] std::string_view name() const noexcept override { return name_; }
+  [[nodiscard]] bool link_down() const noexcept override { return link_down_; }
 
   /// Choose the clock of the receive stamps (default kMonotonic). Not realtime
   /// relevant: call it once after open().
@@ -102,12 +108,14 @@ class SocketCanBus final : public Transport {
   SocketCanBus(int fd, std::string name) noexcept;
   void push_event(const BusEvent& ev) noexcept;
   void set_state(BusState s, std::int64_t t_ns) noexcept;
+  void set_link_down(bool down, int err) noexcept;
 
   int fd_ = -1;
   std::string name_;
   BusState state_ = BusState::kErrorActive;
   BusCounters counters_{};
   int last_errno_ = 0;
+  bool link_down_ = false;  ///< ENETDOWN seen, no frame sent since
   RxClock rx_clock_ = RxClock::kMonotonic;
   std::uint32_t last_kernel_drops_ = 0;
   std::int64_t last_rx_ns_ = 0;  ///< stamp of the last frame received (receive stamps never go back)

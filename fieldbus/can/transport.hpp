@@ -19,7 +19,7 @@ enum class SendResult : std::uint8_t {
   kOk = 0,
   kQueueFull = 1,  ///< transmit queue full (ENOBUFS/EAGAIN): counted, not fatal
   kBusOff = 2,     ///< controller is bus-off; frame dropped
-  kError = 3,      ///< any other failure; see Transport::last_errno()
+  kError = 3,      ///< any other failure (ENETDOWN: the interface is down, see Transport::link_down())
 };
 
 /// Controller error state, from error frames (SocketCAN) or fault injection (SimBus).
@@ -38,6 +38,9 @@ struct BusEvent {
     kTxQueueFull,    ///< a send hit ENOBUFS/EAGAIN
     kRxOverflow,     ///< frames lost in the receive path (kernel drop counter or ring full)
     kErrorFrame,     ///< other error-frame class bits in `detail` (CAN_ERR_* mask)
+    kLinkDown,       ///< the interface is down (`ip link set can0 down`): a send or receive failed
+                     ///< with ENETDOWN, whose value is in `detail`; see Transport::link_down()
+    kLinkUp,         ///< the first frame sent since kLinkDown went out: the interface is up again
   };
   Kind kind = Kind::kStateChanged;
   BusState state = BusState::kErrorActive;
@@ -85,6 +88,11 @@ class Transport {
   [[nodiscard]] virtual BusCounters counters() const noexcept = 0;
   /// Interface name as it appears in traces ("vcan0", "sim0").
   [[nodiscard]] virtual std::string_view name() const noexcept = 0;
+  /// Whether the interface is down: a send (or receive) failed with
+  /// ENETDOWN and no send has succeeded since. send() keeps trying the
+  /// interface (and fails) while it is down; the first frame it gets out
+  /// again ends it (kLinkUp). Realtime-safe.
+  [[nodiscard]] virtual bool link_down() const noexcept { return false; }
 };
 
 }  // namespace canmotion::can

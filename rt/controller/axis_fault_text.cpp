@@ -65,7 +65,7 @@ std::string describe_axis_fault(const Event& e, const AxisSpec& axis, std::size_
       break;
     case K::DriveFault: what = "drive fault (its cause is logged for the drive)"; break;
     case K::NodeLost: what = "node lost (heartbeat lost, or the node left NMT operational)"; break;
-    case K::BusOff: what = "its bus is off"; break;
+    case K::BusOff: what = "its bus is off (bus-off, or its interface down)"; break;
     case K::Count: break;
   }
   const motion::ExceptionAction act = c.action(kind);

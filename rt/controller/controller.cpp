@@ -189,9 +189,15 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   BusRt& bus = buses_[b];
   // Bus events first: a bus-off reported now applies to this cycle's feedback.
   std::array<can::BusEvent, 16>& ev = bus_ev_;
+  bool link_went_down = false, link_came_up = false;
   for (std::size_t n; (n = bus.transport->poll_events(ev)) > 0;) {
     for (std::size_t i = 0; i < n; ++i) {
-      if (ev[i].kind == can::BusEvent::Kind::kStateChanged || ev[i].kind == can::BusEvent::Kind::kRestarted) {
+      if (ev[i].kind == can::BusEvent::Kind::kLinkDown) {
+        link_went_down = true;
+        emit_bus_event(b, Event::Kind::kLinkDown, ev[i].detail);
+      } else if (ev[i].kind == can::BusEvent::Kind::kLinkUp) {
+        link_came_up = true;
+      } else if (ev[i].kind == can::BusEvent::Kind::kStateChanged || ev[i].kind == can::BusEvent::Kind::kRestarted) {
         emit_bus_event(b, Event::Kind::kBusState, 0, ev[i].state);
       } else if (ev[i].kind == can::BusEvent::Kind::kErrorFrame) {
         // Reported when the classes change, else at most once a second (a
@@ -213,6 +219,16 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
     // (their watch of the master expired): boot and configure them again.
     bus.network->reboot_all();
     emit_bus_event(b, Event::Kind::kBusRecovered);
+  }
+  // The interface went down (a send or receive failed with ENETDOWN): the
+  // axes fault as at bus-off, in this cycle even if it is already up again;
+  // once it is up, the drives have missed SYNCs and heartbeats (their watch
+  // of the master may have expired): boot and configure them again.
+  const bool was_down = bus.link_down;
+  bus.link_down = link_went_down || bus.transport->link_down();
+  if (!bus.link_down && (was_down || link_came_up)) [[unlikely]] {
+    bus.network->reboot_all();
+    emit_bus_event(b, Event::Kind::kLinkUp);
   }
   for (std::size_t n; (n = bus.transport->receive(rx_)) > 0;) {
     const bool tracing = trace_on_.load(std::memory_order_relaxed);
@@ -267,7 +283,8 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   } else {
     f.link = motion::DriveLink::Configuring;
   }
-  f.bus_off = buses_[static_cast<std::size_t>(ax.bus)].bus_off;
+  const BusRt& bus = buses_[static_cast<std::size_t>(ax.bus)];
+  f.bus_off = bus.bus_off || bus.link_down;  // nothing reaches the drive either way (exception bus_off)
   // The proxy's view of the homing it started: never a bit left from an
   // earlier homing (DriveProxy::start_homing).
   using HR = cia402::HomingResult;

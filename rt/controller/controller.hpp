@@ -184,6 +184,9 @@ struct Event {
                    ///< `value` = the class bits (SocketCAN CAN_ERR_*); at most once a second per
                    ///< bus unless the classes change
     kBusRecovered, ///< the bus left bus-off: every node of the bus is re-booted (NMT reset node, configuration)
+    kLinkDown,     ///< the bus's interface is down (`ip link set can0 down`): `value` = the errno (ENETDOWN);
+                   ///< its axes see it as bus-off (exception bus_off) until it is up
+    kLinkUp,       ///< the interface is up again: every node of the bus is re-booted, as after bus-off
     kAxisFault,    ///< an axis latched an exception as a fault (its rising edge in AxisTag::exception_faults):
                    ///< `value` = the motion::ExceptionKind, `detail` = the position error (PositionError) or
                    ///< the command position (soft overtravel) in the axis's units; see describe_axis_fault()
@@ -366,6 +369,7 @@ class Controller {
     std::unique_ptr<cia402::DriveNetwork> network;
     std::unique_ptr<canopen::FrameSink> sink;
     bool bus_off = false;
+    bool link_down = false;            ///< the interface is down (Transport::link_down, or kLinkDown this cycle)
     std::uint64_t rejected = 0;
     std::uint32_t err_classes = 0;     ///< error classes reported last (kBusError)
     std::int64_t err_reported_ns = 0;  ///< when

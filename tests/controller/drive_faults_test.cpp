@@ -5,6 +5,7 @@
 // (tests/faults/); the reaction times measured here are in BENCHMARKS.md.
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -754,6 +755,68 @@ TEST(DriveFaults, BusOffFaultsTheAxisAndMasrRecoversOnceTheBusIsBack) {
   r.recover("MASR");
 }
 
+// The controller's interface goes down and up (`ip link set can0 down`, the
+// SimBus endpoint's set_link: every send fails with ENETDOWN, nothing is
+// received). The first refused send (the cycle's RPDO) reports it; in the
+// next cycle the axis faults as at bus-off (bus_off exception: ModuleFault,
+// Shutdown) and kLinkDown names the errno. Every cycle meanwhile tries its
+// SYNC (refused, counted). The first frame that gets out after the interface
+// is up again (kLinkUp) makes the controller re-boot the bus's nodes (NMT
+// reset node, the configuration); MASR, MSO and a move work, canmotiond never
+// restarted (vcan.peer.link_down does the same on a real vcan0).
+TEST(DriveFaults, InterfaceDownFaultsTheAxisAndItsDrivesRebootWhenItIsUp) {
+  FaultRig r([](AxisSpec&, emulator::EmulatorConfig& e) {
+    e.behaviour.boot_ns = 0;
+    e.behaviour.optional_objects_absent = false;  // the drive has 0x1016: it watches the master
+  });
+  auto& link = static_cast<can::SimBus::Endpoint&>(*r.ctl->spec().buses[0].transport);
+  r.enable_and_jog();
+  std::vector<Event> events;
+  r.each_cycle = [&] {
+    Event e;
+    while (r.ctl->pop_event(e))
+      if (e.kind == Event::Kind::kLinkDown || e.kind == Event::Kind::kLinkUp || e.kind == Event::Kind::kBusRecovered)
+        events.push_back(e);
+  };
+  const std::int64_t down_at = r.now;
+  link.set_link(false);
+  ASSERT_TRUE(r.run_until([&] { return module_fault(r.read("X.AxisFault")); }, 100));
+  std::printf("interface down before the cycle of %.0f ms, axis faulted in the cycle of %.0f ms\n", ms(down_at),
+              ms(r.status().time_ns));
+  EXPECT_EQ(r.status().time_ns, down_at + kPeriod) << "not in the cycle after the first refused send";
+  EXPECT_TRUE(link.link_down());
+  EXPECT_EQ(r.read("X.JogStatus"), 0.0);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, Event::Kind::kLinkDown);
+  EXPECT_EQ(events[0].value, static_cast<std::uint64_t>(ENETDOWN));
+  const std::uint64_t sent_before = r.status().buses[0].syncs_sent;
+  const std::uint64_t refused_before = r.status().buses[0].syncs_refused;
+  const std::uint64_t boot_ups = r.world.drive(0).counters().boot_ups;
+  r.cycles(300);  // 3 s: both heartbeat watches expire meanwhile
+  EXPECT_EQ(r.status().buses[0].syncs_sent, sent_before);
+  EXPECT_EQ(r.status().buses[0].syncs_refused, refused_before + 300);
+  EXPECT_EQ(events.size(), 1u) << "the interface down is reported once";
+  EXPECT_TRUE(module_fault(r.read("X.AxisFault")));
+  bool reset_sent = false;
+  r.world.bus(0).set_tap([&](const can::TimedFrame& f, std::string_view) {
+    reset_sent = reset_sent || (f.frame.id == 0 && f.frame.len == 2 && f.frame.data[0] == 0x81 && f.frame.data[1] == kNode);
+  });
+  link.set_link(true);
+  r.step();  // its frames go out again: kLinkUp
+  EXPECT_FALSE(link.link_down());
+  ASSERT_TRUE(r.run_until([&] { return r.axis().phase == cia402::Phase::kOperational; }, 3000))
+      << r.axis().failure.to_string();
+  EXPECT_TRUE(reset_sent) << "no NMT reset node after the interface came back";
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[1].kind, Event::Kind::kLinkUp);
+  EXPECT_EQ(r.world.drive(0).counters().boot_ups, boot_ups + 1) << "the drive was not re-booted";
+  EXPECT_TRUE(module_fault(r.read("X.AxisFault"))) << "the fault stays until MASR";
+  r.each_cycle = nullptr;
+  r.world.bus(0).set_tap(nullptr);
+  r.recover("MASR");
+  EXPECT_EQ(r.read("X.AxisFault"), 0.0);
+}
+
 // Error passive: frames still flow. The state change is reported (an event
 // and the bus status) and nothing else happens: the jog goes on.
 TEST(DriveFaults, ErrorPassiveIsReportedAndMotionGoesOn) {
@@ -947,7 +1010,7 @@ TEST(DriveFaults, AxisFaultTexts) {
             "drive fault (its cause is logged for the drive): Stop Drive (axes[1].exception_actions.drive_fault): motion "
             "stopped, servo off (drive disabled); MAFR clears it, then MSO");
   e.value = static_cast<std::uint64_t>(motion::ExceptionKind::BusOff);
-  EXPECT_EQ(describe_axis_fault(e, a, 2).rfind("its bus is off: Shutdown (axes[2].exception_actions.bus_off)", 0), 0u);
+  EXPECT_EQ(describe_axis_fault(e, a, 2).rfind("its bus is off (bus-off, or its interface down): Shutdown (axes[2].exception_actions.bus_off)", 0), 0u);
 }
 
 }  // namespace

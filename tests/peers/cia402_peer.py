@@ -20,6 +20,7 @@ Run it with the system interpreter (Debian's python3-can): /usr/bin/python3.
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import select
 import signal
@@ -1087,6 +1088,7 @@ class Runner:
         self.powered = powered            # False: no supply, nothing in or out until `power on`
         self.stop = False
         self.sent = 0
+        self.bus_error = None             # the errno of the last failed recv/send, while it lasts (logged once)
 
     def send(self, frames):
         import can   # here, not at the top: the trace checks import this module without python-can
@@ -1098,11 +1100,42 @@ class Runner:
                 try:
                     self.bus.send(msg)
                     self.sent += 1
+                    self.bus_ok()
                     break
                 except can.CanError as e:     # ENOBUFS: the queue is full, retry shortly
+                    if getattr(e, 'error_code', None) == errno.ENETDOWN:
+                        self.bus_failed('send', e)   # the interface is down: the frame is lost, as on a cut cable
+                        break
                     if attempt == 49:
                         print(f'cia402_peer: send 0x{can_id:03X} failed: {e}', file=sys.stderr)
                     time.sleep(0.001)
+
+    def bus_failed(self, what, e):
+        """A recv or send the interface refused (ENETDOWN: `ip link set
+        vcan0 down`): logged once until the bus works again; the drive runs
+        on, as a drive whose cable is cut."""
+        code = getattr(e, 'error_code', None)
+        if self.bus_error != code:
+            self.bus_error = code
+            self.drive.log(f'bus: {what} failed: {e}')
+            print(f'cia402_peer: bus: {what} failed: {e}', file=sys.stderr, flush=True)
+
+    def bus_ok(self):
+        """A frame went out: the interface is up (again)."""
+        if self.bus_error is not None:
+            self.bus_error = None
+            self.drive.log('bus: frames flow again')
+
+    def recv(self, timeout=0):
+        """One frame from the bus, or None; a failed recv (ENETDOWN after
+        the interface went down) is logged, not raised."""
+        import can
+        try:
+            msg = self.bus.recv(timeout=timeout)
+        except can.CanError as e:
+            self.bus_failed('recv', e)
+            return None
+        return msg    # a frame read is no sign that the interface is up: it may have waited since before it went down
 
     def start(self, now=None):
         if not self.powered:
@@ -1127,7 +1160,7 @@ class Runner:
         """Process every frame waiting on the bus, then the timers (which run
         on while silenced: only the frames are dropped)."""
         while True:
-            msg = self.bus.recv(timeout=0)
+            msg = self.recv(timeout=0)
             if msg is None:
                 break
             self.handle(msg, self.clock() if now is None else now)
@@ -1192,7 +1225,7 @@ class Runner:
             fds = [f for f in (bus_fd, control_fd) if f is not None]
             if bus_fd is None:
                 ready = []
-                msg = self.bus.recv(timeout=min(wait, 0.01))
+                msg = self.recv(timeout=min(wait, 0.01))
                 if msg is not None:
                     self.handle(msg, self.clock())
                 if control_fd is not None:
@@ -1207,7 +1240,7 @@ class Runner:
                 # when frames come faster than this process handles them.
                 t_batch = self.clock() + 0.005
                 while self.clock() < t_batch:
-                    msg = self.bus.recv(timeout=0)
+                    msg = self.recv(timeout=0)
                     if msg is None:
                         break
                     self.handle(msg, self.clock())

@@ -557,6 +557,80 @@ class ControlAndCli(PeerCase):
         self.link.runner.command('power on')          # already on: nothing
         self.assertEqual(self.frames(HB), [])
 
+    def test_power_cycle_while_following(self):
+        # A power cycle while following set-points in CSP (vcan.peer.power_cycle):
+        # the drive comes back where the motor stopped, in Switch on disabled
+        # and pre-operational, with nothing enabled and nothing followed until
+        # a master configures and enables it again.
+        self.make(heartbeat_ms=10, position=1000)
+        self.csp()
+        for cw in (0x06, 0x07, 0x0F):
+            self.link.send(RPDO1, struct.pack('<Hi', cw, 1000))
+            self.sync()
+        for k in range(1, 6):
+            self.link.send(RPDO1, struct.pack('<Hi', 0x0F, 1000 + 50 * k))
+            self.sync()
+        self.assertEqual(self.drive.actual, 1200)       # each set-point reached at the next SYNC
+        self.frames(HB)
+        self.link.runner.command('power off')
+        self.link.send(RPDO1, struct.pack('<Hi', 0x0F, 9999))   # not heard: no supply
+        self.sync(3)
+        self.link.runner.command('power on')
+        self.assertEqual([f[2] for f in self.frames(HB)], [b'\x00'])
+        self.assertEqual(self.drive.nmt, peer.PREOPERATIONAL)
+        self.assertEqual(self.drive.state, peer.SWITCH_ON_DISABLED)
+        self.assertEqual(self.sdo.read(0x6064, 0, '<i'), 1200)   # where it stood at power off (1250 not reached)
+        self.assertEqual(self.sdo.read(0x6060, 0, '<b'), 0)      # every default: no mode until written
+
+    def test_interface_down_is_survived(self):
+        # `ip link set vcan0 down` while running (vcan.peer.link_down): every
+        # recv and send fails with ENETDOWN; the peer logs it once, loses
+        # those frames (no retry loop), keeps its timers, and works again
+        # when the interface is back.
+        import can
+        import errno as errno_
+
+        class Cut:
+            def __init__(self, bus):
+                self.bus, self.down = bus, False
+
+            def _check(self, what):
+                if self.down:
+                    raise can.CanOperationError(f'Failed to {what}: Network is down', errno_.ENETDOWN)
+
+            def recv(self, timeout=None):
+                self._check('receive')
+                return self.bus.recv(timeout=timeout)
+
+            def send(self, msg, timeout=None):
+                self._check('transmit')
+                self.bus.send(msg, timeout)
+
+        logs = []
+        self.make(heartbeat_ms=10)
+        self.drive.log = logs.append
+        cut = Cut(self.link.runner.bus)
+        self.link.runner.bus = cut
+        self.frames(HB)
+        cut.down = True
+        import contextlib
+        import io
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            self.link.advance(0.1)                      # ten heartbeats due, all refused
+            self.link.send(0x600 + NODE, struct.pack('<BHB4x', 0x40, 0x1000, 0))   # not received either
+        self.assertEqual(self.frames(HB), [])
+        self.assertEqual(self.frames(0x580 + NODE), [])
+        failed = [m for m in logs if m.startswith('bus:')]
+        self.assertEqual(len(failed), 1, failed)              # once, not per frame
+        self.assertIn('Network is down', failed[0])
+        self.assertEqual(err.getvalue().count('Network is down'), 1)
+        cut.down = False
+        self.link.advance(0.05)
+        self.assertGreaterEqual(len(self.frames(HB)), 4)
+        self.assertIn('bus: frames flow again', logs)
+        self.assertEqual(self.sdo.read(0x1000, 0, '<I'), 0x00020192)
+
     def test_bad_command(self):
         import contextlib
         import io

@@ -3,12 +3,14 @@
 # $CANMOTION_TRACE): canmotiond against the independent peer as separate
 # processes.
 #   vcan-peer-run.sh SCENARIO CANMOTIOND [PEER_OPTION...]
-# SCENARIO is boot_enable_move, fault_recovery, vanish, nmt_preop or
-# boot_late (scenarios/*.script).
+# SCENARIO is boot_enable_move, fault_recovery, vanish, nmt_preop,
+# boot_late, power_cycle, link_down or never_heard (scenarios/*.script).
 # 1. the peer powers up (/usr/bin/python3 cia402_peer.py -i vcan0 -n 5
 #    --position 123456 --heartbeat-ms 100 --control FIFO -v PEER_OPTION...),
 #    then canmotiond
 #    --config vcan.yaml --script scenarios/SCENARIO.script --csv, real time;
+#    never_heard: --config vcan-two.yaml (a second axis, on node 6, where
+#    nothing answers);
 #    boot_late: the peer process starts first but --powered-off (silent);
 # 2. fault_recovery: after canmotiond printed the `X.JogStatus` line, the
 #    peer gets `fault 0xFF00` on its control FIFO; nmt_preop: `nmt preop`
@@ -16,12 +18,16 @@
 #    killed with SIGKILL at that point (the kill time is logged);
 #    boot_late: 0.5 s after canmotiond's first `X.Statusword` line the peer
 #    gets `power on` (boot-up, pre-operational);
+#    power_cycle: after the `X.JogStatus` line the peer gets `power off`,
+#    0.3 s later `power on` (its boot-up while canmotiond has it operational);
+#    link_down: after the `X.JogStatus` line `ip link set vcan0 down`, 1.5 s
+#    later `ip link set vcan0 up` (needs root: the VM's, or a host's);
 # 3. canmotiond's exit status goes to canmotiond.status (vcan_peer_check.py
 #    fails on anything but 0, after its analysis of the trace); then the
 #    peer is stopped (SIGTERM: it prints its summary); run-vcan-test lets
 #    the trace settle. This script fails only when the processes cannot be run.
-# Artefacts: vcan.yaml, canmotiond.log, canmotiond.csv, canmotiond.status,
-# peer.log, events.log.
+# Artefacts: vcan.yaml (never_heard: vcan-two.yaml), canmotiond.log,
+# canmotiond.csv, canmotiond.status, peer.log, events.log.
 set -euo pipefail
 scenario="$1" daemon="$2"; shift 2
 peer_opts=("$@")
@@ -30,7 +36,10 @@ art="$CANMOTION_ARTIFACTS" trace="$CANMOTION_TRACE"
 fail() { echo "vcan-peer-run: $*" >&2; exit 1; }
 script="$here/scenarios/$scenario.script"
 [[ -f "$script" ]] || fail "no scenario '$scenario' ($script)"
-cp "$here/vcan.yaml" "$art/vcan.yaml"
+config=vcan.yaml
+[[ $scenario == never_heard ]] && config=vcan-two.yaml
+rm -f "$art/vcan.yaml" "$art/vcan-two.yaml"
+cp "$here/$config" "$art/$config"
 ctl_dir="$(mktemp -d)"            # VM-local: a FIFO cannot live on the shared build tree, and a log polled there can be seen stale
 ctl="$ctl_dir/peer.ctl"
 rm -f "$art/events.log"
@@ -68,7 +77,7 @@ for ((i = 0; i < 2400; i++)); do
 done
 grep -q "$ready" "$art/peer.log" || { cat "$art/peer.log" >&2; fail "the peer did not start"; }
 event "peer started (pid $ppid_)"
-timeout -s INT -k 30 120 stdbuf -oL "$daemon" --config "$art/vcan.yaml" --script "$script" --csv "$art/canmotiond.csv" \
+timeout -s INT -k 30 120 stdbuf -oL "$daemon" --config "$art/$config" --script "$script" --csv "$art/canmotiond.csv" \
   > "$ctl_dir/canmotiond.log" 2>&1 &
 dpid=$!
 event "canmotiond started (pid $dpid)"
@@ -91,9 +100,20 @@ if [[ $scenario == boot_late ]]; then
     event "no 'X.Statusword=' line from canmotiond (it exited, or 1200 polls): the peer stays off"
   fi
 fi
-if [[ $scenario == fault_recovery || $scenario == vanish || $scenario == nmt_preop ]]; then
+if [[ $scenario == fault_recovery || $scenario == vanish || $scenario == nmt_preop || $scenario == power_cycle ||
+      $scenario == link_down ]]; then
   if wait_line 'X.JogStatus='; then
-    if [[ $scenario == fault_recovery ]]; then
+    if [[ $scenario == power_cycle ]]; then
+      echo 'power off' > "$ctl"
+      event "peer: power off"
+      sleep 0.3
+      echo 'power on' > "$ctl"
+      event "peer: power on"
+    elif [[ $scenario == link_down ]]; then
+      if ip link set vcan0 down; then event "vcan0 down"; else event "ip link set vcan0 down failed"; fi
+      sleep 1.5
+      if ip link set vcan0 up; then event "vcan0 up"; else event "ip link set vcan0 up failed"; fi
+    elif [[ $scenario == fault_recovery ]]; then
       echo 'fault 0xFF00' > "$ctl"
       event "peer: fault 0xFF00 injected"
     elif [[ $scenario == nmt_preop ]]; then

@@ -379,6 +379,180 @@ class Check:
                   f'last TPDO1 position {tp[-1][2]} (want {p0} + 10000)')
         self.item(fault[-1:] == ['0'], 'X.AxisFault 0 after MASR + MSO', f'{fault}')
 
+    def states_from(self, t0, t1=None):
+        """The CiA 402 states the TPDO1s show from t0 on: [(t, state, position)] at each change."""
+        states = []
+        for t, sw, p in self.tpdos(t0, t1):
+            st = state_of(sw)
+            if not states or states[-1][1] != st:
+                states.append((t, st, p))
+        return states
+
+    def event_time(self, regex):
+        m = re.search(rf'^(\d+\.\d+) {regex}', self.read('events.log'), re.M)
+        return float(m.group(1)) if m else None
+
+    def configured_again(self, t_from, name):
+        """After t_from: the configuration (0x6060 = 8, RPDO1/TPDO1 valid
+        again, no abort but the tolerated ones) and the NMT start after it.
+        Returns the NMT start's time, or None."""
+        starts = [f[0] for f in self.t.of(0x000, t_from) if f[2] in (bytes([1, self.a.node]), b'\x01\x00')]
+        t_nmt = starts[0] if starts else None
+        xs = [x for x in self.sdo_transfers() if t_from < x[0] < (t_nmt or float('inf'))]
+        written = {(i, s_): v for _, i, s_, v, c in xs if c == 0}
+        aborts = [x for x in xs if x[4] and not self.tolerated_abort(x)]
+        ok = t_nmt is not None and written.get((0x6060, 0)) == 8 and not aborts and \
+            written.get((0x1400, 1)) == self.RPDO and written.get((0x1800, 1)) == self.TPDO
+        self.item(ok, name, f'{len(xs)} SDO writes, 0x6060 = {written.get((0x6060, 0))}, RPDO1 COB-ID '
+                  f'{written.get((0x1400, 1))}, TPDO1 COB-ID {written.get((0x1800, 1))}, {len(aborts)} aborted; NMT start '
+                  + (f'{1e3 * (t_nmt - t_from):.1f} ms after' if t_nmt else 'none'))
+        return t_nmt if ok else None
+
+    def held_at_enable(self, t_nmt, hold, name):
+        """Re-enable without a jump: from the NMT start until `hold` s after
+        the first TPDO1 in Operation enabled, every RPDO1 target and TPDO1
+        position is the position the drive showed at that NMT start, and the
+        peer's last enable took its first set-point at its position."""
+        states = self.states_from(t_nmt)
+        oe = next((t for t, st, _ in states if st == 'operation enabled'), None)
+        if not self.item(oe is not None, 're-enabled by MSO', ' -> '.join(st for _, st, _ in states[:8]) or 'no TPDO1'):
+            return None
+        p0 = states[0][2]
+        held_t = {p for _, _, p in self.rpdos(t_nmt, oe + hold)}
+        held_p = {p for _, _, p in self.tpdos(t_nmt, oe + hold)}
+        enables = re.findall(r'operation enabled at position (-?\d+), first set-point (-?\d+)', self.peer_log)
+        self.item(held_t <= {p0} and held_p == {p0} and bool(enables) and enables[-1] == (str(p0), str(p0)), name,
+                  f'position {p0} at the NMT start; RPDO1 targets {sorted(held_t)[:6]}, TPDO1 positions '
+                  f'{sorted(held_p)[:6]} until {1e3 * hold:.0f} ms after Operation enabled; peer: {enables[-1:]} '
+                  '(position, first set-point)', around=oe)
+        return p0
+
+    def power_cycle(self, t_start):
+        """power_cycle: the peer is powered off and on while jogging; its
+        boot-up reaches canmotiond with the node operational: the axis
+        faults (unexpected boot-up), the node is configured again at once,
+        nothing enables it until MAFR + MSO, which enable it where it stands."""
+        t_off, t_on = self.event_time('peer: power off'), self.event_time('peer: power on')
+        powered = 'power off: no frames in or out' in self.peer_log and re.search(r': power on$', self.peer_log, re.M)
+        if not self.item(t_off is not None and t_on is not None and bool(powered), 'peer powered off and on',
+                         f'off at {t_off}, on {1e3 * (t_on - t_off):.0f} ms later' if t_off and t_on else 'no events'):
+            return
+        last = [f for f in self.tpdos(t_start) if f[0] < t_off]
+        boot = [f[0] for f in self.t.of(self.HB, t_off) if f[2] == b'\x00']
+        if not self.item(bool(boot), 'boot-up after the power cycle',
+                         f'0x{self.HB:03X}#00 {1e3 * (boot[0] - t_on):.1f} ms after `power on`' if boot else 'none'):
+            return
+        t_boot = boot[0]
+        gap = [f for f in self.t.frames if f[1] in (self.TPDO, self.HB, self.EMCY, self.SDO_RSP) and t_off < f[0] < t_boot]
+        print(f'vcan-peer-check: info: last TPDO1 before the power off: position {last[-1][2] if last else None}; '
+              f'{len(gap)} frame(s) of the peer between `power off` and its boot-up')
+        m = re.search(r'node \d+: unexpected boot-up while operational[^\n]*', self.log)
+        self.item(bool(m), "canmotiond: 'unexpected boot-up while operational'", m.group(0) if m else 'no such message')
+        resets = [f for f in self.t.of(0x000, t_boot) if f[2][0] in (0x81, 0x82)]
+        self.item(not resets, 'no NMT reset after the boot-up', f'{len(resets)} NMT reset(s): the boot-up is enough')
+        t_nmt = self.configured_again(t_boot, 'configured again after the boot-up')
+        fault, enabled = self.printed('X.AxisFault'), self.printed('X.DriveEnableStatus')
+        physical, jog = self.printed('X.PhysicalAxisFault'), self.printed('X.JogStatus')
+        self.item(fault[:2] == ['1', '1'] and enabled[:2] == ['0', '0'] and physical == ['1'] and jog[-1:] == ['0'],
+                  'axis faulted (drive fault), disabled until MAFR',
+                  f'AxisFault {fault}, PhysicalAxisFault {physical}, DriveEnableStatus {enabled}, JogStatus {jog} '
+                  '(at the fault, 3 s later, after MAFR + MSO, 1 s after that)')
+        if t_nmt is None:
+            return
+        enables = re.findall(r'operation enabled at position (-?\d+), first set-point (-?\d+)', self.peer_log)
+        oe = [t for t, st, _ in self.states_from(t_nmt) if st == 'operation enabled']
+        self.item(len(enables) == 2 and len(oe) == 1, 'enabled once after the power cycle (by MSO)',
+                  f'peer: {len(enables)} entries into Operation enabled in all (want 2: the first MSO, the MSO after '
+                  f'MAFR); {len(oe)} in the TPDO1s after the new NMT start')
+        p0 = self.held_at_enable(t_nmt, 0.8, 're-enable without a jump, and still')
+        if p0 is None:
+            return
+        tp = self.tpdos()
+        rp = self.rpdos()
+        self.item(tp[-1][2] == p0 and rp[-1][2] == p0, 'no move after the re-enable',
+                  f'last TPDO1 position {tp[-1][2]}, last RPDO1 target {rp[-1][2]} (want {p0})')
+        got = self.printed('X.ActualPosition')
+        self.item(got[-2:] == [f'{p0 / 1000:g}'] * 2 and enabled[-2:] == ['1', '1'] and fault[-2:] == ['0', '0'],
+                  'X enabled and still after MAFR + MSO', f'ActualPosition {got[-2:]}, DriveEnableStatus '
+                  f'{enabled[-2:]}, AxisFault {fault[-2:]} (want {p0 / 1000:g}, 1, 0)')
+
+    def link_down(self, t_start):
+        """link_down: vcan0 goes down while jogging and up 1.5 s later;
+        canmotiond (not restarted) reports it naming bus and interface, the
+        axis faults; once up, frames flow again, canmotiond re-boots the
+        node (NMT reset node, boot-up, configuration, NMT start); MASR, MSO
+        without a jump, a 10 mm MAM that arrives exactly."""
+        t_down, t_up = self.event_time('vcan0 down'), self.event_time('vcan0 up')
+        if not self.item(t_down is not None and t_up is not None, 'vcan0 down and up',
+                         f'down at {t_down}, up {1e3 * (t_up - t_down):.0f} ms later' if t_down and t_up
+                         else 'events: ' + ' | '.join(self.read('events.log').splitlines()[2:])):
+            return
+        starts = re.findall(r'canmotiond started', self.read('events.log'))
+        self.item(len(starts) == 1, 'canmotiond ran through (not restarted)', f'{len(starts)} start(s)')
+        ts = [f[0] for f in self.t.frames if f[0] > t_start]
+        gaps = sorted(((b - a, a, b) for a, b in zip(ts, ts[1:])), reverse=True)
+        g = gaps[0] if gaps else (0, 0, 0)
+        self.item(g[0] >= 1.0 and g[1] <= t_up and g[2] >= t_down, 'frames stop while vcan0 is down',
+                  f'longest silence {1e3 * g[0]:.0f} ms, from {1e3 * (g[1] - t_down):+.0f} ms to '
+                  f'{1e3 * (g[2] - t_up):+.0f} ms of `ip link set vcan0 down` / `up` returning')
+        t_back = g[2]
+        syncs = self.t.of(self.SYNC, t_back)
+        self.item(len(syncs) > 100, 'SYNC flows again', f'{len(syncs)} SYNC after the silence')
+        m = re.search(r'bus can0: interface vcan0 is down \(ENETDOWN[^\n]*', self.log)
+        self.item(bool(m), "canmotiond: 'interface vcan0 is down (ENETDOWN'", m.group(0) if m else 'no such message')
+        m2 = re.search(r'bus can0: interface vcan0 is up again[^\n]*', self.log)
+        self.item(bool(m2), "canmotiond: 'interface vcan0 is up again'", m2.group(0) if m2 else 'no such message')
+        fault, module, jog = self.printed('X.AxisFault'), self.printed('X.ModuleFault'), self.printed('X.JogStatus')
+        self.item(fault[:1] not in ([], ['0']) and module[:1] == ['1'] and jog[-1:] == ['0'],
+                  'axis faulted (ModuleFault), jog stopped', f'AxisFault {fault}, ModuleFault {module}, JogStatus {jog}')
+        resets = [f[0] for f in self.t.of(0x000, t_back) if f[2] in (bytes([0x81, self.a.node]), b'\x81\x00')]
+        if not self.item(bool(resets), 'NMT reset node once vcan0 is up',
+                         f'{1e3 * (resets[0] - t_back):.1f} ms after the first frame' if resets else 'none'):
+            return
+        boot = [f[0] for f in self.t.of(self.HB, resets[0]) if f[2] == b'\x00']
+        if not self.item(bool(boot), 'boot-up after the reset', f'{1e3 * (boot[0] - resets[0]):.1f} ms after it'
+                         if boot else 'none'):
+            return
+        t_nmt = self.configured_again(boot[0], 'configured again after the boot-up')
+        self.item(self.printed('masr1.DN')[:1] == ['1'], 'MASR DN', f'{self.printed("masr1.DN")}')
+        if t_nmt is None:
+            return
+        p0 = self.held_at_enable(t_nmt, 0.2, 're-enable without a jump')
+        if p0 is None:
+            return
+        tp = self.tpdos()
+        self.item(tp[-1][2] == p0 + 10000, 'MAM after the recovery arrives exactly',
+                  f'last TPDO1 position {tp[-1][2]} (want {p0} + 10000)')
+        self.item(fault[-1:] == ['0'], 'X.AxisFault 0 after MASR + MSO', f'{fault}')
+
+    def never_heard(self):
+        """never_heard: node 6 (axis Y) never answers: canmotiond sends it
+        nothing but its NMT reset node (no SDO, no RPDO), says which node and
+        axis is missing, Y gets ModuleFault and its MSO ERR 11; X was not held up."""
+        n6 = self.a.node + 1
+        to6 = [f for f in self.t.frames if f[1] in (0x600 + n6, 0x200 + n6, 0x300 + n6)]
+        nmt6 = [f[2].hex() for f in self.t.of(0x000) if len(f[2]) == 2 and f[2][1] == n6]
+        from6 = [f for f in self.t.frames if f[1] in (0x080 + n6, 0x180 + n6, 0x280 + n6, 0x580 + n6, 0x700 + n6)]
+        self.item(not to6 and nmt6 == ['81' + f'{n6:02x}'] and not from6, f'node {n6}: nothing past its boot attempts',
+                  f'{len(to6)} SDO/RPDO frames to it, NMT commands to it {nmt6} (want one reset node), '
+                  f'{len(from6)} frames from it')
+        m = re.search(rf'axis Y: node {n6}: no boot-up or heartbeat within[^\n]*', self.log)
+        self.item(bool(m), f"canmotiond: 'axis Y: node {n6}: no boot-up or heartbeat'", m.group(0) if m else 'no such message')
+        yfault, ymodule = self.printed('Y.AxisFault'), self.printed('Y.ModuleFault')
+        er, err = self.printed('mso2.ER'), self.printed('mso2.ERR')
+        self.item(yfault[:1] == ['0'] and ymodule == ['1'] and er == ['1'] and err == ['11'],
+                  'Y: ModuleFault, MSO ends with ERR 11', f'Y.AxisFault {yfault}, Y.ModuleFault {ymodule}, mso2.ER {er}, '
+                  f'mso2.ERR {err}')
+        lines = self.log.splitlines()
+        i_move = next((i for i, ln in enumerate(lines) if 'X.ActualPosition=143.456 X.CommandPosition' in ln), None)
+        i_fail = next((i for i, ln in enumerate(lines) if 'no boot-up or heartbeat' in ln), None)
+        self.item(i_move is not None and i_fail is not None and i_move < i_fail, 'X moved while Y was still booting',
+                  'the MAM of X ended before the failure of Y was logged' if i_move is not None and i_fail is not None
+                  and i_move < i_fail else f'log lines: move {i_move}, failure {i_fail}')
+        fault = self.printed('X.AxisFault')
+        self.item(fault[-1:] == ['0'] and self.printed('X.DriveEnableStatus')[-1:] == ['1'], 'X still enabled, no fault',
+                  f'X.AxisFault {fault}, X.DriveEnableStatus {self.printed("X.DriveEnableStatus")}')
+
     def vanish(self, t_start):
         peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
         killed = re.search(r'^(\d+\.\d+) peer killed', self.read('events.log'), re.M)
@@ -419,7 +593,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0],
                                  epilog='Environment: CANMOTION_TRACE, CANMOTION_ARTIFACTS, CANMOTION_BUILD_DIR '
                                         '(run-vcan-test); PEER_SYNC_MEAN_MAX (1.5), PEER_VANISH_SLACK_MS (100).')
-    ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish', 'nmt_preop', 'boot_late'))
+    ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish', 'nmt_preop', 'boot_late',
+                                         'power_cycle', 'link_down', 'never_heard'))
     ap.add_argument('--period-ms', type=float, default=10.0)
     ap.add_argument('--node', type=int, default=5)
     ap.add_argument('--start', type=int, default=123456, help='the peer\'s --position')
@@ -431,17 +606,23 @@ def main():
         c.live_boot()
     t_start = c.boot()
     if t_start is not None:
-        oe = c.enable(t_start, 0.4 if a.scenario in ('boot_enable_move', 'boot_late') else 0.0)
-        if a.scenario in ('boot_enable_move', 'boot_late'):
+        oe = c.enable(t_start, 0.4 if a.scenario in ('boot_enable_move', 'boot_late', 'never_heard') else 0.0)
+        if a.scenario in ('boot_enable_move', 'boot_late', 'never_heard'):
             got, want = c.printed('X.ActualPosition'), f'{a.start / 1000:g}'
             c.item(got[:1] == [want], 'X.ActualPosition after MSO', f'{got[:1]} (want {want})')
             c.sync_period(t_start)
             if oe is not None:
                 c.move(a.start, 20000)
+            if a.scenario == 'never_heard':
+                c.never_heard()
         elif a.scenario == 'fault_recovery':
             c.fault_recovery(t_start)
         elif a.scenario == 'nmt_preop':
             c.nmt_preop(t_start)
+        elif a.scenario == 'power_cycle':
+            c.power_cycle(t_start)
+        elif a.scenario == 'link_down':
+            c.link_down(t_start)
         else:
             c.vanish(t_start)
     print(f"vcan-peer-check: {a.scenario}: {'FAIL (' + ', '.join(c.failed) + ')' if c.failed else 'PASS'}")

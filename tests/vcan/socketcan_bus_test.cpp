@@ -3,9 +3,14 @@
 #include <gtest/gtest.h>
 #include <linux/can/error.h>
 
+#include <net/if.h>
+#include <sys/ioctl.h>
 #include <time.h>
 
 #include <array>
+#include <cerrno>
+#include <cstring>
+#include <vector>
 
 #include "fieldbus/can/socketcan_bus.hpp"
 
@@ -145,6 +150,71 @@ TEST_F(ReceiveStamps, RealtimeOnRequest) {
   round_trip(CLOCK_REALTIME, before, stamp, after);
   EXPECT_GE(stamp, before - 1'000'000);
   EXPECT_LE(stamp, after + 1'000'000);
+}
+
+// `ip link set vcan0 down` while the bus is open, then up (vcan.peer.link_down
+// does it under canmotiond): every send fails with ENETDOWN, reported once as
+// kLinkDown and link_down(); the socket stays bound, and the first send after
+// the interface is up again gets out (kLinkUp) and reaches the other socket.
+// Needs CAP_NET_ADMIN (the VM's root): skipped without it.
+class LinkDown : public ReceiveStamps {
+ protected:
+  /// Set vcan0's IFF_UP (SIOCSIFFLAGS, on the bus's own socket); errno or 0.
+  int set_up(bool up) {
+    ifreq ifr{};
+    std::strncpy(ifr.ifr_name, "vcan0", sizeof ifr.ifr_name - 1);
+    if (::ioctl(tx_->fd(), SIOCGIFFLAGS, &ifr) < 0) return errno;
+    ifr.ifr_flags = static_cast<short>(up ? (ifr.ifr_flags | IFF_UP) : (ifr.ifr_flags & ~IFF_UP));
+    return ::ioctl(tx_->fd(), SIOCSIFFLAGS, &ifr) < 0 ? errno : 0;
+  }
+  void TearDown() override {
+    if (tx_ && taken_down_) (void)set_up(true);  // never leave vcan0 down for the next test
+  }
+  std::vector<BusEvent> drain(SocketCanBus& bus) {
+    std::array<BusEvent, 16> ev{};
+    const std::size_t n = bus.poll_events(ev);
+    return {ev.begin(), ev.begin() + static_cast<std::ptrdiff_t>(n)};
+  }
+  bool taken_down_ = false;
+};
+
+TEST_F(LinkDown, SendsFailWithEnetdownUntilTheInterfaceIsUpAgain) {
+  if (const int err = set_up(false); err != 0)
+    GTEST_SKIP() << "cannot take vcan0 down (" << std::strerror(err) << "): needs CAP_NET_ADMIN; runs in the VM";
+  taken_down_ = true;
+  EXPECT_FALSE(tx_->link_down());
+  EXPECT_EQ(tx_->send(Frame{0x080, {}}), SendResult::kError);
+  EXPECT_EQ(tx_->last_errno(), ENETDOWN);
+  EXPECT_TRUE(tx_->link_down());
+  EXPECT_EQ(tx_->send(Frame{0x205, {0x0F, 0}}), SendResult::kError);
+  EXPECT_EQ(tx_->counters().tx_errors, 2u);
+  const std::vector<BusEvent> down = drain(*tx_);
+  ASSERT_EQ(down.size(), 1u) << "reported once, not per frame";
+  EXPECT_EQ(down[0].kind, BusEvent::Kind::kLinkDown);
+  EXPECT_EQ(down[0].detail, static_cast<std::uint32_t>(ENETDOWN));
+  // The other socket: its receive reports the interface down too (the
+  // socket error the kernel left at NETDEV_DOWN), and gets no frame.
+  std::array<TimedFrame, 4> got{};
+  EXPECT_EQ(rx_->receive(got), 0u);
+  EXPECT_TRUE(rx_->link_down());
+  ASSERT_EQ(set_up(true), 0);
+  taken_down_ = false;
+  EXPECT_TRUE(tx_->link_down()) << "up again only once a frame gets out";
+  EXPECT_EQ(tx_->send(Frame{0x080, {}}), SendResult::kOk);
+  EXPECT_FALSE(tx_->link_down());
+  const std::vector<BusEvent> up = drain(*tx_);
+  ASSERT_EQ(up.size(), 1u);
+  EXPECT_EQ(up[0].kind, BusEvent::Kind::kLinkUp);
+  std::size_t n = 0;
+  for (int i = 0; i < 2000 && n == 0; ++i) {
+    n = rx_->receive(got);
+    if (n == 0) {
+      timespec ms{0, 1'000'000};
+      nanosleep(&ms, nullptr);
+    }
+  }
+  ASSERT_EQ(n, 1u) << "the frame sent after the interface came back did not arrive";
+  EXPECT_EQ(got[0].frame.id, 0x080u);
 }
 
 }  // namespace canmotion::can

@@ -6,8 +6,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -187,6 +189,17 @@ class Outputs {
                    can::SocketCanBus::error_classes_text(static_cast<std::uint32_t>(e.value)));
       } else if (e.kind == rt::Event::Kind::kBusRecovered) {
         fmt::print(stderr, "canmotiond: bus {}: back from bus-off: re-booting its drives\n", cfg_.buses[e.bus].name);
+      } else if (e.kind == rt::Event::Kind::kLinkDown) {
+        const std::string& i = cfg_.buses[e.bus].interface;
+        fmt::print(stderr,
+                   "canmotiond: bus {}: interface {} is down ({}: {}): no frame goes out or comes in, its axes "
+                   "fault (bus_off); canmotiond keeps trying it every cycle and re-boots its drives once it is up "
+                   "(`ip link set {} up`), then MASR, MSO\n",
+                   cfg_.buses[e.bus].name, i, e.value == ENETDOWN ? "ENETDOWN" : "errno " + std::to_string(e.value),
+                   std::strerror(static_cast<int>(e.value)), i);
+      } else if (e.kind == rt::Event::Kind::kLinkUp) {
+        fmt::print(stderr, "canmotiond: bus {}: interface {} is up again: re-booting its drives\n",
+                   cfg_.buses[e.bus].name, cfg_.buses[e.bus].interface);
       }
     }
   }
@@ -294,7 +307,7 @@ void print_summary(const Options& o, config::Runtime& rt, rt::ControllerHost& ho
   // A SYNC the transport refused is a cycle every drive on that bus missed.
   for (std::size_t b = 0; b < c.spec().buses.size() && b < s.buses.size(); ++b) {
     const rt::BusSnapshot& bs = s.buses[b];
-    fmt::print("summary: bus {}: {} SYNCs sent, {} refused by the transport (transmit queue full or bus-off); "
+    fmt::print("summary: bus {}: {} SYNCs sent, {} refused by the transport (transmit queue full, bus-off or interface down); "
                "{} frames refused in all\n",
                c.spec().buses[b].name, bs.syncs_sent, bs.syncs_refused, bs.send_rejected);
   }

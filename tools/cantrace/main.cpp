@@ -430,6 +430,8 @@ int App::read_live() {
         case can::BusEvent::Kind::kRestarted: cls = 0x100U; break;
         case can::BusEvent::Kind::kRxOverflow: cls = 0x04U; break;
         case can::BusEvent::Kind::kTxQueueFull: break;
+        case can::BusEvent::Kind::kLinkDown: break;
+        case can::BusEvent::Kind::kLinkUp: break;
       }
       if (cls == 0) continue;
       const tr::Decoded& d = b->decoder->decode_error(cls, e.t_ns);
