@@ -77,6 +77,9 @@ struct ControllerSettings {
   /// PM QoS request held on /dev/cpu_dma_latency while the cycle runs, in
   /// microseconds (0 = shallowest CPU idle state only); -1 = do not ask.
   std::int32_t cpu_dma_latency_us = 0;
+  /// The SYNC first in each cycle, at wake-up, before receiving and planning
+  /// (rt::ControllerSpec::sync_first); false = RPDOs, then the SYNC.
+  bool sync_first = false;
   Location where;
 };
 

@@ -6,7 +6,8 @@ namespace canmotion::config::load {
 ControllerSettings controller(Reader& r, const YAML::Node& n) {
   ControllerSettings c;
   c.where = r.loc(n);
-  if (!r.check_map(n, "controller", {"period_ms", "priority", "cpu", "lock_memory", "cpu_dma_latency_us"})) return c;
+  if (!r.check_map(n, "controller", {"period_ms", "priority", "cpu", "lock_memory", "cpu_dma_latency_us", "sync_first"}))
+    return c;
   double ms = c.period_ms();
   if (r.scalar(n, "controller", "period_ms", ms, 0.25, 100.0, "ms")) c.period_s = period_s_from_ms(ms);
   r.scalar(n, "controller", "priority", c.priority, 0, 99);
@@ -14,6 +15,7 @@ ControllerSettings controller(Reader& r, const YAML::Node& n) {
   r.scalar(n, "controller", "lock_memory", c.lock_memory, false, true);
   // -1 = leave the CPU idle states alone; the top is the kernel's "no constraint" (rt/pm_qos.hpp).
   r.scalar(n, "controller", "cpu_dma_latency_us", c.cpu_dma_latency_us, std::int32_t{-1}, std::int32_t{2'000'000'000}, "us");
+  r.scalar(n, "controller", "sync_first", c.sync_first, false, true);
   return c;
 }
 

@@ -283,6 +283,7 @@ RuntimeSpec build_spec(const Config& cfg, bool force_sim) {
   RuntimeSpec r;
   rt::ControllerSpec& spec = r.controller;
   spec.period_ns = cfg.controller.period_ns();
+  spec.sync_first = cfg.controller.sync_first;
   // The simulated buses' indices in the SimWorld (added in order), per bus.
   std::vector<std::size_t> sim_index(cfg.buses.size(), 0);
   std::size_t sim_buses = 0;

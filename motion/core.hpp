@@ -142,6 +142,10 @@ struct AxisRt {
   double base = 0.0;          ///< drive-frame position with all finished motion folded in
   double frame_offset = 0.0;  ///< user = drive + frame_offset (MRP, homing)
   Kin cmd{};                  ///< total command (drive frame)
+  /// The command position one cycle older than `cmd` (set by step_axis(),
+  /// and to `cmd` when the feedback step takes the command from the actual):
+  /// with Core::command_lag the command the feedback is compared with.
+  double prev_cmd_p = 0.0;
   double fb_pos = 0.0, fb_vel = 0.0;
   AxisFeedback fb{};
   std::array<Generator, kSlots> gen{};
@@ -186,6 +190,9 @@ struct Core {
   std::size_t order_n = 0;
   bool order_dirty = true;  ///< a slot or an axis changed since `order` was computed
   ControllerMode mode = ControllerMode::Run;  ///< Program: no instruction starts motion (ERR 24)
+  /// Cycles between a command and the feedback that shows it applied,
+  /// beyond the usual one (Planner::set_command_lag): 0 or 1.
+  std::uint8_t command_lag = 0;
 
   /// Configure (or reconfigure) an axis. Not realtime.
   bool configure_axis(AxisId id, const AxisConfig& cfg) noexcept;
@@ -248,6 +255,12 @@ struct Core {
   Err common_checks(const AxisRt& a, bool need_servo) const noexcept;
   Kin slot_kin(const AxisRt& a, Slot s) const noexcept;
   double user_command(const AxisRt& a) const noexcept { return a.cmd.p + a.frame_offset; }
+  /// The command position a CIP axis's actual position is compared with
+  /// (position error, its exception, a coordinate system's following error):
+  /// the command the drive applied when it measured that actual, in the
+  /// drive frame: `cmd.p` before this cycle's step, or one cycle older with
+  /// command_lag. Realtime-safe.
+  double compared_command(const AxisRt& a) const noexcept { return command_lag != 0 ? a.prev_cmd_p : a.cmd.p; }
   /// A stop ramp runs (StoppingStatus; MAM/MAJ/MAPC refused, ERR 78).
   bool any_stopping(const AxisRt& a) const noexcept {
     for (unsigned m = a.live; m != 0; m &= m - 1)  // live slots only

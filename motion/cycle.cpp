@@ -15,6 +15,7 @@ namespace canmotion::motion {
 // ---------------------------------------------------------------- feedback
 void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   if (a.cfg.type != AxisType::CipDrive) return;
+  const double cmd_before = a.cmd.p;
   if (fb) {
     a.fb = *fb;
     a.fb_pos = fb->position;
@@ -29,6 +30,9 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   }
   // a drive that dropped out of Operation Enabled switches the servo off
   if (a.servo.on && a.fb.drive != DriveState::Enabled && !a.direct.waiting) servo_off(a);
+  // A command taken from the actual here (servo off, homing, MSO closing the
+  // loop) has no older one: the drive is taken to be at it.
+  if (a.cmd.p != cmd_before) a.prev_cmd_p = a.cmd.p;
 }
 
 // -------------------------------------------------------------- exceptions
@@ -45,7 +49,7 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
     if (a.fb.node_lost && !resetting) active |= bit(ExceptionKind::NodeLost);
     if (a.fb.bus_off) active |= bit(ExceptionKind::BusOff);
     if (a.servo.on && a.cfg.position_error_tolerance > 0 &&
-        std::fabs(a.cmd.p - a.fb_pos) > a.cfg.position_error_tolerance)
+        std::fabs(compared_command(a) - a.fb_pos) > a.cfg.position_error_tolerance)
       active |= bit(ExceptionKind::PositionError);
   }
   if (a.cfg.soft_limits_enabled && !a.cfg.rotary) {
@@ -78,7 +82,8 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   a.tag.exception_faults |= faults;
   // the values that latched them, before the action below moves the command
   if (fresh & bit(ExceptionKind::PositionError))
-    a.tag.exception_fault_values[static_cast<std::size_t>(ExceptionKind::PositionError)] = std::fabs(a.cmd.p - a.fb_pos);
+    a.tag.exception_fault_values[static_cast<std::size_t>(ExceptionKind::PositionError)] =
+        std::fabs(compared_command(a) - a.fb_pos);
   for (ExceptionKind k : {ExceptionKind::SoftOvertravelPos, ExceptionKind::SoftOvertravelNeg})
     if (fresh & bit(k)) a.tag.exception_fault_values[static_cast<std::size_t>(k)] = user_command(a);
   // the most severe action of the new faults wins
@@ -156,6 +161,7 @@ void Core::read_feedback(const Input& in) noexcept {
       sum_a += g->k.a;
     }
   }
+  a.prev_cmd_p = a.cmd.p;
   a.cmd = Kin{a.base + sum_p, sum_v, sum_a};
   if (out) {
     out->position = a.cmd.p;
@@ -258,7 +264,7 @@ void Core::update_status(AxisRt& a) noexcept {
   t.command_velocity = a.cmd.v;
   t.command_acceleration = a.cmd.a;
   t.actual_velocity = actv;
-  t.position_error = a.cmd.p - act;
+  t.position_error = (a.cfg.type == AxisType::Virtual ? a.cmd.p : compared_command(a)) - act;
 }
 
 // -------------------------------------------------------------- step order

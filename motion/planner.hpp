@@ -75,6 +75,22 @@ class Planner {
   void set_controller_mode(ControllerMode m) noexcept;
   ControllerMode controller_mode() const noexcept { return c_.mode; }
 
+  /// Cycles between a command and the feedback that shows it applied, beyond
+  /// the usual one: 0 when the feedback read in cycle k shows the command of
+  /// cycle k-1 (the drives apply a cycle's targets at that cycle's SYNC), 1
+  /// when it shows the command of cycle k-2 (the SYNC goes out first, before
+  /// the RPDOs: controller.sync_first). The position error, its exception
+  /// and a coordinate system's following error then compare the actual
+  /// position with that older command, so that they read the same as with 0
+  /// (motion/README.md, Exceptions). False (nothing changed) for other
+  /// values. Not realtime (configuration).
+  bool set_command_lag(unsigned extra_cycles) noexcept {
+    if (extra_cycles > 1) return false;
+    c_.command_lag = static_cast<std::uint8_t>(extra_cycles);
+    return true;
+  }
+  unsigned command_lag() const noexcept { return c_.command_lag; }
+
   /// Register the CAM_PROFILE array tag `id` (the binder's cam_profiles id).
   /// The profile must outlive the planner. Not realtime (configuration).
   bool attach_cam_profile(std::uint16_t id, cam::CamProfile* profile) noexcept;

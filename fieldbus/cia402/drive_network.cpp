@@ -12,7 +12,7 @@
 namespace canmotion::cia402 {
 
 DriveNetwork::DriveNetwork(const NetworkConfig& cfg)
-    : tx_queue_frames_(cfg.tx_queue_frames), master_(cfg.master), events_(kEventCapacity) {
+    : tx_queue_frames_(cfg.tx_queue_frames), sync_first_(cfg.sync_first), master_(cfg.master), events_(kEventCapacity) {
   index_.fill(-1);
   tpdo_owner_.fill(-1);
 }
@@ -69,12 +69,19 @@ void DriveNetwork::update(std::int64_t now_ns) noexcept {
     while (d->poll_notice(e)) keep(e);
 }
 
+void DriveNetwork::sync(canopen::FrameSink& out) noexcept {
+  // First in the burst, into a queue that had a whole period to drain: its
+  // place in the cycle's budget is taken off in cycle().
+  if (sync_first_) master_.send_sync(out);
+}
+
 void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept {
   update(now_ns);
   // The burst: RPDOs, the SYNC, then what may wait or be repeated (SDO,
-  // heartbeat). With a transmit queue shorter than the burst
-  // (tx_queue_frames) one place stays free for the SYNC: a full queue drops
-  // an RPDO or an SDO request, never the SYNC that every drive needs.
+  // heartbeat); with sync_first the SYNC went out before (sync()). With a
+  // transmit queue shorter than the burst (tx_queue_frames) one place stays
+  // free for the SYNC: a full queue drops an RPDO or an SDO request, never
+  // the SYNC that every drive needs.
   budget_.out = &out;
   budget_.left = tx_queue_frames_ == 0 ? 0xFFFFFFFFu : tx_queue_frames_ - 1;
   // With a budget the drives take turns at the front, so a queue too short
@@ -82,9 +89,15 @@ void DriveNetwork::cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept 
   const std::size_t n = drives_.size();
   const std::size_t first = tx_queue_frames_ != 0 && n > 0 ? static_cast<std::size_t>(turn_++ % n) : 0;
   for (std::size_t i = 0; i < n; ++i) drives_[(first + i) % n]->step(now_ns, budget_);
-  if (tx_queue_frames_ != 0) ++budget_.left;  // the place kept for the SYNC
-  master_.send_sync(budget_);
-  for (auto& d : drives_) d->on_sync_sent();
+  if (sync_first_) {
+    // The SYNC of this cycle's wake-up applied the last cycle's RPDOs; its
+    // TPDOs are read in the next cycle, after the next SYNC.
+    for (auto& d : drives_) d->on_sync_sent(false);
+  } else {
+    if (tx_queue_frames_ != 0) ++budget_.left;  // the place kept for the SYNC
+    master_.send_sync(budget_);
+    for (auto& d : drives_) d->on_sync_sent();
+  }
   // After the proxies and the SYNC, so that what they queued this cycle goes out now.
   master_.step_sdo(now_ns, budget_);
   master_.produce_heartbeat(now_ns, budget_);

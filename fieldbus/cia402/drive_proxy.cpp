@@ -603,9 +603,13 @@ void DriveProxy::check_mode_switch(std::int64_t now_ns) noexcept {
   }
 }
 
-void DriveProxy::on_sync_sent() noexcept {
+void DriveProxy::on_sync_sent(bool after_rpdos) noexcept {
   expect_tpdo_ = phase_ == Phase::kOperational && tpdo_seen_ && !nmt_left_;
-  if (homing_step_ == HomingStep::kStarted && (cw_ & cw::kHomingStart) != 0) homing_sync_ = true;
+  // The controlword the drive applied at that SYNC: this cycle's, or (SYNC
+  // first) the previous cycle's.
+  const std::uint16_t applied = after_rpdos ? cw_ : cw_sent_;
+  cw_sent_ = cw_;
+  if (homing_step_ == HomingStep::kStarted && (applied & cw::kHomingStart) != 0) homing_sync_ = true;
 }
 
 }  // namespace canmotion::cia402

@@ -251,10 +251,18 @@ class DriveProxy {
   /// Feed a master event concerning this node.
   void on_node_event(const canopen::NodeEvent& e) noexcept;
   /// Boot/configuration progress, state machine, then the RPDOs of this
-  /// cycle (only when operational). Call before the cycle's SYNC.
+  /// cycle (only when operational). Call before the cycle's SYNC (or, SYNC
+  /// first, after it: see on_sync_sent()).
   void step(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
-  /// Tell the proxy the cycle's SYNC went out (arms missed-TPDO counting).
-  void on_sync_sent() noexcept;
+  /// Tell the proxy about the SYNC whose TPDOs the next step() reads: it
+  /// arms missed-TPDO counting, and a homing's start bit counts once a SYNC
+  /// applied it. `after_rpdos` true: the SYNC followed this cycle's RPDOs
+  /// (the drive applies them at it; call after the SYNC). False: the SYNC
+  /// went out first, at this cycle's wake-up (NetworkConfig::sync_first),
+  /// so the drive applies the previous cycle's RPDOs at it; call at the end
+  /// of the cycle, after step(), since the TPDOs answering it are read in
+  /// the next cycle. Realtime-safe.
+  void on_sync_sent(bool after_rpdos = true) noexcept;
 
   /// Tag the proxy uses for its own run-time SDO writes (0x6060); the
   /// application's transfers on master().sdo(node) should use other tags and
@@ -489,6 +497,7 @@ class DriveProxy {
   std::int64_t mode_switch_since_ns_ = 0;
   void check_mode_switch(std::int64_t now_ns) noexcept;
   std::uint16_t cw_ = 0;
+  std::uint16_t cw_sent_ = 0;  // on_sync_sent(false): the controlword of the previous cycle's RPDO
   std::int32_t target_position_ = 0;
   std::int32_t target_velocity_ = 0;
   std::int16_t target_torque_ = 0;
@@ -517,9 +526,17 @@ struct NetworkConfig {
   canopen::MasterConfig master{};
   /// Frames the interface can queue (its txqueuelen; 0 = no limit). One
   /// cycle then writes at most this many, and at most this many minus one
-  /// before the SYNC, so a burst longer than the queue never loses the SYNC
+  /// besides the SYNC, so a burst longer than the queue never loses the SYNC
   /// (the RPDOs past the limit are left out and counted: tx_budget_skipped()).
   std::uint32_t tx_queue_frames = 0;
+  /// The SYNC goes out first, at the cycle's wake-up (DriveNetwork::sync(),
+  /// before receiving and planning), and cycle() sends the RPDOs computed in
+  /// the cycle after it: the drives apply them at the next SYNC. The SYNC's
+  /// time on the wire then no longer carries the planner's execution time,
+  /// at the cost of one cycle between a command and the drive applying it.
+  /// False: RPDOs, then the SYNC, in cycle() (the drives apply a cycle's
+  /// RPDOs at its own SYNC).
+  bool sync_first = false;
 };
 
 /// The CANopen master plus one DriveProxy per node: the object the RT
@@ -543,9 +560,15 @@ class DriveNetwork {
   /// that detects it. cycle() does it too (a no-op when update() ran).
   /// Realtime-safe.
   void update(std::int64_t now_ns) noexcept;
-  /// One cycle: master heartbeat, update(), each proxy's step (RPDOs), SDO,
-  /// then SYNC. Realtime-safe.
+  /// One cycle: update(), each proxy's step (RPDOs), the SYNC (not with
+  /// NetworkConfig::sync_first: sync() sent it), SDO requests, the master's
+  /// heartbeat. Realtime-safe.
   void cycle(std::int64_t now_ns, canopen::FrameSink& out) noexcept;
+  /// NetworkConfig::sync_first: the cycle's SYNC, the first frame of its
+  /// burst; call at wake-up, before the received frames are read, then
+  /// cycle() as usual. Does nothing without sync_first. Realtime-safe.
+  void sync(canopen::FrameSink& out) noexcept;
+  [[nodiscard]] bool sync_first() const noexcept { return sync_first_; }
 
   [[nodiscard]] canopen::Master& master() noexcept { return master_; }
   [[nodiscard]] DriveProxy* drive(std::uint8_t node) noexcept;
@@ -587,6 +610,7 @@ class DriveNetwork {
     }
   };
   std::uint32_t tx_queue_frames_ = 0;
+  bool sync_first_ = false;
   BudgetSink budget_;
   std::uint64_t turn_ = 0;
   canopen::Master master_;

@@ -8,7 +8,10 @@
 namespace canmotion::emulator {
 
 SimRig::SimRig(const SimRigConfig& cfg)
-    : cfg_(cfg), bus_("sim0"), net_(cia402::NetworkConfig{cfg.master, cfg.tx_queue_frames}), master_ep_(&bus_.add_endpoint("master")) {
+    : cfg_(cfg),
+      bus_("sim0"),
+      net_(cia402::NetworkConfig{cfg.master, cfg.tx_queue_frames, cfg.sync_first}),
+      master_ep_(&bus_.add_endpoint("master")) {
   for (std::uint8_t node : cfg_.nodes) {
     cia402::DriveConfig d = cfg_.drive;
     d.node = node;
@@ -43,12 +46,6 @@ void SimRig::power_on() {
 void SimRig::step() {
   now_ns_ = static_cast<std::int64_t>(cycles_) * cfg_.cycle_ns;
   bus_.set_time(now_ns_);
-  std::array<can::TimedFrame, 256> buf;
-  for (;;) {
-    const std::size_t n = master_ep_->receive(buf);
-    for (std::size_t i = 0; i < n; ++i) net_.on_frame(buf[i]);
-    if (n < buf.size()) break;
-  }
   // The master's interface queue (tx_queue_depth frames per cycle).
   struct Queue final : canopen::FrameSink {
     can::Transport& t;
@@ -67,6 +64,13 @@ void SimRig::step() {
       return t.send(f) == can::SendResult::kOk;
     }
   } sink(*master_ep_, cfg_.tx_queue_depth, tx_refused_, syncs_refused_);
+  net_.sync(sink);  // sync_first only
+  std::array<can::TimedFrame, 256> buf;
+  for (;;) {
+    const std::size_t n = master_ep_->receive(buf);
+    for (std::size_t i = 0; i < n; ++i) net_.on_frame(buf[i]);
+    if (n < buf.size()) break;
+  }
   net_.cycle(now_ns_, sink);
   for (std::size_t i = 0; i < emus_.size(); ++i) {
     if (!connected_[i]) {

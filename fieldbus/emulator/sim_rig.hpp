@@ -6,8 +6,10 @@
 /// runtime's --sim mode can use the same pieces (SimBus endpoint + Emulator).
 ///
 /// One step() is one cycle at t = cycle_index x period:
+///   0. (SimRigConfig::sync_first) DriveNetwork::sync sends the SYNC;
 ///   1. the master endpoint drains its frames into DriveNetwork::on_frame;
-///   2. DriveNetwork::cycle sends heartbeat/SDO/NMT, the RPDOs, then SYNC;
+///   2. DriveNetwork::cycle sends the RPDOs, then SYNC (not with sync_first),
+///      then SDO and heartbeat;
 ///   3. each emulator handles what it received (RPDOs latch, SYNC applies
 ///      them, moves the motor and sends the TPDOs) and its timers.
 
@@ -36,6 +38,9 @@ struct SimRigConfig {
   std::uint32_t tx_queue_depth = 0;
   /// NetworkConfig::tx_queue_frames of the master (0 = no limit).
   std::uint32_t tx_queue_frames = 0;
+  /// NetworkConfig::sync_first: step() sends the SYNC before it drains the
+  /// master's frames, and cycle() the RPDOs after.
+  bool sync_first = false;
 };
 
 class SimRig {

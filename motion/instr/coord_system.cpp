@@ -107,7 +107,7 @@ coord::Present present(const Core& c, const CoordSystemRt& s, const MdccLink& li
     const AxisRt& a = c.axes[s.cfg.axes[k]];
     now.total.c[k] = c.user_command(a) * s.cfg.ratio[k];
     if (a.cfg.type == AxisType::CipDrive) {
-      const double e = (a.cmd.p - a.fb_pos) * s.cfg.ratio[k];
+      const double e = (c.compared_command(a) - a.fb_pos) * s.cfg.ratio[k];
       fe2 += e * e;
     }
   }

@@ -1,5 +1,6 @@
 #include "rt/controller/controller.hpp"
 
+#include "fieldbus/canopen/cob_id.hpp"
 #include "fieldbus/canopen/sdo_abort.hpp"
 
 #include <algorithm>
@@ -34,6 +35,8 @@ class Controller::RecordingSink final : public canopen::FrameSink {
       ++b.rejected;
       return false;
     }
+    if (c_.sync_timing_ && f.id == canopen::cob::kSync) [[unlikely]]
+      c_.sync_timing_->record(bus_, now_ns);
     if (c_.trace_on_.load(std::memory_order_relaxed)) c_.record(bus_, can::TimedFrame{f, now_ns}, true);
     return true;
   }
@@ -60,6 +63,7 @@ Controller::Controller(ControllerSpec spec)
     if (spec_.buses[b].transport == nullptr)
       throw std::invalid_argument("bus '" + spec_.buses[b].name + "' has no transport");
     buses_[b].transport = spec_.buses[b].transport;
+    spec_.buses[b].network.sync_first = spec_.sync_first;
     buses_[b].network = std::make_unique<cia402::DriveNetwork>(spec_.buses[b].network);
     buses_[b].sink = std::make_unique<RecordingSink>(*this, static_cast<std::uint8_t>(b));
   }
@@ -83,6 +87,8 @@ Controller::Controller(ControllerSpec spec)
     cams_.push_back(std::move(prof));
   }
   build_arrays();
+  // SYNC first: the drives apply a cycle's command one cycle later.
+  (void)planner_.set_command_lag(spec_.sync_first ? 1 : 0);
   axes_.resize(spec_.axes.size());
   for (std::size_t a = 0; a < spec_.axes.size(); ++a) {
     AxisSpec& s = spec_.axes[a];
@@ -355,6 +361,7 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
 }
 
 void Controller::cycle(std::int64_t now_ns) noexcept {
+  if (spec_.sync_first) sync_all(now_ns);                    // 1
   receive_all(now_ns);                                       // 2
   for (std::size_t a = 0; a < axes_.size(); ++a) feedback(a);  // 3
   take_commands(now_ns);                                     // 4
@@ -365,6 +372,21 @@ void Controller::cycle(std::int64_t now_ns) noexcept {
   publish(now_ns);                                           // 8
   ++cycle_index_;
   cycle_.store(cycle_index_, std::memory_order_release);
+}
+
+// 1. SYNC first (ControllerSpec::sync_first): before anything whose time
+// varies, so that the SYNC leaves at a fixed offset from the wake-up. The
+// TPDOs read next (receive_all) answer the last cycle's SYNC; those
+// answering this one come while the cycle runs and are read in the next
+// cycle. (A drive that answered within the few microseconds between this
+// SYNC and the reads below would have its answer read one cycle early: not
+// on a CAN wire, where a SYNC and a TPDO take >= 150 us at 1 Mbit/s.)
+void Controller::sync_all(std::int64_t now_ns) noexcept {
+  for (std::size_t b = 0; b < buses_.size() && halt_ != Halt::kHalted; ++b) {
+    auto& sink = static_cast<RecordingSink&>(*buses_[b].sink);
+    sink.now_ns = now_ns;
+    buses_[b].network->sync(sink);
+  }
 }
 
 // 2. Drain received frames on every bus; heartbeat timeouts and node events
@@ -464,7 +486,8 @@ void Controller::plan() noexcept {
   (void)planner_.update(in, out);
 }
 
-// 7. RPDOs, then SYNC, per bus (the drive state machines stepped in apply()).
+// 7. RPDOs, then SYNC, per bus (the drive state machines stepped in apply());
+// with sync_first the RPDOs only (the SYNC went out in sync_all()).
 void Controller::send_all(std::int64_t now_ns) noexcept {
   for (std::size_t b = 0; b < buses_.size() && halt_ != Halt::kHalted; ++b) {
     auto& sink = static_cast<RecordingSink&>(*buses_[b].sink);
@@ -475,7 +498,8 @@ void Controller::send_all(std::int64_t now_ns) noexcept {
 
 // The controlled stop, second step: once the 0x1016 writes are answered (or
 // after kDisarmTimeoutNs), NMT pre-operational after this cycle's SYNC, so
-// its TPDOs still come back; then silence.
+// its TPDOs still come back; then silence. (With sync_first the RPDOs sent
+// after that SYNC are never applied: no SYNC follows them.)
 void Controller::advance_halt(std::int64_t now_ns) noexcept {
   bool done = true;
   for (auto& ax : axes_) {

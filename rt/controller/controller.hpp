@@ -3,6 +3,8 @@
 /// The Controller: one cycle of canmotion, joining the motion planner and the
 /// CANopen drive networks (DESIGN.md, "One cycle"):
 ///
+///   1. sync_all()       ControllerSpec::sync_first only: the SYNC on every
+///                       bus, first thing after the wake-up
 ///   2. receive_all()    drain received frames on every bus (TPDOs, EMCY,
 ///                       heartbeats, SDO); heartbeat timeouts and node events
 ///                       reach the drive proxies (DriveNetwork::update), so
@@ -11,7 +13,8 @@
 ///   4. take_commands()  take pending commands from the command ring
 ///   5. plan()           Planner::update (masters before slaves, inside the planner)
 ///   6. apply()          step each drive's CiA 402 state machine, pack its RPDOs
-///   7. send_all()       send the RPDOs, then SYNC, in one burst
+///   7. send_all()       send the RPDOs, then SYNC, in one burst (sync_first:
+///                       the RPDOs only; the drives apply them at the next SYNC)
 ///      advance_halt()   (a controlled stop: NMT pre-operational after that SYNC)
 ///   8. publish()        publish a status snapshot; queue trace and telemetry records
 ///
@@ -40,6 +43,7 @@
 #include "motion/planner.hpp"
 #include "rt/snapshot.hpp"
 #include "rt/spsc_ring.hpp"
+#include "rt/sync_timing.hpp"
 
 namespace canmotion::rt {
 
@@ -119,6 +123,12 @@ struct CoordSystemSpec {
 /// Everything a Controller is built from (config::build_spec makes it from a file).
 struct ControllerSpec {
   std::int64_t period_ns = 1'000'000;
+  /// The SYNC goes out first in each cycle, at wake-up, on every bus
+  /// (cia402::NetworkConfig::sync_first, set on every bus from this), and
+  /// the planner compares the actual positions with the command one cycle
+  /// older (motion::Planner::set_command_lag(1)): config key
+  /// `controller.sync_first`. False: RPDOs, then the SYNC, at the end of the cycle.
+  bool sync_first = false;
   std::vector<BusSpec> buses;
   std::vector<AxisSpec> axes;
   std::vector<CamSpec> cams;
@@ -358,6 +368,16 @@ class Controller {
   [[nodiscard]] double period_s() const noexcept { return static_cast<double>(spec_.period_ns) * 1e-9; }
   [[nodiscard]] std::uint64_t cycles() const noexcept { return cycle_.load(std::memory_order_acquire); }
 
+  /// Measure when each SYNC is handed to its transport, on `clock` (the
+  /// clock whose time cycle() is given: its wake-up): sync_timing(). Set
+  /// before the loop runs (allocates the histograms); nullptr = not measured
+  /// (the default: one clock read per SYNC saved). Not realtime.
+  void set_sync_clock(Clock* clock) {
+    sync_timing_ = clock == nullptr ? nullptr : std::make_unique<SyncTiming>(*clock, spec_.period_ns);
+  }
+  /// The SYNC timing measured since set_sync_clock(), or null. Any thread (its histograms are lock-free).
+  [[nodiscard]] const SyncTiming* sync_timing() const noexcept { return sync_timing_.get(); }
+
   /// The planner, for set-up before the loop runs (e.g. cams) and for tests
   /// on the loop thread. Not for other threads while running.
   motion::Planner& planner() noexcept { return planner_; }
@@ -394,6 +414,7 @@ class Controller {
   };
 
   // The steps of cycle(), in order (RT).
+  void sync_all(std::int64_t now_ns) noexcept;
   void receive_all(std::int64_t now_ns) noexcept;
   void receive(std::size_t b, std::int64_t now_ns) noexcept;
   void feedback(std::size_t a) noexcept;
@@ -464,6 +485,7 @@ class Controller {
   SpscRing<TraceRecord, kTraceCapacity> trace_;
   SpscRing<Sample, kTelemetryCapacity> telemetry_;
   std::unique_ptr<SnapshotBuffer<Status>> snapshot_;  ///< heap: three Status copies are large
+  std::unique_ptr<SyncTiming> sync_timing_;  ///< set_sync_clock(); null: not measured
 
   mutable std::mutex names_mu_;  ///< non-RT only: control names and the producer side of commands_
   std::map<std::string, motion::ControlId, std::less<>> control_names_;

@@ -113,6 +113,24 @@ TEST(Config, CpuDmaLatencyDefaultRangeAndPosition) {
   EXPECT_NE(errors_of(y).find("cpu_dma_latency_us"), std::string::npos) << "the nearest key is suggested";
 }
 
+// controller.sync_first (issue 28): false by default; a boolean, and an
+// error naming the key otherwise.
+TEST(Config, SyncFirstIsABooleanFalseByDefault) {
+  EXPECT_FALSE(load_string(kGood, "good.yaml").controller.sync_first);
+  std::string y = kGood;
+  y.replace(y.find("  cpu: 1\n"), 9, "  cpu: 1\n  sync_first: true\n");
+  EXPECT_TRUE(load_string(y, "on.yaml").controller.sync_first);
+  for (const char* bad : {"2", "fast", "[true]"}) {
+    y = kGood;
+    y.replace(y.find("  cpu: 1\n"), 9, std::string("  cpu: 1\n  sync_first: ") + bad + "\n");
+    const std::string e = errors_of(y);
+    EXPECT_NE(e.find("test.yaml:5:15: error: controller.sync_first: must be"), std::string::npos) << e;
+  }
+  y = kGood;
+  y.replace(y.find("  cpu: 1\n"), 9, "  cpu: 1\n  syncfirst: true\n");
+  EXPECT_NE(errors_of(y).find("sync_first"), std::string::npos) << "the nearest key is suggested";
+}
+
 // sdo_writes of objects in the one object table (canopen::known_objects())
 // take their size from it; a different size, a read-only object or a value
 // that does not fit the size is refused, naming the entry.

@@ -129,6 +129,23 @@ TEST(ConfigRuntimeSpec, SimulatesEveryBusWhenForced) {
   EXPECT_EQ(rt.trace_names, (std::vector<std::string>{"field", "bench"}));
 }
 
+// controller.sync_first reaches the controller, every bus's network and the
+// planner (one cycle more between a command and the feedback showing it).
+TEST(ConfigRuntimeSpec, SyncFirstReachesEveryBusAndThePlanner) {
+  for (const bool on : {false, true}) {
+    const std::string y = std::string("controller: {sync_first: ") + (on ? "true" : "false") + "}\n" +
+                          "buses:\n  - {name: a, interface: sim}\n  - {name: b, interface: sim}\n"
+                          "axes:\n  - {name: X, type: AXIS_CIP_DRIVE, bus: a, node: 2}\n"
+                          "  - {name: Y, type: AXIS_CIP_DRIVE, bus: b, node: 2}\n";
+    const Config cfg = load_string(y, "sync.yaml");
+    Runtime rt = build_runtime(cfg, build_spec(cfg, false));
+    EXPECT_EQ(rt.controller->spec().sync_first, on);
+    EXPECT_EQ(rt.controller->network(0).sync_first(), on);
+    EXPECT_EQ(rt.controller->network(1).sync_first(), on);
+    EXPECT_EQ(rt.controller->planner().command_lag(), on ? 1u : 0u);
+  }
+}
+
 TEST(ConfigRuntimeSpec, VirtualAxesOnlyNeedNoWorld) {
   const Config cfg = load_string("axes:\n  - {name: V, type: AXIS_VIRTUAL, max_speed: 1, max_accel: 1, max_decel: 1}\n");
   const RuntimeSpec r = build_spec(cfg, false);

@@ -60,13 +60,22 @@ void active_switch_homing(AxisSpec& x, std::int8_t method) {
   x.config.homing.accel = 500;
 }
 
-TEST(ControllerHoming, MahWithMethod35ReachesPcWithAxisHomedStatus) {
-  HomingRig r([](AxisSpec& x, emulator::EmulatorConfig& ec) {
-    active_switch_homing(x, 35);
-    x.config.homing.write_offset = true;
-    x.config.homing.offset = 2;  // mm -> 0x607C = 2000 counts
-    ec.initial_position = 1234;
-  });
+// The homing handshake in both orders of the cycle's burst (RPDOs then
+// SYNC, or controller.sync_first): with the SYNC first the drive applies bit
+// 4 one SYNC later, and only TPDOs answering a SYNC after that count.
+class ControllerHomingOrder : public ::testing::TestWithParam<bool> {};
+INSTANTIATE_TEST_SUITE_P(Orders, ControllerHomingOrder, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "SyncFirst" : "RpdosThenSync"; });
+
+TEST_P(ControllerHomingOrder, MahWithMethod35ReachesPcWithAxisHomedStatus) {
+  HomingRig r(
+      [](AxisSpec& x, emulator::EmulatorConfig& ec) {
+        active_switch_homing(x, 35);
+        x.config.homing.write_offset = true;
+        x.config.homing.offset = 2;  // mm -> 0x607C = 2000 counts
+        ec.initial_position = 1234;
+      },
+      GetParam());
   r.servo_on();
   test::reset_allocation_count();
   {
@@ -100,11 +109,13 @@ TEST(ControllerHoming, MahWithMethod35ReachesPcWithAxisHomedStatus) {
 // then MAH is PC. A second MAH after moving away homes again: the first
 // homing's "homing attained", still shown when the drive is back in mode 6,
 // does not end it (on main it ended the second MAH at once, or never started).
-TEST(ControllerHoming, SearchingMethodTwiceEachHomesFromWhereTheAxisIs) {
-  HomingRig r([](AxisSpec& x, emulator::EmulatorConfig& ec) {
-    active_switch_homing(x, 19);
-    ec.initial_position = 3000;  // 3 mm from the emulator's home reference
-  });
+TEST_P(ControllerHomingOrder, SearchingMethodTwiceEachHomesFromWhereTheAxisIs) {
+  HomingRig r(
+      [](AxisSpec& x, emulator::EmulatorConfig& ec) {
+        active_switch_homing(x, 19);
+        ec.initial_position = 3000;  // 3 mm from the emulator's home reference
+      },
+      GetParam());
   r.servo_on();
   r.exec("MAH(X, mah1)");
   const std::int64_t t0 = r.now;

@@ -23,10 +23,13 @@ struct SimController {
   std::unique_ptr<rt::Controller> ctl;
   std::int64_t now = 0;
 
-  /// `tweak` may change axis X and its drive's emulator before the controller is built.
-  explicit SimController(const std::function<void(rt::AxisSpec&, emulator::EmulatorConfig&)>& tweak = {}) {
+  /// `tweak` may change axis X and its drive's emulator before the controller
+  /// is built; `sync_first` is rt::ControllerSpec::sync_first.
+  explicit SimController(const std::function<void(rt::AxisSpec&, emulator::EmulatorConfig&)>& tweak = {},
+                         bool sync_first = false) {
     rt::ControllerSpec spec;
     spec.period_ns = kPeriod;
+    spec.sync_first = sync_first;
     rt::BusSpec bus;
     bus.name = "sim0";
     bus.transport = &world.add_bus("sim0");

@@ -311,6 +311,10 @@ void print_summary(const Options& o, config::Runtime& rt, rt::ControllerHost& ho
                "{} frames refused in all\n",
                c.spec().buses[b].name, bs.syncs_sent, bs.syncs_refused, bs.send_rejected);
   }
+  // --stats: when the SYNCs left, on the cycle's clock (issue 28).
+  if (const rt::SyncTiming* t = c.sync_timing())
+    fmt::print("summary: {} ({}, all buses)\n", rt::format_sync_timing(t->snapshot()),
+               c.spec().sync_first ? "controller.sync_first: SYNC first" : "RPDOs, then SYNC");
   // The emulated drives' side (--sim, `interface: sim`): what they received.
   if (rt.sim)
     for (std::size_t d = 0; d < rt.sim->drive_count(); ++d) {
@@ -638,13 +642,15 @@ int run(const Options& o) {
   rt::VirtualClock vclock;
   rt::MonotonicClock mclock;
   rt::Clock& clock = o.sim ? static_cast<rt::Clock&>(vclock) : static_cast<rt::Clock&>(mclock);
+  // --stats in real time: each SYNC's send time on the cycle's clock (one clock read per SYNC).
+  if (o.stats && !o.sim) ctl.set_sync_clock(&mclock);
   rt::CyclicExecutive exec(executive_config(cfg, period, o.sim), clock);
   exec_for_tags = &exec;
   const std::unique_ptr<rt::CommandServer> server = open_socket(o, ctl, host, exec);
 
-  fmt::print("canmotiond: {} axes, {} buses ({}), period {} ms{}\n", ctl.axis_count(), cfg.buses.size(),
+  fmt::print("canmotiond: {} axes, {} buses ({}), period {} ms{}{}\n", ctl.axis_count(), cfg.buses.size(),
              o.sim ? "simulated, virtual time" : "real time", config::period_ms(ctl.period_s()),
-             script ? ", script " + o.script : std::string());
+             ctl.spec().sync_first ? ", SYNC first" : "", script ? ", script " + o.script : std::string());
   Housekeeping hk(o, host, exec, *out, server.get(), runner.get());
   const auto sim_start_ns = static_cast<std::int64_t>(std::llround(o.sim_clock_start * 1e9));
   if (rt.sim) rt.sim->power_on(o.sim ? sim_start_ns : clock.now().count());  // boot-up frames at the run's start time
@@ -696,7 +702,9 @@ int main(int argc, char** argv) {
   app.add_option("--script", o.script, "motion script to run (see README: Motion scripts)")->check(CLI::ExistingFile);
   app.add_option("--trace", o.trace, "write every frame on every bus to FILE in candump -L format")->type_name("FILE");
   app.add_option("--csv", o.csv, "write one row per axis per cycle to FILE")->type_name("FILE");
-  app.add_flag("--stats", o.stats, "print cycle statistics once a second and at the end");
+  app.add_flag("--stats", o.stats,
+               "print cycle statistics once a second and at the end (real time: with the SYNC timing, wake-up -> "
+               "SYNC and |SYNC interval - period|)");
   app.add_option("--histogram", o.histogram,
                  "real time: write the cycle's wake-up latency histogram to FILE at the end (one \"lower_ns "
                  "upper_ns count\" line per non-empty bucket, as rt-latency --histogram)")
