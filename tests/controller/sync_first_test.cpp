@@ -40,6 +40,7 @@ struct OrderRig : test::SimController {
   std::uint64_t misplaced = 0;      ///< of them, with the SYNC not where the order puts it
   std::string first_misplaced;      ///< the first one, described
   std::vector<std::uint32_t> burst; ///< the last cycle's transmitted identifiers, in order
+  std::uint64_t read_after_sync = 0; ///< frames the controller read after its SYNC in the same cycle
 
   explicit OrderRig(bool first, const std::function<void(AxisSpec&, emulator::EmulatorConfig&)>& tweak = {})
       : SimController(tweak, first), sync_first(first) {
@@ -48,6 +49,7 @@ struct OrderRig : test::SimController {
   }
   ~OrderRig() override {
     EXPECT_EQ(test::counted_allocations(), 0u) << test::counted_bytes() << " bytes allocated in the cycle";
+    EXPECT_EQ(read_after_sync, 0u) << "frames read after the cycle's SYNC (" << order_name(sync_first) << ")";
   }
   OrderRig(const OrderRig&) = delete;
   OrderRig& operator=(const OrderRig&) = delete;
@@ -63,8 +65,14 @@ struct OrderRig : test::SimController {
     now += kPeriod;
     burst.clear();
     TraceRecord tr;
-    while (ctl->pop_trace(tr))
+    bool synced = false;
+    while (ctl->pop_trace(tr)) {
       if (tr.tx && tr.frame.t_ns == t) burst.push_back(tr.frame.frame.id);
+      if (tr.tx && tr.frame.frame.id == kSync) synced = true;
+      // Every frame of a cycle is read before its SYNC goes out (sync_first:
+      // a drive's answer to this SYNC, however fast, is read next cycle).
+      if (!tr.tx && synced) ++read_after_sync;
+    }
     check_burst();
   }
   void check_burst() {
