@@ -105,6 +105,17 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
       got_tpdo_ = true;
       tpdo_seen_ = true;
     }
+    // The TPDO that shows this homing completed: the drive re-referenced
+    // 0x6064 (to the home offset, an int32), so the position takes its base
+    // again from it, and the homing ends now, so that whoever reads the
+    // feedback before step() (the controller's planner) sees the completion
+    // and the new frame together: the jump to the home position is neither
+    // read as a move of up to 2^31 counts on top of the old frame's high
+    // bits nor seen before the homing's end.
+    if (homing_step_ == HomingStep::kStarted && homing_fresh_ && homing_status() == HomingStatus::kCompleted) {
+      fb_.position = fb_.position_raw;
+      end_homing(HomingResult::kCompleted);
+    }
     return true;
   }
   return false;
@@ -287,14 +298,7 @@ void DriveProxy::step_homing(std::int64_t now_ns) noexcept {
   }
   if (homing_step_ == HomingStep::kStarted && homing_fresh_) {
     const HomingStatus h = homing_status();
-    if (h == HomingStatus::kCompleted) {
-      // The drive re-referenced 0x6064 (to the home offset, an int32): its
-      // jump to the home position is not a move, so the unwrapped position
-      // takes its base again from this TPDO (a jump read as an int32
-      // difference would keep the old frame's high bits).
-      fb_.position = fb_.position_raw;
-      end_homing(HomingResult::kCompleted);
-    }
+    if (h == HomingStatus::kCompleted) end_homing(HomingResult::kCompleted);  // (on_frame() ends it first)
     else if (h == HomingStatus::kErrorMoving || h == HomingStatus::kErrorStopped) end_homing(HomingResult::kError);
   }
 }
