@@ -1,6 +1,7 @@
 // Issue 29 part 5: a CIP axis without position_error_tolerance is named once
 // at start (config::startup_warnings(), printed by canmotiond): the drive's
-// own 0x6065 following error window is then its only guard.
+// own 0x6065 following error window is then its only guard. And issue 29
+// part 3's load check of homing.offset against 0x607C's INTEGER32.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -58,6 +59,36 @@ TEST(StartupWarnings, NoneWhenEveryCipAxisIsGuarded) {
   std::string yaml = kYaml;
   yaml = yaml.substr(0, yaml.find("  - name: Bare"));
   EXPECT_TRUE(startup_warnings(load_string(yaml, "guarded.yaml")).empty());
+}
+
+// 0x607C (home offset) is INTEGER32 and the drive re-references 0x6064 to
+// it: an offset that does not fit is refused at load, never clamped.
+TEST(HomeOffset, OutsideInteger32IsRefusedNamingTheKey) {
+  const std::string head = R"(controller: {period_ms: 1}
+buses:
+  - {name: can0, interface: sim}
+axes:
+  - name: X
+    type: AXIS_CIP_DRIVE
+    bus: can0
+    node: 2
+    units: mm
+    conversion_constant: 1000
+    max_speed: 10
+    max_accel: 100
+    max_decel: 100
+    position_error_tolerance: 1
+    homing: {mode: Active, sequence: Switch, offset: )";
+  EXPECT_NO_THROW((void)load_string(head + "2147483.647}\n", "ok.yaml"));
+  try {
+    (void)load_string(head + "2147483.648}\n", "big.yaml");
+    FAIL() << "an offset of 2^31 counts was accepted";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("big.yaml:15:"), std::string::npos) << what;
+    EXPECT_NE(what.find("axes[0].homing.offset"), std::string::npos) << what;
+    EXPECT_NE(what.find("0x607C home offset (INTEGER32"), std::string::npos) << what;
+  }
 }
 
 }  // namespace
