@@ -7,7 +7,7 @@ namespace canmotion::config::load {
 
 namespace {
 
-void homing(Reader& r, const YAML::Node& n, const std::string& path, motion::HomingConfig& h) {
+void homing(Reader& r, const YAML::Node& n, const std::string& path, motion::HomingConfig& h, double conv) {
   if (!r.check_map(n, path, {"mode", "sequence", "position", "method", "speed_search", "speed_zero", "accel", "offset"}))
     return;
   using M = motion::HomingConfig::Mode;
@@ -23,7 +23,17 @@ void homing(Reader& r, const YAML::Node& n, const std::string& path, motion::Hom
   r.scalar(n, path, "speed_zero", h.speed_zero, 0.0, 1e12, "units/s");
   r.scalar(n, path, "accel", h.accel, 0.0, 1e15, "units/s^2");
   // 0x607C is written only when configured (a drive keeps its own otherwise).
-  if (n["offset"] && r.scalar(n, path, "offset", h.offset, -1e12, 1e12, "units")) h.write_offset = true;
+  if (n["offset"] && r.scalar(n, path, "offset", h.offset, -1e12, 1e12, "units")) {
+    // 0x607C is INTEGER32 (the drive re-references 0x6064 to it): never clamped.
+    const double cnt = std::round(h.offset * conv);
+    if (cnt < -2147483648.0 || cnt > 2147483647.0)
+      r.error(n["offset"], sub(path, "offset"),
+              fmt::format("{} units x conversion_constant {} = {} counts does not fit 0x607C home offset (INTEGER32, "
+                          "-2147483648 .. 2147483647)",
+                          h.offset, conv, cnt));
+    else
+      h.write_offset = true;
+  }
 }
 
 /// `direct_control:` of a CIP axis (MDS): direct command kind, drive ramps, SLAT.
@@ -140,7 +150,7 @@ AxisSettings axis(Reader& r, const YAML::Node& n, const std::string& path, const
                                   c.soft_limit_pos));
     }
   }
-  if (n["homing"]) homing(r, n["homing"], path + ".homing", c.homing);
+  if (n["homing"]) homing(r, n["homing"], path + ".homing", c.homing, c.conversion_constant);
   if (n["exception_actions"]) exception_actions(r, n["exception_actions"], path + ".exception_actions", c);
   const bool cip = c.type == motion::AxisType::CipDrive;
   if (cip) {

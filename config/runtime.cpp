@@ -332,4 +332,27 @@ Runtime build_runtime(const Config& cfg, RuntimeSpec spec, std::vector<std::uniq
 
 Runtime simulated_runtime(const Config& cfg) { return build_runtime(cfg, build_spec(cfg, true)); }
 
+std::vector<Diagnostic> startup_warnings(const Config& cfg) {
+  std::vector<Diagnostic> w;
+  for (std::size_t i = 0; i < cfg.axes.size(); ++i) {
+    const AxisSettings& a = cfg.axes[i];
+    if (a.axis.type != motion::AxisType::CipDrive || a.axis.position_error_tolerance > 0) continue;
+    Diagnostic d;
+    d.severity = Diagnostic::Severity::kWarning;
+    d.file = cfg.path;
+    d.where = a.where;
+    d.key = fmt::format("axes[{}].position_error_tolerance", i);
+    const std::string window =
+        a.drive.following_error_window > 0
+            ? fmt::format("{} counts, set by drive.following_error_window", a.drive.following_error_window)
+            : std::string("the drive's own value: drive.following_error_window is not set");
+    d.message = fmt::format(
+        "axis '{}' (AXIS_CIP_DRIVE) has no position_error_tolerance: the master does not check its position error, "
+        "and the drive's own 0x6065 following error window ({}) is then its only guard",
+        a.name, window);
+    w.push_back(std::move(d));
+  }
+  return w;
+}
+
 }  // namespace canmotion::config

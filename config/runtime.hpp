@@ -60,6 +60,14 @@ struct Runtime {
 /// Every bus simulated (`--sim`, tests): build_runtime(cfg, build_spec(cfg, true)).
 [[nodiscard]] Runtime simulated_runtime(const Config& cfg);
 
+/// What a run should say once at start about how its axes are guarded: one
+/// warning per AXIS_CIP_DRIVE axis without `position_error_tolerance`
+/// (named, at its line in the file): the master then never checks the
+/// position error, and the drive's own following error window 0x6065 is
+/// the only guard. canmotiond prints them after the configuration's own
+/// warnings. No I/O.
+[[nodiscard]] std::vector<Diagnostic> startup_warnings(const Config& cfg);
+
 /// The master-side drive configuration of a CIP axis (timeouts in ns, extra
 /// SDO writes, heartbeats, PDO profile), for the controller's period. The
 /// write hints name the YAML keys behind each boot write (`axes[axis_index]...`),

@@ -695,6 +695,52 @@ enum class HomingStatus : std::uint8_t {
 }
 
 // ============================================================================
+// Statusword bits 7, 11, 12, 13 by mode of operation (§1.2, §3)
+// ============================================================================
+/// What statusword bits 7 (warning), 11 (internal limit active), 12 and 13
+/// (operation mode specific) say in the mode 0x6061 shows. Bits 12 and 13
+/// mean different things per mode: in CSP, CSV and CST bit 12 is "drive
+/// follows the command value" (0: the target is ignored); in CSP bit 13 is
+/// "following error" (in CSV and CST it is reserved); in homing they are
+/// homing attained / homing error (decode_homing_status()), in profile
+/// position set-point acknowledge / following error. Only what the master
+/// uses is decoded here; other modes give follows_command and
+/// following_error false.
+struct StatusBits {
+  bool warning = false;          ///< bit 7, every mode
+  bool internal_limit = false;   ///< bit 11, every mode
+  bool follows_command = false;  ///< bit 12 in CSP, CSV, CST
+  bool following_error = false;  ///< bit 13 in CSP and PP
+  friend constexpr bool operator==(const StatusBits&, const StatusBits&) = default;
+};
+[[nodiscard]] constexpr StatusBits decode_status_bits(std::uint16_t statusword, Mode mode) noexcept {
+  StatusBits b;
+  b.warning = (statusword & sw::kWarning) != 0;
+  b.internal_limit = (statusword & sw::kInternalLimitActive) != 0;
+  b.follows_command = is_cyclic(mode) && (statusword & sw::kFollowsCommand) != 0;
+  b.following_error = (mode == Mode::kCsp || mode == Mode::kProfilePosition) && (statusword & sw::kFollowingError) != 0;
+  return b;
+}
+
+// ============================================================================
+// Positions: the drive frame is 64-bit counts, the wire carries 32 bits
+// ============================================================================
+/// The low 32 bits of a 64-bit position, as 0x607A / 0x6064 carry it (two's
+/// complement: it wraps modulo 2^32, never saturates). Realtime-safe.
+[[nodiscard]] constexpr std::int32_t low32(std::int64_t counts) noexcept {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::uint64_t>(counts)));
+}
+/// The 64-bit position whose low 32 bits are `wire` and that is nearest to
+/// `previous` (the position unwrapped by the int32 difference: previous +
+/// (int32)(wire - low32(previous))). Right as long as the position moves
+/// less than 2^31 counts between two readings. Realtime-safe.
+[[nodiscard]] constexpr std::int64_t unwrap32(std::int64_t previous, std::int32_t wire) noexcept {
+  const auto diff = static_cast<std::int32_t>(static_cast<std::uint32_t>(wire) -
+                                              static_cast<std::uint32_t>(static_cast<std::uint64_t>(previous)));
+  return previous + diff;
+}
+
+// ============================================================================
 // Interpolation time period (0x60C2): value x 10^index seconds
 // ============================================================================
 struct InterpolationPeriod {

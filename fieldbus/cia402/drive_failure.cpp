@@ -62,6 +62,13 @@ int Failure::describe_sdo_abort(std::span<char> out, double waited_ms) const noe
 
 int Failure::describe_transition(std::span<char> out, double waited_ms, const char* emcy) const noexcept {
   const auto sn = state_name(reached);
+  if (follow_missing)
+    return std::snprintf(out.data(), out.size(),
+                         "node %u: transition 4 towards Operation enabled not completed after %.1f ms: the drive shows "
+                         "Operation enabled in CSP, but statusword bit 12 (drive follows the command) stayed 0, "
+                         "statusword 0x%04X%s: the drive ignores 0x607A (target position); see its manual for what "
+                         "holds the command back (e.g. a halt, an interpolation or synchronisation setting)",
+                         node, waited_ms, statusword, emcy);
   const auto wn = state_name(wanted);
   const auto from = transition < kTransitions.size() ? state_name(kTransitions[transition].from) : "?";
   const auto to = transition < kTransitions.size() ? state_name(kTransitions[transition].to) : wn;

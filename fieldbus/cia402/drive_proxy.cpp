@@ -58,6 +58,7 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
 
 void DriveProxy::fail(FailureKind k, std::int64_t now_ns, std::int64_t waited, std::int64_t timeout) noexcept {
   failure_.kind = k;
+  failure_.follow_missing = false;  // (wait_follow() sets it after this)
   failure_.node = cfg_.node;
   failure_.phase = phase_;
   failure_.reached = state_;
@@ -88,7 +89,12 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
       // controller's feedback to the planner), not the last cycle's.
       if (phase_ == Phase::kOperational) state_ = decode_state(fb_.statusword);
     }
-    if (pos_slot_.pdo == p) fb_.position = static_cast<std::int32_t>(canopen::sign_extend(get(pos_slot_), 32));
+    if (pos_slot_.pdo == p) {
+      // The drive frame is 64-bit counts: 0x6064 unwrapped by int32 differences.
+      fb_.position_raw = static_cast<std::int32_t>(canopen::sign_extend(get(pos_slot_), 32));
+      fb_.position = pos_base_ ? unwrap32(fb_.position, fb_.position_raw) : fb_.position_raw;
+      pos_base_ = true;
+    }
     if (vel_slot_.pdo == p) fb_.velocity = static_cast<std::int32_t>(canopen::sign_extend(get(vel_slot_), 32));
     if (trq_slot_.pdo == p) fb_.torque = static_cast<std::int16_t>(canopen::sign_extend(get(trq_slot_), 16));
     if (mdisp_slot_.pdo == p) fb_.mode_display = static_cast<std::int8_t>(canopen::sign_extend(get(mdisp_slot_), 8));
@@ -98,6 +104,17 @@ bool DriveProxy::on_frame(const can::TimedFrame& tf) noexcept {
       fb_.last_tpdo_ns = tf.t_ns;
       got_tpdo_ = true;
       tpdo_seen_ = true;
+    }
+    // The TPDO that shows this homing completed: the drive re-referenced
+    // 0x6064 (to the home offset, an int32), so the position takes its base
+    // again from it, and the homing ends now, so that whoever reads the
+    // feedback before step() (the controller's planner) sees the completion
+    // and the new frame together: the jump to the home position is neither
+    // read as a move of up to 2^31 counts on top of the old frame's high
+    // bits nor seen before the homing's end.
+    if (homing_step_ == HomingStep::kStarted && homing_fresh_ && homing_status() == HomingStatus::kCompleted) {
+      fb_.position = fb_.position_raw;
+      end_homing(HomingResult::kCompleted);
     }
     return true;
   }
@@ -155,6 +172,7 @@ void DriveProxy::on_node_event(const canopen::NodeEvent& e) noexcept {
       }
       break;
     case K::kBootUp:
+      pos_base_ = false;  // a booted drive counts 0x6064 afresh: its next TPDO sets the base
       switch (phase_) {
         case Phase::kOperational:
         case Phase::kStarting:
@@ -187,6 +205,7 @@ void DriveProxy::follow_actual() noexcept {
 
 void DriveProxy::set_wanted(State s) noexcept {
   wanted_ = s;
+  follow_waiting_ = false;  // a new request times its wait for bit 12 afresh
   // A fault reset under way keeps its timing (and its bit 7 edge) when the
   // target changes, e.g. enable() right after fault_reset().
   if (!(in_flight_ && flight_.command == Command::kFaultReset && state_ == State::kFault)) in_flight_ = false;
@@ -279,7 +298,7 @@ void DriveProxy::step_homing(std::int64_t now_ns) noexcept {
   }
   if (homing_step_ == HomingStep::kStarted && homing_fresh_) {
     const HomingStatus h = homing_status();
-    if (h == HomingStatus::kCompleted) end_homing(HomingResult::kCompleted);
+    if (h == HomingStatus::kCompleted) end_homing(HomingResult::kCompleted);  // (on_frame() ends it first)
     else if (h == HomingStatus::kErrorMoving || h == HomingStatus::kErrorStopped) end_homing(HomingResult::kError);
   }
 }
@@ -353,6 +372,13 @@ bool DriveProxy::set_mode(Mode m) noexcept {
 [[gnu::always_inline]] inline void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
   state_ = decode_state(fb_.statusword);
   if (state_ != State::kOperationEnabled) leaving_enabled_ = false;  // it acted (or faulted)
+  // Bit 12 in CSP (awaiting_follow()): latched once seen in this Operation enabled.
+  if (state_ != State::kOperationEnabled) {
+    follow_ok_ = follow_waiting_ = false;
+  } else if (!awaiting_follow()) {
+    follow_ok_ = true;
+    follow_waiting_ = false;
+  }
   const bool faulted = state_ == State::kFault || state_ == State::kFaultReactionActive;
   if (faulted && !reset_requested_) {
     // (a fault reset that timed out keeps that failure: it says why the drive is still in Fault)
@@ -375,6 +401,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   // transition times out), then the enable climbs from where it is.
   const State target = leaving_enabled() && wanted_ == State::kOperationEnabled ? leave_.expect : wanted_;
   if (state_ == target) {
+    if (target == State::kOperationEnabled && awaiting_follow()) wait_follow(now_ns);
     hold_state(target);
     return;
   }
@@ -425,6 +452,22 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   ++flight_cycles_;
 }
 
+// Operation enabled in CSP without statusword bit 12 (awaiting_follow()):
+// timed like a transition (4, the one that was to make the drive follow),
+// failing once with Failure::follow_missing. From step_state_machine() only.
+void DriveProxy::wait_follow(std::int64_t now_ns) noexcept {
+  if (!follow_waiting_ || heartbeat_lost() || nmt_left_) {  // (a node that cannot hear us is not timed)
+    follow_waiting_ = true;
+    follow_since_ns_ = now_ns;
+  }
+  const std::int64_t waited = now_ns - follow_since_ns_;
+  if (waited <= cfg_.transition_timeout_ns || failure_.kind != FailureKind::kNone) return;
+  fail(FailureKind::kTransitionTimeout, now_ns, waited, cfg_.transition_timeout_ns);
+  failure_.transition = 4;
+  failure_.wanted = State::kOperationEnabled;
+  failure_.follow_missing = true;
+}
+
 void DriveProxy::send_rpdos(canopen::FrameSink& out) noexcept {
   for (std::uint8_t p = 0; p < pdos_.rpdo_count; ++p) {
     const canopen::PdoMap& m = pdos_.rpdo[p];
@@ -437,7 +480,7 @@ void DriveProxy::send_rpdos(canopen::FrameSink& out) noexcept {
     auto put = [&](std::uint64_t w, const Slot& s, std::uint64_t v) { return plan.put(w, static_cast<std::size_t>(s.entry), v); };
     std::uint64_t w = 0;
     if (cw_slot_.pdo == pi) w = put(w, cw_slot_, cw_);
-    if (tpos_slot_.pdo == pi) w = put(w, tpos_slot_, static_cast<std::uint32_t>(target_position_));
+    if (tpos_slot_.pdo == pi) w = put(w, tpos_slot_, static_cast<std::uint32_t>(low32(target_position_)));
     if (tvel_slot_.pdo == pi) w = put(w, tvel_slot_, static_cast<std::uint32_t>(target_velocity_));
     if (ttrq_slot_.pdo == pi) w = put(w, ttrq_slot_, static_cast<std::uint16_t>(target_torque_));
     if (mode_slot_.pdo == pi) w = put(w, mode_slot_, static_cast<std::uint8_t>(static_cast<std::int8_t>(mode_)));

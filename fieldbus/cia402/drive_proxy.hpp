@@ -204,6 +204,10 @@ struct Failure {
   /// after the node left NMT operational; false: they are its last TPDO's,
   /// from before it left (a Stopped node answers no SDO).
   bool statusword_read = false;
+  /// kTransitionTimeout: the drive showed Operation enabled in CSP, but
+  /// statusword bit 12 (drive follows the command) stayed 0: the master
+  /// never took it as enabled (DriveProxy::awaiting_follow()).
+  bool follow_missing = false;
   BootCheck check = BootCheck::kNone;  ///< kBootCheck: what did not match
   std::uint32_t read_value = 0;        ///< kBootCheck: what the drive has
   std::uint32_t expected = 0;          ///< kBootCheck: what the configuration expects (kSupportedModes: the missing mode)
@@ -232,7 +236,13 @@ struct Failure {
 /// Feedback from the TPDOs, in drive units (counts).
 struct Feedback {
   std::uint16_t statusword = 0;
-  std::int32_t position = 0;     ///< 0x6064
+  /// 0x6064 in the drive frame of 64-bit counts: unwrapped by int32
+  /// differences (cia402::unwrap32), so it goes on past +-2^31 where the
+  /// wire value wraps. The first TPDO after a boot-up (or NMT reset node)
+  /// sets the base: the position is then 0x6064 sign-extended; so does the
+  /// TPDO that shows a homing completed (the drive re-referenced 0x6064).
+  std::int64_t position = 0;
+  std::int32_t position_raw = 0;  ///< 0x6064 as the last TPDO carried it
   std::int32_t velocity = 0;     ///< 0x606C (if mapped)
   std::int16_t torque = 0;       ///< 0x6077 (if mapped)
   std::int8_t mode_display = 0;  ///< 0x6061 (if mapped; otherwise the mode last confirmed over SDO)
@@ -326,8 +336,10 @@ class DriveProxy {
   /// Homing status from statusword bits 13, 12, 10 as the drive shows them
   /// now (may be left from an earlier homing: see homing_result()).
   [[nodiscard]] HomingStatus homing_status() const noexcept { return decode_homing_status(fb_.statusword); }
-  /// Targets in drive units; used only while Operation enabled.
-  void set_target_position(std::int32_t counts) noexcept { target_position_ = counts; }
+  /// Targets in drive units; used only while Operation enabled. The
+  /// position is in the 64-bit drive frame (Feedback::position); 0x607A
+  /// carries its low 32 bits (cia402::low32: it wraps, never saturates).
+  void set_target_position(std::int64_t counts) noexcept { target_position_ = counts; }
   void set_target_velocity(std::int32_t counts_per_s) noexcept { target_velocity_ = counts_per_s; }
   void set_target_torque(std::int16_t per_mille) noexcept { target_torque_ = per_mille; }
   /// Restart the boot sequence from the start (wait for the node, NMT
@@ -344,9 +356,22 @@ class DriveProxy {
   [[nodiscard]] State state() const noexcept { return state_; }
   [[nodiscard]] State wanted() const noexcept { return wanted_; }
   /// True in Operation enabled with the targets taken from the setters (not
-  /// while leaving_enabled()).
+  /// while leaving_enabled() or awaiting_follow()).
   [[nodiscard]] bool enabled() const noexcept {
-    return phase_ == Phase::kOperational && state_ == State::kOperationEnabled && !leaving_enabled();
+    return phase_ == Phase::kOperational && state_ == State::kOperationEnabled && !leaving_enabled() &&
+           !awaiting_follow();
+  }
+  /// In CSP, Operation enabled counts as reached only once statusword bit 12
+  /// (drive follows the command) shows it: until then the drive may ignore
+  /// 0x607A. True from the TPDO that shows Operation enabled in CSP without
+  /// bit 12 until one shows it set (then latched while the drive stays in
+  /// Operation enabled; a later bit 12 = 0 is only reported, see
+  /// cia402::decode_status_bits()). The wait is timed with
+  /// DriveConfig::transition_timeout_ns, then a kTransitionTimeout failure
+  /// with Failure::follow_missing. Realtime-safe.
+  [[nodiscard]] bool awaiting_follow() const noexcept {
+    return state_ == State::kOperationEnabled && !follow_ok_ && mode_ == Mode::kCsp &&
+           (fb_.statusword & sw::kFollowsCommand) == 0;
   }
   /// True while no transition is in progress (the state is the wanted one).
   [[nodiscard]] bool settled() const noexcept { return state_ == wanted_ && !leaving_enabled(); }
@@ -360,7 +385,7 @@ class DriveProxy {
   [[nodiscard]] bool leaving_enabled() const noexcept { return leaving_enabled_ && state_ == State::kOperationEnabled; }
   [[nodiscard]] const Feedback& feedback() const noexcept { return fb_; }
   [[nodiscard]] Mode mode() const noexcept { return mode_; }
-  [[nodiscard]] std::int32_t target_position() const noexcept { return target_position_; }
+  [[nodiscard]] std::int64_t target_position() const noexcept { return target_position_; }
   [[nodiscard]] std::int32_t target_velocity() const noexcept { return target_velocity_; }
   [[nodiscard]] std::int16_t target_torque() const noexcept { return target_torque_; }
   [[nodiscard]] std::uint16_t controlword() const noexcept { return cw_; }
@@ -418,6 +443,7 @@ class DriveProxy {
   void queue_transfers(canopen::SdoClient& sdo) noexcept;
   void step_state_machine(std::int64_t now_ns) noexcept;
   void hold_state(State target) noexcept;            // step_state_machine(): the controlword in the wanted state
+  void wait_follow(std::int64_t now_ns) noexcept;     // step_state_machine(): Operation enabled in CSP without bit 12
   void send_fault_reset(std::int64_t now_ns) noexcept;  // step_state_machine(): transition 15's bit 7 edge
   void send_rpdos(canopen::FrameSink& out) noexcept;
   void follow_actual() noexcept;
@@ -469,6 +495,9 @@ class DriveProxy {
   // The transition in progress.
   bool in_flight_ = false;
   bool leaving_enabled_ = false;       // leaving_enabled(): a command out of Operation enabled went out
+  bool follow_ok_ = false;             // awaiting_follow(): bit 12 (or a mode other than CSP) seen in this Operation enabled
+  bool follow_waiting_ = false;        // awaiting_follow() is being timed since follow_since_ns_
+  std::int64_t follow_since_ns_ = 0;
   PlanStep leave_{Command::kDisableVoltage, kNoTransition, State::kUnknown};  // that command
   PlanStep flight_{Command::kShutdown, kNoTransition, State::kUnknown};
   State flight_from_ = State::kUnknown;
@@ -498,10 +527,11 @@ class DriveProxy {
   void check_mode_switch(std::int64_t now_ns) noexcept;
   std::uint16_t cw_ = 0;
   std::uint16_t cw_sent_ = 0;  // on_sync_sent(false): the controlword of the previous cycle's RPDO
-  std::int32_t target_position_ = 0;
+  std::int64_t target_position_ = 0;  // drive frame (64-bit counts); the RPDO carries low32()
   std::int32_t target_velocity_ = 0;
   std::int16_t target_torque_ = 0;
   Feedback fb_{};
+  bool pos_base_ = false;  // fb_.position has a base (false: the next 0x6064 sets it)
   bool got_tpdo_ = false;
   bool expect_tpdo_ = false;
   bool tpdo_seen_ = false;

@@ -105,7 +105,7 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
                         static_cast<std::int32_t>(sval(hot_.target_velocity)),
                         static_cast<std::int16_t>(sval(hot_.target_torque))};
       delay_.fill(sp);
-      prev_demand_ = sp.position;
+      prev_demand_ = static_cast<double>(cia402::unwrap32(position_counts(), sp.position));
       if (!cfg_.refuse_mode_switch && cfg_.behaviour.mode_switch_syncs == 0 && mode_supported(static_cast<std::int8_t>(sval(hot_.modes))))
         set_mode_display(static_cast<std::int8_t>(sval(hot_.modes)));
       reset_direct_model();
@@ -148,7 +148,11 @@ void Emulator::advance_motor(double dt) noexcept {
   if (state_ == State::kOperationEnabled) {
     switch (mode) {
       case cia402::Mode::kCsp: {
-        const double demand = sp.position;
+        // 0x607A is 32 bits and wraps like 0x6064: the demand is the 64-bit
+        // position nearest the last one with these low bits (a step of more
+        // than 2^31 counts per SYNC is not a target a drive can take).
+        const double demand = static_cast<double>(
+            cia402::unwrap32(static_cast<std::int64_t>(std::clamp(prev_demand_, -0x1p62, 0x1p62)), sp.position));
         // Feed-forward of the demand's change plus a proportional correction
         // of the error left from the previous SYNC: a ramp is followed exactly
         // (the only following error is the lag), a step settles geometrically.
@@ -345,7 +349,9 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
   const auto window = static_cast<std::uint32_t>(val(hot_.fe_window));
   if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kCsp) &&
       window != 0xFFFFFFFFu) {
-    const double fe = std::abs(static_cast<double>(sval(hot_.target_position)) - pos_);
+    // The error between 0x607A and the position, both modulo 2^32 (as 0x60F4).
+    const auto target = static_cast<std::int32_t>(sval(hot_.target_position));
+    const double fe = std::abs(static_cast<double>(cia402::unwrap32(position_counts(), target)) - pos_);
     if (fe > window) {
       following_error_ = true;
       ++following_error_cycles_;

@@ -45,7 +45,7 @@ Emulator::Emulator(const EmulatorConfig& cfg)
   cfg_.lag_cycles = std::min<std::uint32_t>(cfg_.lag_cycles, kMaxLag);
   build_dictionary();
   resolve_hot();
-  pos_ = cfg_.initial_position;
+  pos_ = static_cast<double>(cfg_.initial_position);
   torque_per_acc_ = 1000.0 / cfg_.max_acceleration;
 }
 

@@ -171,7 +171,7 @@ struct EmulatorConfig {
   std::uint32_t lag_cycles = 2;            ///< targets take effect this many SYNCs late
   double position_gain = 0.5;              ///< fraction of the position error corrected per SYNC (0..1]
   std::uint32_t following_error_window = 100'000;  ///< 0x6065 default
-  std::int32_t initial_position = 0;
+  std::int64_t initial_position = 0;  ///< counts (0x6064 shows its low 32 bits)
   // Fault injection.
   std::uint64_t fail_after_syncs = 0;      ///< 0 = never
   std::uint16_t fail_emcy_code = 0x2310;   ///< code used by fail_after_syncs
@@ -291,8 +291,14 @@ class Emulator final : public canopen::SdoServerBackend {
   [[nodiscard]] canopen::NmtState nmt_state() const noexcept { return nmt_; }
   [[nodiscard]] cia402::State state() const noexcept { return state_; }
   [[nodiscard]] std::uint16_t statusword() const noexcept;
-  [[nodiscard]] std::int32_t position() const noexcept {
-    return static_cast<std::int32_t>(std::clamp(cia402::round_half_away(pos_), -2147483648.0, 2147483647.0));
+  /// 0x6064 as the drive sends it: the low 32 bits of position_counts()
+  /// (two's complement: it wraps at +-2^31 like a real drive's counter,
+  /// never saturates).
+  [[nodiscard]] std::int32_t position() const noexcept { return cia402::low32(position_counts()); }
+  /// The motor's position in whole counts, 64 bits (the model's own frame:
+  /// it never wraps).
+  [[nodiscard]] std::int64_t position_counts() const noexcept {
+    return static_cast<std::int64_t>(std::clamp(cia402::round_half_away(pos_), -0x1p62, 0x1p62));
   }
   [[nodiscard]] double position_exact() const noexcept { return pos_; }
   [[nodiscard]] double velocity() const noexcept { return vel_; }

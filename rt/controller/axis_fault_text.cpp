@@ -1,7 +1,8 @@
 // describe_axis_fault(): the log text of an axis exception latched as a
 // fault (Event::Kind::kAxisFault); describe_drive_wait(): of an instruction
-// that waited on the drive and ended with an error (Event::Kind::kDriveWait).
-// Not RT: canmotiond's housekeeping thread.
+// that waited on the drive and ended with an error (Event::Kind::kDriveWait);
+// describe_drive_status_bit(): a statusword bit's rising edge
+// (Event::Kind::kDriveStatusBit). Not RT: canmotiond's housekeeping thread.
 #include <fmt/format.h>
 
 #include <cstdlib>
@@ -105,6 +106,34 @@ std::string describe_drive_wait(const Event& e, const AxisSpec& axis, std::size_
   const std::string_view name = motion::signature(w.instr).name;
   return fmt::format("{}{}{} ended with ERR {} EXERR {} after {:.3f} s: {}{}", name, control.empty() ? "" : " ", control,
                      w.err, w.exerr, static_cast<double>(w.waited_cycles) * period_s, why, drive);
+}
+
+std::string describe_drive_status_bit(const Event& e, const AxisSpec& axis, std::size_t index) {
+  std::string_view what, why;
+  switch (e.value) {
+    case 7:
+      what = "bit 7 (warning)";
+      why = "the drive reports a condition short of a fault (its EMCY or 0x603F says which, where it sends one); "
+            "motion goes on";
+      break;
+    case 11:
+      what = "bit 11 (internal limit active)";
+      why = "the drive limits its own motion (a position, speed, torque or current limit of its own): the axis "
+            "may not follow the command while it lasts";
+      break;
+    default:
+      what = "bit 13 (following error)";
+      why = "the drive's own following error window 0x6065 is exceeded (it faults when 0x6066 expires, if its "
+            "following error option says so)";
+      break;
+  }
+  const std::string_view mode = cia402::mode_name(static_cast<cia402::Mode>(e.mode_display));
+  std::string guard;
+  if (e.value == 13 && axis.config.position_error_tolerance <= 0)
+    guard = fmt::format("; axes[{}].position_error_tolerance is not set: the drive's window is the axis's only guard",
+                        index);
+  return fmt::format("drive node {} set statusword {} in {} (0x6061 = {}), statusword 0x{:04X}: {}{}", e.drive.node,
+                     what, mode, e.mode_display, e.drive.statusword, why, guard);
 }
 
 }  // namespace canmotion::rt

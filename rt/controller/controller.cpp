@@ -254,7 +254,7 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   const cia402::DriveProxy& p = *ax.proxy;
   const cia402::Feedback& d = p.feedback();
   const bool operational = p.phase() == cia402::Phase::kOperational;
-  f.position = static_cast<double>(d.position) / ax.conv;
+  f.position = static_cast<double>(d.position) / ax.conv;  // 64-bit counts (DriveProxy unwraps 0x6064)
   const bool vel_mapped = p.pdos().tpdo_count > 1;
   if (vel_mapped) {
     f.velocity = static_cast<double>(d.velocity) / ax.conv;
@@ -266,7 +266,21 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   // Operation enabled that may predate a command out of it (the drive has not
   // shown the transition yet, DriveProxy::leaving_enabled) is not Enabled:
   // an MSO then waits for the drive to leave it and be enabled again.
-  f.drive = drive_state_of(p.state(), operational && !p.leaving_enabled());
+  // In CSP, Operation enabled without statusword bit 12 (the drive does not
+  // follow the command yet, DriveProxy::awaiting_follow()) is not Enabled
+  // either: MSO ends only once the drive follows.
+  f.drive = drive_state_of(p.state(), operational && !p.leaving_enabled() && !p.awaiting_follow());
+  // Statusword bits 7, 11 and 13 (by mode): one event on each rising edge.
+  if (operational) {
+    const cia402::StatusBits sb = cia402::decode_status_bits(d.statusword, static_cast<cia402::Mode>(d.mode_display));
+    const auto bits = static_cast<std::uint8_t>((sb.warning ? 1u : 0u) | (sb.internal_limit ? 2u : 0u) |
+                                                (sb.following_error ? 4u : 0u));
+    if (const auto rising = static_cast<std::uint8_t>(bits & ~ax.status_bits); rising != 0) [[unlikely]]
+      emit_status_bits(a, rising);
+    ax.status_bits = bits;
+  } else {
+    ax.status_bits = 0;  // reported again if still set once the drive is back
+  }
   using FK = cia402::FailureKind;
   const FK kind = p.failure().kind;
   // A refused mode switch (0x6061 never showed the mode, drive.timeouts.mode_switch_ms)
@@ -313,6 +327,26 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   ax.failure_rev = p.failure_revision();
 }
 
+// A statusword bit's rising edge (rare): out of line, one event per bit
+// (`rising`: 1 bit 7 warning, 2 bit 11 internal limit, 4 bit 13 following error).
+[[gnu::cold, gnu::noinline]] void Controller::emit_status_bits(std::size_t a, std::uint8_t rising) noexcept {
+  const AxisRt& ax = axes_[a];
+  const cia402::DriveProxy& p = *ax.proxy;
+  constexpr std::array<std::uint8_t, 3> kBit{7, 11, 13};
+  for (std::size_t k = 0; k < kBit.size(); ++k) {
+    if (!(rising & (1u << k))) continue;
+    Event e;
+    e.kind = Event::Kind::kDriveStatusBit;
+    e.bus = static_cast<std::uint8_t>(ax.bus);
+    e.axis = static_cast<std::int16_t>(a);
+    e.value = kBit[k];
+    e.cycle = cycle_index_;
+    e.drive = Event::DriveView{p.phase(), p.state(), p.feedback().statusword, p.node()};
+    e.mode_display = p.feedback().mode_display;
+    emit(e);
+  }
+}
+
 // Called once per axis per cycle from cycle() only: inlined there (no call per axis).
 [[gnu::always_inline]] inline void Controller::apply(std::size_t a, const motion::AxisOutput& out) noexcept {
   AxisRt& ax = axes_[a];
@@ -354,7 +388,12 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
     if (v < std::numeric_limits<std::int32_t>::min()) return std::numeric_limits<std::int32_t>::min();
     return static_cast<std::int32_t>(v);
   };
-  p.set_target_position(sat32(out.position * ax.conv));
+  // The position in the drive frame of 64-bit counts (0x607A carries its
+  // low 32 bits: DriveProxy); a command that is not a number holds the last
+  // target. Beyond 2^62 counts (never reached: 2^53 is the last exact double,
+  // README "Positions past 32 bits") it is held at that bound.
+  const double pc = round_half_away(out.position * ax.conv);
+  if (pc == pc) p.set_target_position(static_cast<std::int64_t>(std::clamp(pc, -0x1p62, 0x1p62)));
   p.set_target_velocity(sat32(out.velocity * ax.conv));
   const double t = out.torque == 0.0 ? 0.0 : round_half_away(out.torque);  // CSP and CSV axes: 0
   p.set_target_torque(static_cast<std::int16_t>(t > 32767 ? 32767 : (t < -32768 ? -32768 : t)));

@@ -203,6 +203,9 @@ struct Event {
     kDriveWait,    ///< an instruction that waited on an axis's drive (MSO, MSF, MDS, MAFR, MASR, MGSR) ended
                    ///< with an error: `wait` says which and why, `drive` and `failure` what the drive
                    ///< was doing then; see describe_drive_wait()
+    kDriveStatusBit,  ///< a CIP axis's statusword bit rose: `value` = 7 (warning), 11 (internal limit
+                      ///< active) or 13 (following error, CSP); `drive` and `mode_display` as then
+                      ///< (cia402::decode_status_bits()); see describe_drive_status_bit()
   };
   Kind kind = Kind::kNode;
   std::uint8_t bus = 0;
@@ -222,6 +225,7 @@ struct Event {
     std::uint16_t statusword = 0;
     std::uint8_t node = 0;
   } drive{};
+  std::int8_t mode_display = 0;  ///< kDriveStatusBit: 0x6061 when the bit rose
 };
 
 /// One frame on one bus, for the candump trace.
@@ -247,8 +251,8 @@ struct AxisSnapshot {
   cia402::State drive_state = cia402::State::kUnknown;
   std::uint16_t statusword = 0;
   std::uint16_t controlword = 0;
-  std::int32_t target_counts = 0;
-  std::int32_t actual_counts = 0;
+  std::int64_t target_counts = 0;  ///< 64-bit drive frame (0x607A carries the low 32 bits)
+  std::int64_t actual_counts = 0;  ///< 0x6064 unwrapped (cia402::Feedback::position)
   std::int8_t mode_display = 0;
   std::uint16_t last_emcy = 0;
   std::uint64_t tpdo_missed = 0;
@@ -399,7 +403,8 @@ class Controller {
     cia402::DriveProxy* proxy = nullptr;
     double conv = 1.0;
     bool have_prev = false;
-    std::int32_t prev_counts = 0;
+    std::int64_t prev_counts = 0;
+    std::uint8_t status_bits = 0;  ///< statusword bits 7, 11, 13 last cycle (1, 2, 4): kDriveStatusBit on rising edges
     bool failure_reported = false;
     std::uint32_t failure_rev = 0;  ///< DriveProxy::failure_revision() when the failure was last reported
     bool homing_out = false;  ///< the planner's homing_start as last handed to the proxy (its edges start/cancel)
@@ -439,6 +444,7 @@ class Controller {
   void emit(const Event& e) noexcept;
   void emit_bus_event(std::size_t b, Event::Kind k, std::uint64_t value = 0,
                       can::BusState state = can::BusState::kErrorActive) noexcept;
+  void emit_status_bits(std::size_t a, std::uint8_t rising) noexcept;
   void build_arrays();                              ///< controller_arrays.cpp (constructor)
 
   ControllerSpec spec_;
@@ -508,5 +514,9 @@ class Controller {
 /// realtime (fmt).
 [[nodiscard]] std::string describe_drive_wait(const Event& e, const AxisSpec& axis, std::size_t index,
                                               std::string_view control, double period_s);
+/// The log text of an Event::Kind::kDriveStatusBit on axis `axis` (its
+/// index in the configuration), e.g. "drive node 2 set statusword bit 11
+/// (internal limit active) in CSP, statusword 0x0A37: ...". Not realtime (fmt).
+[[nodiscard]] std::string describe_drive_status_bit(const Event& e, const AxisSpec& axis, std::size_t index);
 
 }  // namespace canmotion::rt

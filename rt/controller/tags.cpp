@@ -29,6 +29,7 @@ enum Attr : std::uint8_t {
   kActualPosition, kCommandPosition, kActualVelocity, kCommandVelocity, kCommandAcceleration, kPositionError,
   kMotionStatus, kAxisStatus, kAxisFault, kAxisState, kDriveState, kStatusword, kControlword, kLastEmcy,
   kTpdoMissed, kMaxPositionError, kDirectCommandVelocity, kDirectCommandTorque,
+  kDriveWarning, kInternalLimitActive, kDriveFollowsCommand, kDriveFollowingError, kActualCounts, kTargetCounts,
 };
 struct Named {
   std::string_view name;
@@ -45,6 +46,11 @@ constexpr std::array kAttrs{
     Named{"TpdoMissed", kTpdoMissed},           Named{"MaxPositionError", kMaxPositionError},
     // MDS live commands (writable; read back as the last value written here)
     Named{"DirectCommandVelocity", kDirectCommandVelocity}, Named{"DirectCommandTorque", kDirectCommandTorque},
+    // Statusword bits 7, 11, 12, 13 as the drive's mode gives them meaning (cia402::decode_status_bits)
+    Named{"DriveWarning", kDriveWarning},       Named{"InternalLimitActive", kInternalLimitActive},
+    Named{"DriveFollowsCommand", kDriveFollowsCommand}, Named{"DriveFollowingError", kDriveFollowingError},
+    // The drive frame in 64-bit counts: 0x6064 unwrapped, 0x607A before its low 32 bits are sent
+    Named{"ActualCounts", kActualCounts},       Named{"TargetCounts", kTargetCounts},
 };
 namespace ms = motion::motion_status;
 constexpr std::array kMotionBits{
@@ -361,6 +367,20 @@ double TagTable::read(const Status& s, const TagRef& t) const {
         case kDirectCommandTorque: {
           const auto it = direct_.find((static_cast<std::uint32_t>(t.index) << 8) | t.member);
           return it == direct_.end() ? 0.0 : it->second;
+        }
+        case kActualCounts: return static_cast<double>(a.actual_counts);
+        case kTargetCounts: return static_cast<double>(a.target_counts);
+        case kDriveWarning:
+        case kInternalLimitActive:
+        case kDriveFollowsCommand:
+        case kDriveFollowingError: {
+          const cia402::StatusBits b =
+              cia402::decode_status_bits(a.statusword, static_cast<cia402::Mode>(a.mode_display));
+          const bool on = t.member == kDriveWarning          ? b.warning
+                          : t.member == kInternalLimitActive ? b.internal_limit
+                          : t.member == kDriveFollowsCommand ? b.follows_command
+                                                             : b.following_error;
+          return on ? 1.0 : 0.0;
         }
         default: return a.max_abs_position_error;
       }

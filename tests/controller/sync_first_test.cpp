@@ -193,7 +193,7 @@ MoveRecord record_move(bool sync_first, double tolerance, bool planner_lag = tru
   r.servo_on("mso1");
   r.exec(OrderRig::mam("mam1", 100.0, 50.0));  // taken in the last cycle exec() ran
   auto sample = [&] {
-    m.target.push_back(r.axis().target_counts);
+    m.target.push_back(static_cast<int>(r.axis().target_counts));
     m.applied.push_back(r.world.drive(0).read_int(0x607A));
     m.position.push_back(r.world.drive(0).position());
     m.max_position_error = std::max(m.max_position_error, std::abs(r.read("X.PositionError")));

@@ -60,10 +60,10 @@ TEST(FieldbusLoop, CspRampFollowedWithinLag) {
   auto& d = rig.drive(2);
   EXPECT_EQ(d.target_position(), 12345);  // target followed actual until enabled
   const double v = 100'000.0;              // counts/s
-  const std::int32_t start = d.feedback().position;
+  const std::int64_t start = d.feedback().position;
   double max_err = 0;
   for (int k = 1; k <= 2000; ++k) {
-    const auto target = static_cast<std::int32_t>(start + v * k * 1e-3);
+    const std::int64_t target = start + static_cast<std::int64_t>(v * k * 1e-3);
     for (std::uint8_t n : kNodes) rig.drive(n).set_target_position(target);
     rig.step();
     if (k > 200) max_err = std::max(max_err, std::abs(static_cast<double>(d.target_position() - d.feedback().position)));
@@ -386,9 +386,9 @@ TEST(FieldbusLoop, CsvAndCstModeSwitching) {
   EXPECT_EQ(d.feedback().mode_display, 9);
   EXPECT_EQ(d.feedback().velocity, 50'000);
   EXPECT_TRUE(d.enabled());
-  const std::int32_t p0 = d.feedback().position;
+  const std::int64_t p0 = d.feedback().position;
   for (int i = 0; i < 100; ++i) rig.step();
-  EXPECT_NEAR(d.feedback().position - p0, 5'000, 2);  // 50 000 counts/s for 100 ms
+  EXPECT_NEAR(static_cast<double>(d.feedback().position - p0), 5'000, 2);  // 50 000 counts/s for 100 ms
   ASSERT_TRUE(d.set_mode(cia402::Mode::kCst));
   EXPECT_EQ(d.target_torque(), d.feedback().torque);  // bumpless: starts at the actual torque
   d.set_target_torque(-100);

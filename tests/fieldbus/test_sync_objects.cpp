@@ -96,15 +96,15 @@ TEST(SyncObjects, CounterOnAStrictDriveEverySyncTakenAndMotionFollows) {
   rig.network().enable_all();
   ASSERT_TRUE(rig.run_until([&] { return rig.network().all_enabled(); }, 2000)) << rig.drive(2).failure().to_string();
   // A ramp of 20 counts per cycle for 500 cycles on both drives.
-  const std::int32_t p2 = rig.drive(2).feedback().position, p3 = rig.drive(3).feedback().position;
+  const std::int64_t p2 = rig.drive(2).feedback().position, p3 = rig.drive(3).feedback().position;
   for (int i = 1; i <= 500; ++i) {
     rig.drive(2).set_target_position(p2 + 20 * i);
     rig.drive(3).set_target_position(p3 - 20 * i);
     rig.step();
   }
   for (int i = 0; i < 20; ++i) rig.step();
-  EXPECT_NEAR(rig.emulator(2).position(), p2 + 10'000, 2);
-  EXPECT_NEAR(rig.emulator(3).position(), p3 - 10'000, 2);
+  EXPECT_NEAR(static_cast<double>(rig.emulator(2).position_counts() - p2), 10'000, 2);
+  EXPECT_NEAR(static_cast<double>(rig.emulator(3).position_counts() - p3), -10'000, 2);
   for (const std::uint8_t n : {std::uint8_t{2}, std::uint8_t{3}}) {
     const emulator::EmulatorCounters& k = rig.emulator(n).counters();
     EXPECT_EQ(k.sync_length_errors, dropped[n - 2u]) << int{n};

@@ -107,12 +107,12 @@ int main(int argc, char** argv) {
     cycle_once();
   }
   std::printf("fieldbus-vcan-master: all enabled\n");
-  std::vector<std::int32_t> start;
+  std::vector<std::int64_t> start;
   for (std::size_t i = 0; i < net.size(); ++i) start.push_back(net.at(i).feedback().position);
   constexpr std::int32_t kStep = 100;  // counts per cycle
   for (long k = 1; k <= ramp_cycles; ++k) {
     for (std::size_t i = 0; i < net.size(); ++i)
-      net.at(i).set_target_position(start[i] + static_cast<std::int32_t>(k) * kStep);
+      net.at(i).set_target_position(start[i] + static_cast<std::int64_t>(k) * kStep);
     cycle_once();
     if (net.any_failed()) return fail("failure during the ramp");
   }
@@ -121,13 +121,14 @@ int main(int argc, char** argv) {
   int rc = 0;
   for (std::size_t i = 0; i < net.size(); ++i) {
     const auto& d = net.at(i);
-    const std::int32_t want = start[i] + static_cast<std::int32_t>(ramp_cycles) * kStep;
-    const std::int32_t got = d.feedback().position;
-    std::printf("fieldbus-vcan-master: node %u moved %d -> %d (target %d), TPDOs %llu, missed %llu\n", d.node(), start[i],
-                got, want, static_cast<unsigned long long>(d.feedback().tpdo_count),
+    const std::int64_t want = start[i] + static_cast<std::int64_t>(ramp_cycles) * kStep;
+    const std::int64_t got = d.feedback().position;
+    std::printf("fieldbus-vcan-master: node %u moved %lld -> %lld (target %lld), TPDOs %llu, missed %llu\n", d.node(),
+                static_cast<long long>(start[i]), static_cast<long long>(got), static_cast<long long>(want), static_cast<unsigned long long>(d.feedback().tpdo_count),
                 static_cast<unsigned long long>(d.feedback().tpdo_missed));
     if (std::abs(got - want) > 2) {
-      std::fprintf(stderr, "fieldbus-vcan-master: node %u did not follow the ramp (at %d, want %d)\n", d.node(), got, want);
+      std::fprintf(stderr, "fieldbus-vcan-master: node %u did not follow the ramp (at %lld, want %lld)\n", d.node(),
+                   static_cast<long long>(got), static_cast<long long>(want));
       rc = 1;
     }
   }

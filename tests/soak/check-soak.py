@@ -7,6 +7,15 @@ PRINT line per lap of the coordinated loop, then the --stats summary. Checks:
   gear     every lap: G's command position in counts is 3/7 of M's, to
            within one count (MAG fraction 3:7, no clutch: exact integer
            counts, so no drift whatever the run's length)
+  cam      every lap: C's continuous time cam (+360 deg a 2 s pass, counted
+           from the cycle of the line printed after MATC) is exactly
+           360 k deg in the pass's first dwell, 360 (k + 1) in its last,
+           and in between otherwise: no pass lost or gained, no drift
+  wrap     G and C run past 2^31 and 2^32 counts (their ActualCounts, the
+           drive frame of 64-bit counts) when the run is long enough for
+           it (G: 1.4 h, C: 40 min), and ActualPosition x conversion
+           constant stays that count (the feedback is unwrapped, never
+           saturated)
   lap      every lap ends exactly where it started (X = Y = 0)
   cycle    Controller.Cycle equals the lap's time / period (the cycle
            counter and the clock agree), and grows lap by lap
@@ -27,6 +36,9 @@ import re
 import sys
 
 PERIOD_S = 0.001
+CONV_M = CONV_G = 100000.0  # counts/mm (soak.yaml): the gear is in counts
+CONV_C = 10000.0            # counts/deg
+CAM_PASS_S, CAM_RISE = 2.0, 360.0
 LINE = re.compile(r"^t=([0-9.]+) (.*)$")
 DRIVE = re.compile(r"^summary: emulated drive node +(\d+) on bus (\S+): (\d+) SYNCs taken \((\d+) counter errors, "
                    r"(\d+) of the wrong length\), (\d+) RPDOs, (\d+) TPDOs, (\d+) boot-ups, (\d+) EMCYs$")
@@ -47,6 +59,7 @@ def main():
 
     fails = []
     laps = []
+    cam_start = None
     drives, buses, cycles = [], {}, None
     with open(a.log) as f:
         for raw in f:
@@ -55,6 +68,9 @@ def main():
             if m and "Controller.Cycle=" in line:
                 v = {k: float(x) for k, x in (kv.split("=", 1) for kv in m.group(2).split())}
                 v["t"] = float(m.group(1))
+                if "M.CommandPosition" not in v:  # the line after MATC: the cam's start
+                    cam_start = v
+                    continue
                 laps.append(v)
                 continue
             if (m := DRIVE.match(line)):
@@ -76,7 +92,7 @@ def main():
     prev_cycle = -1
     for v in laps:
         where = f"lap at t={v['t']:.3f}"
-        m_counts, g_counts = v["M.CommandPosition"] * 1000, v["G.CommandPosition"] * 1000
+        m_counts, g_counts = v["M.CommandPosition"] * CONV_M, v["G.CommandPosition"] * CONV_G
         err = g_counts - m_counts * 3 / 7
         gear_max = max(gear_max, abs(err))
         v["gear_err"] = err
@@ -88,6 +104,24 @@ def main():
         if abs(c - round(v["t"] / PERIOD_S)) > 0.5 or c <= prev_cycle:
             fails.append(f"{where}: Controller.Cycle {c:.0f} does not match t / period or did not grow (previous {prev_cycle:.0f})")
         prev_cycle = c
+        if cam_start is not None:
+            # The MATC starts in the cycle of the line after it or the next:
+            # the cam coordinate is (cycle - start) ms less 0..2 ms.
+            x = (c - cam_start["Controller.Cycle"]) * PERIOD_S
+            k = int(x // CAM_PASS_S)
+            phase = x - k * CAM_PASS_S
+            cp = v["C.CommandPosition"]
+            if 0.01 <= phase <= 0.39 and cp != CAM_RISE * k:
+                fails.append(f"{where}: cam pass {k} first dwell: C at {cp}, not {CAM_RISE * k}")
+            elif 1.61 <= phase <= 1.99 and cp != CAM_RISE * (k + 1):
+                fails.append(f"{where}: cam pass {k} last dwell: C at {cp}, not {CAM_RISE * (k + 1)}")
+            elif not (CAM_RISE * k - 1e-6 <= cp <= CAM_RISE * (k + 1) + 1e-6):
+                fails.append(f"{where}: cam pass {k}: C at {cp}, outside [{CAM_RISE * k}, {CAM_RISE * (k + 1)}]")
+            v["cam_pass"] = k
+        for ax, conv in (("G", CONV_G), ("C", CONV_C)):
+            counts, act = v[f"{ax}.ActualCounts"], v[f"{ax}.ActualPosition"] * conv
+            if abs(counts - act) > 1.0:
+                fails.append(f"{where}: {ax}.ActualCounts {counts:.0f} but ActualPosition x {conv:.0f} = {act:.1f}")
         if v["mag1.IP"] != 1 or v["matc1.IP"] != 1:
             fails.append(f"{where}: the gear (IP {v['mag1.IP']:.0f}) or the cam (IP {v['matc1.IP']:.0f}) is no longer in process")
         for ax in "GCXY":
@@ -95,6 +129,16 @@ def main():
                 fails.append(f"{where}: {ax}.AxisFault = {v[f'{ax}.AxisFault']:.0f}")
             if v[f"{ax}.TpdoMissed"] != 0:
                 fails.append(f"{where}: {ax}.TpdoMissed = {v[f'{ax}.TpdoMissed']:.0f}")
+
+    if cam_start is None:
+        fails.append("no line after MATC (Controller.Cycle, C.CommandPosition): the cam cannot be checked")
+    # Past the 32-bit wire range: the drive frame is 64-bit counts.
+    for ax, speed in (("G", 20 * 3 / 7 * CONV_G), ("C", CAM_RISE / CAM_PASS_S * CONV_C)):
+        top = max(v[f"{ax}.ActualCounts"] for v in laps)
+        for bound, name in ((2**31, "2^31"), (2**32, "2^32")):
+            if laps[-1]["t"] > bound / speed + 600 and top <= bound:
+                fails.append(f"{ax} never ran past {name} counts (at most {top:.0f}) in {laps[-1]['t']:.0f} s")
+        print(f"check-soak: {ax} reached {top:.0f} counts ({top / 2**32:.2f} x 2^32)")
 
     # The summary: SYNC counter, TPDO/RPDO and cycle counters.
     if cycles is None or not buses or len(drives) != 4:
@@ -127,14 +171,16 @@ def main():
     if 0 < wrap_s < laps[-1]["t"]:
         print(f"check-soak: the clock passed 2^32 ms at t={wrap_s:.3f} s of controller time")
     print(f"check-soak: {len(laps)} laps, {cycles} cycles; per simulated hour:")
-    print(f"{'hour':>5} {'t s':>9} {'laps':>6} {'RSS KiB':>8} {'max |gear error| counts':>24} {'M mm':>12} {'G mm':>12}")
+    print(f"{'hour':>5} {'t s':>9} {'laps':>6} {'RSS KiB':>8} {'max |gear error| counts':>24} {'M mm':>12} {'G mm':>12} "
+          f"{'G counts':>13} {'C deg':>11} {'C counts':>13}")
     h, i0 = 1, 0
     for i, v in enumerate(laps):
         last = i == len(laps) - 1
         if v["t"] >= h * 3600 or last:
             seg = laps[i0:i + 1]
             print(f"{h:>5} {v['t']:>9.1f} {len(seg):>6} {v['Controller.RssKiB']:>8.0f} "
-                  f"{max(abs(x['gear_err']) for x in seg):>24.3f} {v['M.CommandPosition']:>12.3f} {v['G.CommandPosition']:>12.3f}")
+                  f"{max(abs(x['gear_err']) for x in seg):>24.3f} {v['M.CommandPosition']:>12.3f} {v['G.CommandPosition']:>12.3f} "
+                  f"{v['G.ActualCounts']:>13.0f} {v['C.CommandPosition']:>11.1f} {v['C.ActualCounts']:>13.0f}")
             h, i0 = h + 1, i + 1
     print(f"check-soak: largest gear error {gear_max:.3f} counts; RSS {base['Controller.RssKiB']:.0f} KiB at "
           f"t={base['t']:.0f} s, at most {rss_max:.0f} KiB after")

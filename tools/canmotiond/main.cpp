@@ -169,6 +169,10 @@ class Outputs {
           if (cid == e.wait.control) control = name;
         fmt::print(stderr, "canmotiond: axis {}: {}\n", c.axis_name(id),
                    rt::describe_drive_wait(e, c.axis_spec(id), static_cast<std::size_t>(e.axis), control, c.period_s()));
+      } else if (e.kind == rt::Event::Kind::kDriveStatusBit) {
+        const auto id = static_cast<motion::AxisId>(e.axis);
+        fmt::print(stderr, "canmotiond: axis {}: {}\n", c.axis_name(id),
+                   rt::describe_drive_status_bit(e, c.axis_spec(id), static_cast<std::size_t>(e.axis)));
       } else if (!quiet && e.kind == rt::Event::Kind::kNode && e.node.kind == canopen::NodeEvent::Kind::kEmcy) {
         fmt::print(stderr, "canmotiond: bus {} node {}: EMCY 0x{:04X} {}\n", cfg_.buses[e.bus].name, e.node.node,
                    e.node.emcy.code, canopen::emcy_code_text(e.node.emcy.code));
@@ -371,6 +375,7 @@ config::Config load_config(const Options& o) {
     throw Exit{2};
   }
   for (const auto& w : cfg.warnings) fmt::print(stderr, "{}\n", w.str());
+  for (const auto& w : config::startup_warnings(cfg)) fmt::print(stderr, "{}\n", w.str());  // said once, at start
   if (!o.write_dcf.empty() && !o.check_args) throw Exit{write_dcfs(cfg, o.write_dcf)};  // nothing opened
   {
     // Without drive.eds the master cannot know which optional objects a drive has: say once what it does.

@@ -134,7 +134,8 @@ void print_progress(emulator::SimRig& rig) {
               static_cast<unsigned long long>(rig.bus().counters().delivered));
   for (std::size_t i = 0; i < net.size(); ++i) {
     const auto& d = net.at(i);
-    std::printf(" node %u pos %d fe %d |", d.node(), d.feedback().position, d.target_position() - d.feedback().position);
+    std::printf(" node %u pos %lld fe %lld |", d.node(), static_cast<long long>(d.feedback().position),
+                static_cast<long long>(d.target_position() - d.feedback().position));
   }
   std::printf("\n");
   std::fflush(stdout);
@@ -145,7 +146,7 @@ void print_progress(emulator::SimRig& rig) {
 std::vector<double> run_motion(emulator::SimRig& rig, double duration, double T) {
   auto& net = rig.network();
   const Motion m;
-  std::vector<std::int32_t> start(net.size());
+  std::vector<std::int64_t> start(net.size());
   std::vector<double> max_fe(net.size(), 0.0);
   for (std::size_t i = 0; i < net.size(); ++i) start[i] = net.at(i).feedback().position;
   const auto motion_cycles = static_cast<std::uint64_t>(std::llround(duration / T));
@@ -154,8 +155,8 @@ std::vector<double> run_motion(emulator::SimRig& rig, double duration, double T)
     const double t = static_cast<double>(k) * T;
     for (std::size_t i = 0; i < net.size(); ++i) {
       auto& d = net.at(i);
-      d.set_target_position(start[i] + static_cast<std::int32_t>(std::llround(m.target(i, t))));
-      const double fe = std::abs(static_cast<double>(d.target_position()) - d.feedback().position);
+      d.set_target_position(start[i] + std::llround(m.target(i, t)));
+      const double fe = std::abs(static_cast<double>(d.target_position() - d.feedback().position));
       max_fe[i] = std::max(max_fe[i], fe);
     }
     rig.step();
