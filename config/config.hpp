@@ -175,6 +175,21 @@ struct DriveSettings {
   /// naming the same file. Null without `eds:`.
   std::shared_ptr<const eds::Eds> eds_data;
   std::shared_ptr<const canopen::DeviceDictionary> dictionary;
+  /// `units: {velocity: inc/s | rpm}`: 0x60A9 (SI unit velocity) written at
+  /// boot; the EDS must have a writable 0x60A9. `units_key` names it.
+  std::optional<std::uint32_t> velocity_unit;
+  std::string units_key;
+  Location units_where;
+  /// Drive units (README "Drive units"), set by check_drive_descriptions from
+  /// the EDS/DCF (ParameterValue before DefaultValue) and `units:`: counts/s
+  /// per unit of the drive's velocity values (0x60FF, 0x60B1, 0x606C, 0x6099,
+  /// 0x607F, 0x6080) and counts/s^2 per unit of its acceleration values
+  /// (0x6083..0x6085, 0x609A). 1 without an EDS or for an EDS without the
+  /// object (increments); nothing when the unit cannot be known, with why.
+  std::optional<double> velocity_counts = 1.0;
+  std::string velocity_unknown;
+  std::optional<double> acceleration_counts = 1.0;
+  std::string acceleration_unknown;
 };
 
 /// An axis's `direct_control:` block (MDS, seed 002): the direct command's

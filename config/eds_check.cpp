@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "config/runtime.hpp"
+#include "fieldbus/cia402/units.hpp"
 #include "fieldbus/canopen/master.hpp"
 #include "fieldbus/canopen/pdo.hpp"  // sign_extend
 
@@ -177,6 +178,84 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
   return req;
 }
 
+namespace {
+
+/// The value the drive has for index:sub by its file: ParameterValue (DCF)
+/// wins over DefaultValue; nothing when the object or a value is absent.
+std::optional<std::uint64_t> file_value(const eds::Eds& e, std::uint16_t index, std::uint8_t sub, std::uint8_t node) {
+  const eds::SubObject* s = e.find(index, sub);
+  if (s == nullptr) return std::nullopt;
+  const std::optional<eds::Value>& v = s->parameter_value ? s->parameter_value : s->default_value;
+  if (!v || s->size() == 0 || s->size() > 8) return std::nullopt;
+  return v->resolve(node, s->size());
+}
+
+/// Drive units (README "Drive units"): the counts per unit of the drive's
+/// velocity (0x60A9) and acceleration (0x60AA) values from its EDS/DCF and
+/// `units.velocity`, and what needs them refused when they cannot be known.
+void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::string& who,
+                 std::vector<Diagnostic>& diags) {
+  namespace u = cia402::units;
+  DriveSettings& ds = a.drive;
+  const eds::Eds& e = *ds.eds_data;
+  u::EncoderResolution res;
+  if (auto i = file_value(e, u::kPositionEncoderResolution, 1, a.node)) res.increments = static_cast<std::uint32_t>(*i);
+  if (auto r = file_value(e, u::kPositionEncoderResolution, 2, a.node)) res.revolutions = static_cast<std::uint32_t>(*r);
+  // Revolutions of the motor (0x608F) are those of the velocity unit only
+  // without a gear between (0x6091 absent or 1:1): else not known, not guessed.
+  const auto g1 = file_value(e, u::kGearRatio, 1, a.node);
+  const auto g2 = file_value(e, u::kGearRatio, 2, a.node);
+  const bool gear_other = e.find(u::kGearRatio, 1) != nullptr && !(g1 && g2 && *g1 == *g2 && *g1 != 0);
+  if (gear_other) res = {};
+  auto one = [&](std::uint16_t index, bool acceleration, std::optional<std::uint32_t> configured,
+                 std::optional<double>& counts, std::string& unknown) {
+    const eds::SubObject* s = e.find(index, 0);
+    std::optional<std::uint64_t> si = configured ? std::optional<std::uint64_t>(*configured) : file_value(e, index, 0, a.node);
+    if (s == nullptr && !configured) {  // no factor group: increments
+      counts = 1.0;
+      return;
+    }
+    if (!si) {
+      counts.reset();
+      unknown = fmt::format("{}:{} 0x{:04X} ({}) has no value (nor ParameterValue nor DefaultValue)", ds.eds, s->line,
+                            index, acceleration ? "SI unit acceleration" : "SI unit velocity");
+      return;
+    }
+    counts = u::counts_per_unit(static_cast<std::uint32_t>(*si), res, acceleration);
+    if (!counts)
+      unknown = fmt::format("0x{:04X} = 0x{:08X}{}: {}{}", index, *si,
+                            configured ? fmt::format(" ({})", ds.units_key) : fmt::format(" ({}:{})", ds.eds, s->line),
+                            u::unknown_reason(static_cast<std::uint32_t>(*si), res, acceleration),
+                            gear_other ? " (0x6091 gear ratio is not 1:1: revolutions of which shaft is not known)" : "");
+  };
+  one(u::kSiUnitVelocity, false, ds.velocity_unit, ds.velocity_counts, ds.velocity_unknown);
+  one(u::kSiUnitAcceleration, true, std::nullopt, ds.acceleration_counts, ds.acceleration_unknown);
+  const std::string axis = fmt::format("axes[{}]", ai);
+  auto refuse = [&](Location where, const std::string& key, const std::string& what, bool velocity) {
+    const std::string& why = velocity ? ds.velocity_unknown : ds.acceleration_unknown;
+    diags.push_back({Severity::kError, cfg.path, where, key,
+                     fmt::format("{}: {} needs the drive's {} unit, which cannot be known: {}. Nothing is guessed: "
+                                 "give the EDS/DCF the value{}",
+                                  who, what, velocity ? "velocity" : "acceleration", why,
+                                 velocity ? " or set drive.units.velocity (a writable 0x60A9)" : "")});
+  };
+  if (a.direct.present) {
+    const bool torque = a.axis.direct_mode == motion::AxisConfig::DirectMode::Torque;
+    const std::string what = fmt::format("MDS ({}.direct_control, {})", axis, torque ? "CST" : "CSV");
+    if (!ds.velocity_counts) refuse(a.direct.where, axis + ".direct_control", what, true);
+    if (!ds.acceleration_counts && (a.direct.ramp_acceleration || a.direct.ramp_deceleration))
+      refuse(a.direct.where, axis + ".direct_control.ramp", what + " ramps (0x6083/0x6084)", false);
+  }
+  if (a.axis.homing.mode == motion::HomingConfig::Mode::Active &&
+      a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate) {
+    const std::string what = fmt::format("homing on the drive ({}.homing: speeds 0x6099, acceleration 0x609A)", axis);
+    if (!ds.velocity_counts) refuse(ds.eds_where, axis + ".homing", what, true);
+    if (!ds.acceleration_counts) refuse(ds.eds_where, axis + ".homing", what, false);
+  }
+}
+
+}  // namespace
+
 void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
   std::map<std::string, std::pair<std::shared_ptr<const eds::Eds>, std::shared_ptr<const canopen::DeviceDictionary>>> files;
   for (std::size_t ai = 0; ai < cfg.axes.size(); ++ai) {
@@ -200,6 +279,7 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
     if (!it->second.first) continue;  // unreadable: said once
     ds.eds_data = it->second.first;
     ds.dictionary = it->second.second;
+    drive_units(cfg, a, ai, who, diags);
     const BusSettings* bus = cfg.find_bus(a.bus);
     if (bus == nullptr) continue;  // cross_check reported it
     const eds::CheckResult r = eds::check(*ds.eds_data, drive_requirements(a, *bus, cfg.controller.period_s, ai));

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "config/load_sections.hpp"
+#include "fieldbus/cia402/units.hpp"
 #include "fieldbus/canopen/object_names.hpp"
 #include "fieldbus/cia402/cia402.hpp"
 
@@ -122,8 +123,21 @@ std::optional<SdoWrite> sdo_write(Reader& r, const YAML::Node& e, const std::str
 void drive(Reader& r, const YAML::Node& n, const std::string& path, DriveSettings& d) {
   if (!r.check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
                              "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds", "sync_watch",
-                             "mds_objects"}))
+                             "mds_objects", "units"}))
     return;
+  if (const YAML::Node u = n["units"]) {
+    const std::string up = path + ".units";
+    std::string v;
+    if (r.check_map(u, up, {"velocity"}) && u["velocity"] && r.string(u, up, "velocity", v)) {
+      if (const auto code = cia402::units::velocity_unit_code(v)) {
+        d.velocity_unit = *code;
+        d.units_key = up + ".velocity";
+        d.units_where = r.loc(u["velocity"]);
+      } else {
+        r.error(u["velocity"], up + ".velocity", fmt::format("'{}' is not a velocity unit: inc/s or rpm", v));
+      }
+    }
+  }
   if (std::int16_t q = 0; r.scalar(n, path, "quick_stop_option", q, std::int16_t{-32768}, std::int16_t{8},
                                    "(0x605A: 0 coast, 1/2 ramp then Switch on disabled, 5/6 ramp and stay in Quick stop "
                                    "active, ...; < 0 manufacturer-specific)"))

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "fieldbus/canopen/object_names.hpp"
+#include "fieldbus/cia402/units.hpp"
 #include "fieldbus/emulator/eds_dictionary.hpp"
 
 namespace canmotion::config {
@@ -56,8 +57,14 @@ std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
   if (!d.present || a.axis.type != motion::AxisType::CipDrive) return w;
   namespace obj = cia402::obj;
   using cia402::MdsObject;
+  // In the drive's units (README "Drive units"); a unit that cannot be known
+  // refuses the configuration (check_drive_descriptions): 0 then.
   const double conv = a.axis.conversion_constant;
-  auto counts = [&](double v) { return static_cast<std::uint32_t>(std::llround(v * conv)); };
+  const double vel = a.drive.velocity_counts ? conv / *a.drive.velocity_counts : 0.0;
+  const double acc = a.drive.acceleration_counts ? conv / *a.drive.acceleration_counts : 0.0;
+  auto in_units = [](double v, double f) { return static_cast<std::uint32_t>(std::llround(v * f)); };
+  auto velocity = [&](double v) { return in_units(v, vel); };
+  auto acceleration = [&](double v) { return in_units(v, acc); };
   auto standard = [&](cia402::SdoWrite x, std::uint32_t value, const char* key) {
     x.value = value;
     w.push_back(KeyedWrite{x, std::string(key)});
@@ -71,13 +78,13 @@ std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
     w.push_back(KeyedWrite{cia402::SdoWrite{at.index, at.sub, cia402::info(o).size, value}, std::move(k)});
   };
   if (d.ramp_acceleration)
-    standard(od_write(obj::kProfileAcceleration, 0), counts(*d.ramp_acceleration), "direct_control.ramp.acceleration");
+    standard(od_write(obj::kProfileAcceleration, 0), acceleration(*d.ramp_acceleration), "direct_control.ramp.acceleration");
   if (d.ramp_deceleration)
-    standard(od_write(obj::kProfileDeceleration, 0), counts(*d.ramp_deceleration), "direct_control.ramp.deceleration");
+    standard(od_write(obj::kProfileDeceleration, 0), acceleration(*d.ramp_deceleration), "direct_control.ramp.deceleration");
   if (d.ramp_velocity_positive)
-    mds(MdsObject::kRampVelocityPositive, counts(*d.ramp_velocity_positive), "direct_control.ramp.velocity_positive");
+    mds(MdsObject::kRampVelocityPositive, velocity(*d.ramp_velocity_positive), "direct_control.ramp.velocity_positive");
   if (d.ramp_velocity_negative)
-    mds(MdsObject::kRampVelocityNegative, counts(*d.ramp_velocity_negative), "direct_control.ramp.velocity_negative");
+    mds(MdsObject::kRampVelocityNegative, velocity(*d.ramp_velocity_negative), "direct_control.ramp.velocity_negative");
   if (d.ramp_jerk_control) mds(MdsObject::kRampJerkControl, *d.ramp_jerk_control, "direct_control.ramp.jerk_control");
   // The SLAT objects are vendor-area (cia402.hpp): written always, so that a
   // drive keeps no SLAT from an earlier configuration, but without `slat:`
@@ -88,7 +95,7 @@ std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
   // attributes the configuration asks for [seed 002].
   const std::size_t slat_first = w.size();
   mds(MdsObject::kSlatConfiguration, d.slat_configuration, "direct_control.slat.configuration");
-  mds(MdsObject::kSlatSetPoint, counts(d.slat_set_point), "direct_control.slat.set_point");
+  mds(MdsObject::kSlatSetPoint, velocity(d.slat_set_point), "direct_control.slat.set_point");
   mds(MdsObject::kSlatTimeDelay, d.slat_time_delay_ms, "direct_control.slat.time_delay_ms");
   for (std::size_t i = slat_first; i < w.size(); ++i) w[i].write.optional = !d.slat_set;
   return w;
@@ -169,6 +176,10 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   }
   d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
   d.homing_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.homing_ms) * 1'000'000;
+  if (a.drive.velocity_unit) {  // `units.velocity`: before any value in that unit
+    d.extra_writes.push_back(cia402::SdoWrite{cia402::units::kSiUnitVelocity, 0, 4, *a.drive.velocity_unit});
+    d.hints.extra.push_back(fmt::format("{} (line {}; needs a writable 0x60A9)", a.drive.units_key, a.drive.units_where.line));
+  }
   for (const KeyedWrite& k : keyed_direct_control_writes(a)) {
     d.extra_writes.push_back(k.write);
     d.hints.extra.push_back(fmt::format("{}.{}", axis, k.key));
@@ -231,6 +242,9 @@ rt::AxisSpec axis_spec(const Config& cfg, const AxisSettings& a, std::size_t ind
   while (bi < cfg.buses.size() && cfg.buses[bi].name != a.bus) ++bi;
   as.bus = static_cast<int>(bi);
   as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s, index);
+  const double conv = a.axis.conversion_constant;
+  as.velocity_factor = a.drive.velocity_counts ? conv / *a.drive.velocity_counts : std::nan("");
+  as.acceleration_factor = a.drive.acceleration_counts ? conv / *a.drive.acceleration_counts : std::nan("");
   as.config.drive_wait_limit = drive_wait_limit_s(a.drive.timeouts);
   return as;
 }

@@ -2,6 +2,7 @@
 // shared cia402.hpp), modes, faults and the error register, the motor model
 // (advanced only at a SYNC) and the outputs it shows in the dictionary.
 #include "fieldbus/emulator/emulator.hpp"
+#include "fieldbus/cia402/units.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -139,7 +140,8 @@ void Emulator::advance_motor(double dt) noexcept {
   const Setpoint sp = delay_[next];
   delay_head_ = next;
 
-  const double vmax = std::min(cfg_.max_velocity, static_cast<double>(val(hot_.max_profile_velocity)));
+  refresh_units();
+  const double vmax = std::min(cfg_.max_velocity, static_cast<double>(val(hot_.max_profile_velocity)) * vel_scale_);
   double amax = cfg_.max_acceleration;
   double v_des = 0;
   const auto mode = static_cast<cia402::Mode>(mode_display_);
@@ -162,17 +164,17 @@ void Emulator::advance_motor(double dt) noexcept {
         put(hot_.position_demand, static_cast<std::uint32_t>(sp.position));
         break;
       }
-      case cia402::Mode::kCsv: v_des = csv_ramp(sp.velocity, dt); break;
+      case cia402::Mode::kCsv: v_des = csv_ramp(sp.velocity * vel_scale_, dt); break;
       case cia402::Mode::kCst: {
         const double tmax = static_cast<double>(val(hot_.max_torque));
-        v_des = cst_step(std::clamp(static_cast<double>(sp.torque), -tmax, tmax), sp.velocity, dt, torque);
+        v_des = cst_step(std::clamp(static_cast<double>(sp.torque), -tmax, tmax), sp.velocity * vel_scale_, dt, torque);
         break;
       }
       case cia402::Mode::kHoming: v_des = homing_velocity(dt, amax, stop_immediately); break;
       default: break;
     }
   } else if (state_ == State::kQuickStopActive) {
-    amax = static_cast<double>(val(hot_.quick_stop_decel));
+    amax = static_cast<double>(val(hot_.quick_stop_decel)) * acc_scale_;
     v_des = 0;
   } else {
     stop_immediately = true;  // power stage off: the model stops (brake)
@@ -193,11 +195,32 @@ void Emulator::advance_motor(double dt) noexcept {
   put(hot_.torque_actual, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::clamp(round_half_away(trq), -32768.0, 32767.0))));
 }
 
+void Emulator::refresh_units() noexcept {
+  const std::uint64_t key[4] = {get(cia402::units::kSiUnitVelocity), get(cia402::units::kSiUnitAcceleration),
+                                get(cia402::units::kPositionEncoderResolution, 1),
+                                get(cia402::units::kPositionEncoderResolution, 2)};
+  if (key[0] == units_key_[0] && key[1] == units_key_[1] && key[2] == units_key_[2] && key[3] == units_key_[3]) return;
+  for (int i = 0; i < 4; ++i) units_key_[i] = key[i];
+  const cia402::units::EncoderResolution res{static_cast<std::uint32_t>(key[2]), static_cast<std::uint32_t>(key[3])};
+  // A drive without 0x60A9/0x60AA works in increments (CiA 402 without the
+  // factor group); a code this model does not know leaves increments too
+  // (the master refuses such a drive before it commands a velocity).
+  const auto v = find(cia402::units::kSiUnitVelocity, 0) != nullptr
+                     ? cia402::units::counts_per_unit(static_cast<std::uint32_t>(key[0]), res, false)
+                     : std::optional<double>(1.0);
+  const auto a = find(cia402::units::kSiUnitAcceleration, 0) != nullptr
+                     ? cia402::units::counts_per_unit(static_cast<std::uint32_t>(key[1]), res, true)
+                     : std::optional<double>(1.0);
+  vel_scale_ = v && *v > 0 ? *v : 1.0;
+  acc_scale_ = a && *a > 0 ? *a : 1.0;
+}
+
 void Emulator::update_outputs() noexcept {
   const std::int32_t p = position();
   put(hot_.position_actual, static_cast<std::uint32_t>(p));
   put(hot_.position_internal, static_cast<std::uint32_t>(p));
-  put(hot_.velocity_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(round_half_away(vel_))));
+  put(hot_.velocity_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(
+                                 std::clamp(round_half_away(vel_ / vel_scale_), -2147483648.0, 2147483647.0))));
   put(hot_.fe_actual, static_cast<std::uint32_t>(static_cast<std::int32_t>(sval(hot_.target_position) - p)));
   put(hot_.statusword, statusword());
 }

@@ -19,8 +19,8 @@ void Emulator::reset_direct_model() noexcept {
 double Emulator::csv_ramp(double target, double dt) noexcept {
   // A drive without 0x2010 (EmulatorBehaviour::optional_objects_absent) has
   // no ramp velocity limit but its own maximum velocity.
-  const double vpos = hot_.ramp_vpos != nullptr ? static_cast<double>(val(hot_.ramp_vpos)) : cfg_.max_velocity;
-  const double vneg = hot_.ramp_vneg != nullptr ? static_cast<double>(val(hot_.ramp_vneg)) : cfg_.max_velocity;
+  const double vpos = hot_.ramp_vpos != nullptr ? static_cast<double>(val(hot_.ramp_vpos)) * vel_scale_ : cfg_.max_velocity;
+  const double vneg = hot_.ramp_vneg != nullptr ? static_cast<double>(val(hot_.ramp_vneg)) * vel_scale_ : cfg_.max_velocity;
   target = std::clamp(target, -vneg, vpos);
   const double v = vel_;
   const double e = target - v;
@@ -30,7 +30,7 @@ double Emulator::csv_ramp(double target, double dt) noexcept {
   }
   // Deceleration while the speed magnitude falls (moving towards zero).
   const bool decelerating = (v > 0 && e < 0) || (v < 0 && e > 0);
-  double rate = static_cast<double>(val(decelerating ? hot_.profile_decel : hot_.profile_accel));
+  double rate = static_cast<double>(val(decelerating ? hot_.profile_decel : hot_.profile_accel)) * acc_scale_;
   if (rate <= 0) rate = cfg_.max_acceleration;  // 0: no ramp limit
   // S-curve: each of the two jerk segments of a full-scale ramp (0 to the
   // larger ramp velocity) lasts jerk_pct/2 % of that ramp's time.
@@ -60,7 +60,7 @@ double Emulator::cst_step(double torque_cmd, double velocity_cmd, double dt, dou
   const double a_rated = cfg_.rated_torque_acceleration > 0 ? cfg_.rated_torque_acceleration : cfg_.max_acceleration;
   const double load = cfg_.load_torque + cfg_.viscous_friction * vel_;  // per mille
   const auto c = static_cast<cia402::SlatConfiguration>(val(hot_.slat_config));
-  const auto set_point = static_cast<double>(val(hot_.slat_set_point));
+  const auto set_point = static_cast<double>(val(hot_.slat_set_point)) * vel_scale_;
   const std::int64_t delay_ns = static_cast<std::int64_t>(val(hot_.slat_delay)) * 1'000'000;
   // Velocity Error = velocity command (0x60FF) - actual velocity.
   slat_speed_ = cia402::slat_speed_control(c, slat_speed_, velocity_cmd - vel_, set_point, sync_period_.ns, delay_ns,

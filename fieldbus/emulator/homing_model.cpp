@@ -79,10 +79,10 @@ double Emulator::homing_velocity(double dt, double& amax, bool& stop) noexcept {
   if (!cfg_.behaviour.homing_takes_time) {
     const auto method = static_cast<std::int8_t>(sval(hot_.homing_method));
     if (method == 35 || method == 37 || std::abs(pos_) < 1.0) return finish();
-    return move_to(0.0, static_cast<double>(val(hot_.homing_speed_switch)));
+    return move_to(0.0, static_cast<double>(val(hot_.homing_speed_switch)) * vel_scale_);
   }
-  const double fast = static_cast<double>(val(hot_.homing_speed_switch));
-  const double slow = static_cast<double>(get(cia402::obj::kHomingSpeeds, 2));
+  const double fast = static_cast<double>(val(hot_.homing_speed_switch)) * vel_scale_;
+  const double slow = static_cast<double>(get(cia402::obj::kHomingSpeeds, 2)) * vel_scale_;
   const auto fail = [&] {
     homing_error_ = true;
     homing_active_ = false;

@@ -95,6 +95,8 @@ Controller::Controller(ControllerSpec spec)
     if (!planner_.configure_axis(static_cast<motion::AxisId>(a), s.config))
       throw std::invalid_argument("axis '" + s.name + "': the planner rejected its configuration");
     axes_[a].conv = s.config.conversion_constant;
+    axes_[a].vel = s.velocity_factor == 0.0 ? s.config.conversion_constant : s.velocity_factor;
+    axes_[a].acc = s.acceleration_factor == 0.0 ? s.config.conversion_constant : s.acceleration_factor;
     if (s.config.type == motion::AxisType::CipDrive) {
       if (s.bus < 0 || static_cast<std::size_t>(s.bus) >= buses_.size())
         throw std::invalid_argument("axis '" + s.name + "' (AXIS_CIP_DRIVE) has no valid bus");
@@ -255,9 +257,10 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   const cia402::Feedback& d = p.feedback();
   const bool operational = p.phase() == cia402::Phase::kOperational;
   f.position = static_cast<double>(d.position) / ax.conv;  // 64-bit counts (DriveProxy unwraps 0x6064)
-  const bool vel_mapped = p.pdos().tpdo_count > 1;
+  // 0x606C in the drive's velocity unit; a unit that cannot be known is not read.
+  const bool vel_mapped = p.pdos().tpdo_count > 1 && ax.vel == ax.vel;
   if (vel_mapped) {
-    f.velocity = static_cast<double>(d.velocity) / ax.conv;
+    f.velocity = static_cast<double>(d.velocity) / ax.vel;
   } else if (ax.have_prev) {  // differentiate when 0x606C is not mapped
     f.velocity = static_cast<double>(d.position - ax.prev_counts) / ax.conv / period_s();
   }
@@ -363,15 +366,16 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   // rising edge (retried next cycle when the SDO queue is full), dropped on its falling edge.
   const bool homing = out.homing_start && out.mode == motion::DriveMode::Homing;
   if (homing && !ax.homing_out) {
-    auto u32 = [&](double v) noexcept -> std::uint32_t {
-      const double c = round_half_away(std::fabs(v) * ax.conv);
+    // Speeds (0x6099) and acceleration (0x609A) in the drive's units.
+    auto u32 = [&](double v, double factor) noexcept -> std::uint32_t {
+      const double c = round_half_away(std::fabs(v) * factor);
       return !(c == c) ? 0u : (c > 4294967295.0 ? 0xFFFFFFFFu : static_cast<std::uint32_t>(c));
     };
     cia402::HomingParams hp;
     hp.method = out.homing.method;
-    hp.speed_search = u32(out.homing.speed_search);
-    hp.speed_zero = u32(out.homing.speed_zero);
-    hp.accel = u32(out.homing.accel);
+    hp.speed_search = u32(out.homing.speed_search, ax.vel);
+    hp.speed_zero = u32(out.homing.speed_zero, ax.vel);
+    hp.accel = u32(out.homing.accel, ax.acc);
     hp.write_offset = out.homing.write_offset;
     const double off = round_half_away(out.homing.offset * ax.conv);
     hp.offset = static_cast<std::int32_t>(std::clamp(off == off ? off : 0.0, -2147483648.0, 2147483647.0));
@@ -394,7 +398,7 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   // README "Positions past 32 bits") it is held at that bound.
   const double pc = round_half_away(out.position * ax.conv);
   if (pc == pc) p.set_target_position(static_cast<std::int64_t>(std::clamp(pc, -0x1p62, 0x1p62)));
-  p.set_target_velocity(sat32(out.velocity * ax.conv));
+  p.set_target_velocity(sat32(out.velocity * ax.vel));  // drive velocity units; NaN (unknown): 0
   const double t = out.torque == 0.0 ? 0.0 : round_half_away(out.torque);  // CSP and CSV axes: 0
   p.set_target_torque(static_cast<std::int16_t>(t > 32767 ? 32767 : (t < -32768 ? -32768 : t)));
 }

@@ -1,0 +1,172 @@
+// Drive units (issue 29 part 2, README "Drive units"): the same MDS speed and
+// homing speed in user units give the same shaft speed on an emulated drive
+// in inc/s and on one in rpm (tests/units/*.eds: 0x60A9 with 0x608F); a
+// drive whose velocity unit cannot be known is refused for MDS, CSV and
+// homing by the configuration check, before any frame; the factor decoding.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "config/runtime.hpp"
+#include "fieldbus/cia402/units.hpp"
+#include "tests/config/runtime_rig.hpp"
+
+namespace canmotion::config {
+namespace {
+
+const std::string kFile = std::string(CANMOTION_UNITS_DIR) + "/units.yaml";
+
+// 4096 counts per user unit (one motor revolution): 15 units/s = 61440 counts/s
+// = 900 rpm exactly, 5 units/s = 300 rpm.
+std::string yaml(const std::string& eds_a, const std::string& eds_b) {
+  auto axis = [](const char* name, const char* bus, const std::string& eds) {
+    return std::string("  - name: ") + name + "\n    type: AXIS_CIP_DRIVE\n    bus: " + bus +
+           "\n    node: 2\n    conversion_constant: 4096\n    max_speed: 100\n    max_accel: 1000\n    max_decel: 1000\n"
+           "    homing: {mode: Active, sequence: Switch, method: 19, speed_search: 5, speed_zero: 1, accel: 200}\n"
+           "    direct_control: {mode: velocity}\n    drive: {eds: " + eds + "}\n";
+  };
+  return "controller: {period_ms: 1}\nbuses:\n  - {name: can0, interface: sim}\n  - {name: can1, interface: sim}\n"
+         "drives:\n  pdo: csp_csv_cst\naxes:\n" +
+         axis("A", "can0", eds_a) + axis("B", "can1", eds_b);
+}
+
+TEST(DriveUnits, Decoding) {
+  namespace u = cia402::units;
+  const u::EncoderResolution res{4096, 1};
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond, {}, false), 1.0);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kRpm, res, false), 4096.0 / 60.0);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(0xFFB44700u, res, false), 4096.0 / 600.0);  // 0.1 rpm
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(0x00B44700u, {10000, 3}, false), 10000.0 / 3.0 / 60.0);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond2, {}, true), 1.0);
+  EXPECT_FALSE(u::counts_per_unit(u::kRpm, {}, false));              // revolutions without 0x608F
+  EXPECT_FALSE(u::counts_per_unit(u::kIncPerSecond, {}, true));      // a velocity code is no acceleration
+  EXPECT_FALSE(u::counts_per_unit(0xFD010300u, res, false));         // mm/s: no feed known here
+  EXPECT_FALSE(u::counts_per_unit(0x00B50301u, res, false));         // byte 0 not 0
+  EXPECT_EQ(*u::velocity_unit_code("rpm"), u::kRpm);
+  EXPECT_FALSE(u::velocity_unit_code("rps"));
+}
+
+struct Rig : test::RuntimeRig {
+  explicit Rig(const Config& c) : RuntimeRig(c) { rt.sim->power_on(0); }
+  emulator::Emulator& emu(std::size_t bus) { return *rt.sim->find_drive(bus, 2); }
+  void exec(const std::string& call) {
+    ASSERT_TRUE(execute(call));
+    cycle();
+  }
+};
+
+TEST(DriveUnits, SameShaftSpeedInIncPerSecondAndRpm) {
+  const Config c = load_string(yaml("incs-drive.eds", "rpm-drive.eds"), kFile);
+  EXPECT_DOUBLE_EQ(*c.axes[0].drive.velocity_counts, 1.0);
+  EXPECT_DOUBLE_EQ(*c.axes[1].drive.velocity_counts, 4096.0 / 60.0);
+  Rig r(c);
+  auto& inc = r.emu(0);
+  auto& rpm = r.emu(1);
+  r.cycles(300);
+  // ---- MDS: 15 units/s on both --------------------------------------------
+  r.exec("MDS(A, ma, 15, UnitsPerSec)");
+  r.exec("MDS(B, mb, 15, UnitsPerSec)");
+  r.cycles(2000);
+  ASSERT_EQ(r.read("ma.IP"), 1.0) << r.read("ma.ERR");
+  ASSERT_EQ(r.read("mb.IP"), 1.0) << r.read("mb.ERR");
+  EXPECT_EQ(inc.read_int(0x60FF), 61440);  // inc/s
+  EXPECT_EQ(rpm.read_int(0x60FF), 900);    // rpm
+  EXPECT_DOUBLE_EQ(inc.velocity(), 61440.0);  // shaft speed, counts/s
+  EXPECT_DOUBLE_EQ(rpm.velocity(), 61440.0);
+  EXPECT_EQ(rpm.read_int(0x606C), 900);  // 0x606C in the drive's unit too
+  EXPECT_NEAR(r.read("A.ActualVelocity"), 15.0, 1e-9);
+  EXPECT_NEAR(r.read("B.ActualVelocity"), 15.0, 1e-9);
+  // ---- stop, then home: 0x6099 speeds in each drive's unit -------------------
+  r.exec("MAS(A, sa, All, No, 0, UnitsPerSec2, No, 0, UnitsPerSec3)");
+  r.exec("MAS(B, sb, All, No, 0, UnitsPerSec2, No, 0, UnitsPerSec3)");
+  r.cycles(500);
+  r.exec("MSO(A, oa)");
+  r.exec("MSO(B, ob)");
+  r.cycles(300);
+  r.exec("MAH(A, ha)");
+  r.exec("MAH(B, hb)");
+  double vmax_inc = 0, vmax_rpm = 0;
+  for (int i = 0; i < 15000; ++i) {
+    r.cycle();
+    vmax_inc = std::max(vmax_inc, std::abs(inc.velocity()));
+    vmax_rpm = std::max(vmax_rpm, std::abs(rpm.velocity()));
+  }
+  EXPECT_EQ(inc.read_int(0x6099, 1), 20480);  // 5 units/s
+  EXPECT_EQ(rpm.read_int(0x6099, 1), 300);
+  EXPECT_EQ(inc.read_int(0x6099, 2), 4096);  // 1 unit/s
+  EXPECT_EQ(rpm.read_int(0x6099, 2), 60);
+  EXPECT_DOUBLE_EQ(vmax_inc, 20480.0);  // the search at the same shaft speed
+  EXPECT_DOUBLE_EQ(vmax_rpm, 20480.0);
+  EXPECT_EQ(r.read("ha.PC"), 1.0) << r.read("ha.ERR");
+  EXPECT_EQ(r.read("hb.PC"), 1.0) << r.read("hb.ERR");
+}
+
+TEST(DriveUnits, UnknownVelocityUnitIsRefusedBeforeAnyFrame) {
+  // rpm without 0x608F: the counts per revolution cannot be known. The check
+  // refuses the configuration (load_string throws: no runtime, no frame).
+  try {
+    (void)load_string(yaml("incs-drive.eds", "unknown-velocity-drive.eds"), kFile);
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("axes[1].direct_control"), std::string::npos) << w;
+    EXPECT_NE(w.find("MDS (axes[1].direct_control, CSV) needs the drive's velocity unit, which cannot be known"),
+              std::string::npos) << w;
+    EXPECT_NE(w.find("axes[1].homing"), std::string::npos) << w;
+    EXPECT_NE(w.find("0x60A9 = 0x00B44700"), std::string::npos) << w;
+    EXPECT_NE(w.find("0x608F"), std::string::npos) << w;
+    EXPECT_EQ(w.find("axes[0]"), std::string::npos) << w;  // the inc/s drive is fine
+  }
+}
+
+TEST(DriveUnits, CspOnlyAxisWithUnknownVelocityUnitRunsWithoutVelocity) {
+  std::string y = yaml("incs-drive.eds", "unknown-velocity-drive.eds");
+  // Axis B without MDS and homing on the drive: position only.
+  const auto at = y.find("    homing:", y.find("name: B"));
+  y.erase(at, y.find("    drive:", at) - at);
+  const Config c = load_string(y, kFile);
+  EXPECT_FALSE(c.axes[1].drive.velocity_counts);
+  Rig r(c);
+  r.cycles(300);
+  r.exec("MSO(B, ob)");
+  r.cycles(300);
+  ASSERT_EQ(r.read("ob.DN"), 1.0) << r.read("ob.ERR");
+  r.exec("MAJ(B, jb, Forward, 2, UnitsPerSec, 100, UnitsPerSec2, 100, UnitsPerSec2, Trapezoidal, 0, 0, UnitsPerSec3, Disabled, Programmed, 0, None)");
+  r.cycles(200);
+  auto& e = r.emu(1);
+  const std::int64_t p0 = e.position_counts();
+  r.cycles(1000);
+  EXPECT_EQ(e.read_int(0x60FF), 0);  // no velocity sent in a unit that is not known
+  EXPECT_NEAR(static_cast<double>(e.position_counts() - p0), 2.0 * 4096, 2.0);  // CSP follows the position: 2 units/s
+  // Differentiated from 0x6064 (8 or 9 counts a cycle), not read from 0x606C.
+  EXPECT_NEAR(r.read("B.ActualVelocity"), 2.0, 0.25);
+}
+
+TEST(DriveUnits, ConfiguredVelocityUnitIsWrittenAndUsed) {
+  std::string y = yaml("incs-drive.eds", "incs-drive.eds");
+  y.replace(y.rfind("drive: {eds: incs-drive.eds}"), 28, "drive: {eds: incs-drive.eds, units: {velocity: rpm}}");
+  const Config c = load_string(y, kFile);
+  EXPECT_DOUBLE_EQ(*c.axes[1].drive.velocity_counts, 4096.0 / 60.0);
+  Rig r(c);
+  r.cycles(300);
+  EXPECT_EQ(r.emu(1).read_int(0x60A9), 0x00B44700);
+  EXPECT_EQ(r.emu(0).read_int(0x60A9), 0x00B50300);
+  r.exec("MDS(B, mb, 15, UnitsPerSec)");
+  r.cycles(2000);
+  EXPECT_EQ(r.emu(1).read_int(0x60FF), 900);
+  EXPECT_DOUBLE_EQ(r.emu(1).velocity(), 61440.0);
+  // A word that is no unit names the key.
+  std::string bad = yaml("incs-drive.eds", "incs-drive.eds");
+  bad.replace(bad.rfind("drive: {eds: incs-drive.eds}"), 28, "drive: {eds: incs-drive.eds, units: {velocity: rps}}");
+  try {
+    (void)load_string(bad, kFile);
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("axes[1].drive.units.velocity"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace canmotion::config
