@@ -166,6 +166,18 @@ TEST(DriveUnits, ConfiguredVelocityUnitIsWrittenAndUsed) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("axes[1].drive.units.velocity"), std::string::npos) << e.what();
   }
+  // A drive whose 0x60A9 is read-only does not let the master choose.
+  std::string ro = yaml("incs-drive.eds", "incs-drive.eds");
+  ro.replace(ro.rfind("drive: {eds: incs-drive.eds}"), 28,
+             "drive: {eds: unknown-velocity-drive.eds, units: {velocity: inc/s}}");
+  try {
+    (void)load_string(ro, kFile);
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("axes[1].drive.units.velocity"), std::string::npos) << w;
+    EXPECT_NE(w.find("0x60A9:00 (SI unit velocity) is AccessType=ro"), std::string::npos) << w;
+  }
 }
 
 }  // namespace
