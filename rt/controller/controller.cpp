@@ -373,7 +373,7 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
     };
     cia402::HomingParams hp;
     hp.method = out.homing.method;
-    hp.speed_search = u32(out.homing.speed_search, ax.conv);
+    hp.speed_search = u32(out.homing.speed_search, ax.vel);
     hp.speed_zero = u32(out.homing.speed_zero, ax.vel);
     hp.accel = u32(out.homing.accel, ax.acc);
     hp.write_offset = out.homing.write_offset;
@@ -398,7 +398,7 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   // README "Positions past 32 bits") it is held at that bound.
   const double pc = round_half_away(out.position * ax.conv);
   if (pc == pc) p.set_target_position(static_cast<std::int64_t>(std::clamp(pc, -0x1p62, 0x1p62)));
-  p.set_target_velocity(sat32(out.velocity * ax.conv));  // drive velocity units; NaN (unknown): 0
+  p.set_target_velocity(sat32(out.velocity * ax.vel));  // drive velocity units; NaN (unknown): 0
   const double t = out.torque == 0.0 ? 0.0 : round_half_away(out.torque);  // CSP and CSV axes: 0
   p.set_target_torque(static_cast<std::int16_t>(t > 32767 ? 32767 : (t < -32768 ? -32768 : t)));
 }
