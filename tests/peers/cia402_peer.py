@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import math
 import os
 import select
 import signal
@@ -135,6 +136,9 @@ SW_CSP_FOLLOWING = 1 << 12     # CSP: drive follows the command value
 CW_FAULT_RESET = 1 << 7
 
 MODE_NONE, MODE_CSP = 0, 8
+MODE_HOMING, MODE_CSV = 6, 9
+SW_TARGET_REACHED = 1 << 10
+CW_HOMING_START = 1 << 4        # homing mode: bit 4 starts the homing
 QUICK_STOP_OPTION_DEFAULT = 2  # 0x605A: quick-stop ramp, then Switch on disabled
 
 
@@ -339,13 +343,24 @@ class Drive:
     send as (can_id, bytes) tuples."""
 
     def __init__(self, node: int, rpdos: int = 2, tpdos: int = 2, position: int = 0, heartbeat_ms: int = 0,
-                 consumer_heartbeat: int = 0, fault_code: int = 0xFF00, sdo_timeout: float = 1.0, log=None):
+                 consumer_heartbeat: int = 0, fault_code: int = 0xFF00, sdo_timeout: float = 1.0, log=None,
+                 velocity_unit: str = None, encoder_increments: int = 0):
         if not 1 <= node <= 127:
             raise ValueError(f'node-ID {node} is not 1..127')
         if not 1 <= rpdos <= 8 or not 1 <= tpdos <= 8:
             raise ValueError('the number of RPDOs and TPDOs must be 1..8')
         if not 0 <= consumer_heartbeat <= 127:
             raise ValueError('the number of consumer heartbeat entries must be 0..127')
+        if velocity_unit not in (None, 'inc/s', 'rpm'):
+            raise ValueError(f"velocity unit '{velocity_unit}' is not inc/s or rpm")
+        if velocity_unit == 'rpm' and encoder_increments <= 0:
+            raise ValueError('rpm needs --encoder-increments (0x608F:1, increments per motor revolution) > 0')
+        # Drive units (CiA 402 factor group): with a velocity unit the drive
+        # also has CSV (mode 9) and homing (mode 6); 0x60FF, 0x6099 and 0x606C
+        # are in that unit: inc/s (0x60A9 = 0x00B50300) or rpm (0x00B44700,
+        # 0x608F:1 increments per 0x608F:2 = 1 motor revolution).
+        self.velocity_unit = velocity_unit
+        self.encoder_increments = encoder_increments
         self.node = node
         self.default_heartbeat_ms = heartbeat_ms
         self.consumer_entries = consumer_heartbeat
@@ -382,6 +397,14 @@ class Drive:
         self.demand = self.actual
         self.prev_actual = self.actual
         self.velocity = 0
+        self.target_velocity = 0          # 0x60FF, in the velocity unit
+        self.target_torque = 0            # 0x6071
+        self.homing_method = 0
+        self.homing_speeds = [0, 0]       # 0x6099:1/2, in the velocity unit
+        self.homing_accel = 0             # 0x609A
+        self.home_offset = 0              # 0x607C
+        self.homing = None                # None, 'active', 'attained'
+        self.frac = 0.0                   # CSV/homing: sub-count position
         self.following = False
         self.mode = MODE_NONE
         self.quick_stop_option = QUICK_STOP_OPTION_DEFAULT
@@ -447,7 +470,8 @@ class Drive:
                               set=lambda v: setattr(d, 'quick_stop_option', v),
                               check=lambda v: 0 if 0 <= v <= 8 else ABORT_VALUE))
         od.add(0x6060, 0, Var('Modes of operation', 'i8', 'rw', pdo='R', get=lambda: d.mode, set=self._set_mode,
-                              check=lambda v: 0 if v in (MODE_NONE, MODE_CSP) else ABORT_VALUE))
+                              check=lambda v: 0 if v in (MODE_NONE, MODE_CSP) or (
+                                  self.velocity_unit and v in (MODE_CSV, MODE_HOMING)) else ABORT_VALUE))
         od.add(0x6061, 0, Var('Modes of operation display', 'i8', 'ro', pdo='T', get=lambda: d.mode))
         od.add(0x6062, 0, Var('Position demand value', 'i32', 'ro', pdo='T', get=lambda: d.demand))
         od.add(0x6064, 0, Var('Position actual value', 'i32', 'ro', pdo='T', get=lambda: d.actual))
@@ -460,10 +484,36 @@ class Drive:
         od.add(0x60C2, 2, Var('Interpolation time index', 'i8', 'rw', get=lambda: d.ip_index,
                               set=lambda v: setattr(d, 'ip_index', v),
                               check=lambda v: 0 if -128 <= v <= 63 else ABORT_VALUE))
-        od.add(0x6502, 0, Var('Supported drive modes', 'u32', 'ro', 1 << 7))   # bit 7: CSP
+        od.add(0x6502, 0, Var('Supported drive modes', 'u32', 'ro',
+                              (1 << 7) | ((1 << 8) | (1 << 5) if self.velocity_unit else 0)))   # CSP (CSV, homing)
+        if self.velocity_unit:
+            self._add_unit_objects()
         # --- manufacturer-specific area: a writable string (segmented downloads)
         od.add(0x2000, 0, Var('Application note', 'str', 'rw', get=lambda: d.note,
                               set=lambda v: setattr(d, 'note', v), max_len=64))
+
+    def _add_unit_objects(self):
+        od, d = self.od, self
+        rpm = self.velocity_unit == 'rpm'
+        od.add(0x60A9, 0, Var('SI unit velocity', 'u32', 'ro', 0x00B44700 if rpm else 0x00B50300))
+        od.add(0x608F, 0, Var('Position encoder resolution', 'u8', 'ro', 2))
+        od.add(0x608F, 1, Var('Encoder increments', 'u32', 'ro', self.encoder_increments or 1))
+        od.add(0x608F, 2, Var('Motor revolutions', 'u32', 'ro', 1))
+        od.add(0x60FF, 0, Var('Target velocity', 'i32', 'rw', pdo='R', get=lambda: d.target_velocity,
+                              set=lambda v: setattr(d, 'target_velocity', v)))
+        od.add(0x6071, 0, Var('Target torque', 'i16', 'rw', pdo='R', get=lambda: d.target_torque,
+                              set=lambda v: setattr(d, 'target_torque', v)))
+        od.add(0x6077, 0, Var('Torque actual value', 'i16', 'ro', pdo='T', get=lambda: 0))
+        od.add(0x6098, 0, Var('Homing method', 'i8', 'rw', get=lambda: d.homing_method,
+                              set=lambda v: setattr(d, 'homing_method', v)))
+        od.add(0x6099, 0, Var('Homing speeds', 'u8', 'ro', 2))
+        for i in range(2):
+            od.add(0x6099, i + 1, Var('Homing speeds', 'u32', 'rw', get=lambda i=i: d.homing_speeds[i],
+                                      set=lambda v, i=i: d.homing_speeds.__setitem__(i, v)))
+        od.add(0x609A, 0, Var('Homing acceleration', 'u32', 'rw', get=lambda: d.homing_accel,
+                              set=lambda v: setattr(d, 'homing_accel', v)))
+        od.add(0x607C, 0, Var('Home offset', 'i32', 'rw', get=lambda: d.home_offset,
+                              set=lambda v: setattr(d, 'home_offset', v)))
 
     def _add_pdo_objects(self, p: Pdo):
         od = self.od
@@ -602,6 +652,11 @@ class Drive:
         self.mode = m
 
     def _set_controlword(self, cw: int):
+        if (self.mode == MODE_HOMING and self.state == OPERATION_ENABLED and cw & CW_HOMING_START
+                and not self.controlword & CW_HOMING_START):
+            self.homing = 'active'
+            self.log(f'homing started: method {self.homing_method}, speeds 0x6099:1 = {self.homing_speeds[0]} '
+                     f'0x6099:2 = {self.homing_speeds[1]} {self.velocity_unit}, 0x609A = {self.homing_accel}')
         self.controlword = cw
         self._apply_controlword(cw)
 
@@ -631,9 +686,15 @@ class Drive:
         sw = STATE_BITS[self.state] | SW_REMOTE
         if self.state != NOT_READY:
             sw |= SW_VOLTAGE_ENABLED
-        if self.state == OPERATION_ENABLED and self.mode == MODE_CSP:
-            sw |= SW_CSP_FOLLOWING
+        if self.state == OPERATION_ENABLED and self.mode in (MODE_CSP, MODE_CSV):
+            sw |= SW_CSP_FOLLOWING        # bit 12: drive follows the command value
+        if self.mode == MODE_HOMING and self.homing == 'attained':
+            sw |= SW_CSP_FOLLOWING | SW_TARGET_REACHED   # bit 12 homing attained, bit 10 target reached
         return sw
+
+    def counts_per_unit(self) -> float:
+        """Increments per second of one unit of 0x60FF/0x6099/0x606C."""
+        return self.encoder_increments / 60.0 if self.velocity_unit == 'rpm' else 1.0
 
     def _go(self, transition: int, to: int):
         self.log(f'transition {transition}: {STATE_NAMES[self.state]} -> {STATE_NAMES[to]}')
@@ -779,10 +840,24 @@ class Drive:
         # 1. The set-point taken at the last SYNC has been reached (the drive
         #    interpolates to it over the interpolation period, 0x60C2).
         self.prev_actual = self.actual
+        was_at = self.actual + self.frac
         if self.following:
             self.actual = self.demand
         period = self.interpolation_period()
-        self.velocity = int(round((self.actual - self.prev_actual) / period)) if period > 0 else 0
+        enabled = self.state == OPERATION_ENABLED
+        if enabled and self.mode == MODE_CSV:           # 0x60FF in the velocity unit
+            self._advance(self.target_velocity * self.counts_per_unit() * period)
+        elif enabled and self.mode == MODE_HOMING and self.homing == 'active':
+            # to position 0 at 0x6099:1 (search), the last count at 0x6099:2 (zero)
+            step = self.homing_speeds[0] * self.counts_per_unit() * period
+            if abs(self.actual) <= step or step <= 0:
+                self.actual, self.frac, self.homing = -self.home_offset, 0.0, 'attained'
+                self.log(f'homing attained at {self.actual}')
+            else:
+                self._advance(-step if self.actual > 0 else step)
+        vel = (self.actual + self.frac - was_at) / period if period > 0 else 0
+        # 0x606C: counts/s, or in the velocity unit when the drive has one.
+        self.velocity = int(round(vel / self.counts_per_unit()))
         # 2. Synchronous TPDOs, sampled now.
         if self.nmt == OPERATIONAL:
             for p in self.tpdos:
@@ -812,6 +887,8 @@ class Drive:
                 self._write_rpdo(p, data)
         # 5. The new set-point (CSP): the drive follows 0x607A while enabled.
         was = self.demand
+        if not enabled or (self.mode != MODE_HOMING and self.homing == 'active'):
+            self.homing = None            # a homing ends with the enable or its mode
         self.following = self.state == OPERATION_ENABLED and self.mode == MODE_CSP
         if self.following:
             self.demand = self.target
@@ -824,6 +901,11 @@ class Drive:
         else:
             self.demand = self.actual
         return out
+
+    def _advance(self, counts: float):
+        x = self.actual + self.frac + counts
+        self.actual = int(math.floor(x))
+        self.frac = x - self.actual
 
     def _tpdo_payload(self, p: Pdo) -> bytes:
         return b''.join(self.od.entries[(i, s)].encode() for i, s, _ in p.mapped())
@@ -1295,6 +1377,11 @@ Exit status: 0 after quit, SIGINT/SIGTERM or --duration; 1 on errors (bus, argum
     ap.add_argument('--fault-code', type=lambda s: int(s, 0), default=0xFF00,
                     help='EMCY code of `fault` and SIGUSR1 (default 0xFF00)')
     ap.add_argument('--sdo-timeout-ms', type=int, default=1000, help='segmented transfer timeout (default 1000)')
+    ap.add_argument('--velocity-unit', choices=('inc/s', 'rpm'),
+                    help='drive units: 0x60A9 = inc/s or rpm, and CSV (mode 9) and homing (mode 6): 0x60FF, '
+                         '0x6099 and 0x606C in that unit (default: CSP only, no 0x60A9)')
+    ap.add_argument('--encoder-increments', type=int, default=0, metavar='N',
+                    help='0x608F:1, increments per motor revolution (needed by rpm)')
     ap.add_argument('--control', metavar='PATH', help="control channel: a FIFO path, or '-' for stdin")
     ap.add_argument('--powered-off', action='store_true',
                     help='start without power: silent (no boot-up, nothing answered) until the control command '
@@ -1330,7 +1417,7 @@ def main(argv=None) -> int:
         print(f'cia402_peer: cannot open {a.bus_type} bus {a.interface}: {e}', file=sys.stderr)
         return 1
     drive = Drive(a.node, a.rpdos, a.tpdos, a.position, a.heartbeat_ms, a.consumer_heartbeat, a.fault_code,
-                  a.sdo_timeout_ms / 1000.0, log)
+                  a.sdo_timeout_ms / 1000.0, log, a.velocity_unit, a.encoder_increments)
     runner = Runner(drive, bus, powered=not a.powered_off)
 
     def on_stop(signum, frame):

@@ -679,3 +679,87 @@ class ControlAndCli(PeerCase):
 
 if __name__ == '__main__':
     unittest.main()
+
+
+class DriveUnits(PeerCase):
+    """--velocity-unit / --encoder-increments (issue 29, README "Drive units"):
+    0x60A9 and 0x608F shown, CSV (0x60FF) and homing speeds (0x6099) taken in
+    the unit, 0x606C reported in it. rpm: 4096 increments per revolution, so
+    900 rpm = 61440 counts/s."""
+    RPDO2, TPDO2_ = 0x300 + NODE, 0x280 + NODE
+
+    def setup_units(self, unit, increments=4096, period=0.01):
+        self.make(velocity_unit=unit, encoder_increments=increments)
+        c = spec_checks.Ctx(self.link, NODE, period)
+        c.csp_pdos()
+        c.remap(True, 2, [0x60FF0020, 0x60710010, 0x60600008])
+        c.remap(False, 2, [0x606C0020, 0x60770010, 0x60610008])
+        self.sdo.write(0x60C2, 1, int(period * 1000), '<B')
+        self.sdo.write(0x60C2, 2, -3, '<b')
+        self.nmt(0x01)
+        self.period = period
+        return c
+
+    def step(self, n=1):
+        for _ in range(n):
+            self.link.send(SYNC)
+            self.link.advance(self.period)
+        self.link.poll()
+        self.link.queue = []
+
+    def enable_in(self, mode, velocity=0, cw_extra=0):
+        for cw in (0x0006, 0x0007, 0x000F):
+            self.link.send(RPDO1, struct.pack('<Hi', cw, self.drive.actual))
+            self.link.send(self.RPDO2, struct.pack('<ihb', velocity, 0, mode))
+            self.step()
+        self.assertEqual(self.drive.state, peer.OPERATION_ENABLED)
+
+    def test_objects_shown(self):
+        self.make(velocity_unit='rpm', encoder_increments=4096)
+        self.assertEqual(self.sdo.read(0x60A9), 0x00B44700)
+        self.assertEqual(self.sdo.read(0x608F, 1), 4096)
+        self.assertEqual(self.sdo.read(0x608F, 2), 1)
+        self.assertEqual(self.sdo.read(0x6502) & (1 << 8 | 1 << 5), 1 << 8 | 1 << 5)
+        self.link.close()
+        self.make(velocity_unit='inc/s')
+        self.assertEqual(self.sdo.read(0x60A9), 0x00B50300)
+        self.link.close()
+        self.make()   # without the option: CSP only, no 0x60A9, CSV refused
+        self.assertEqual(self.sdo.abort_code(self.sdo.read, 0x60A9), peer.ABORT_NO_OBJECT)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x6060, 0, 9, '<b'), peer.ABORT_VALUE)
+        with self.assertRaises(ValueError):
+            peer.Drive(NODE, velocity_unit='rpm')   # rpm without increments per revolution
+
+    def test_csv_in_rpm_and_inc_per_s_same_shaft_speed(self):
+        moved = {}
+        for unit, v in (('rpm', 900), ('inc/s', 61440)):
+            self.setup_units(unit)
+            self.enable_in(9, v)
+            for _ in range(10):
+                self.link.send(self.RPDO2, struct.pack('<ihb', v, 0, 9))
+                self.step()
+            p0 = self.drive.actual
+            for _ in range(100):               # 1 s
+                self.link.send(self.RPDO2, struct.pack('<ihb', v, 0, 9))
+                self.step()
+            moved[unit] = self.drive.actual - p0
+            self.assertEqual(self.sdo.read(0x606C, 0, '<i'), v, unit)   # 0x606C in the drive's unit
+            self.link.close()
+        self.assertEqual(moved['rpm'], moved['inc/s'])
+        self.assertAlmostEqual(moved['rpm'], 61440, delta=1)   # 1 s at 61440 counts/s (sub-count remainder)
+
+    def test_homing_speed_in_rpm(self):
+        self.setup_units('rpm')
+        self.drive.actual = 20480
+        self.sdo.write(0x6098, 0, 19, '<b')
+        self.sdo.write(0x6099, 1, 300)         # 300 rpm = 20480 counts/s
+        self.sdo.write(0x6099, 2, 60)
+        self.enable_in(6)
+        self.link.send(RPDO1, struct.pack('<Hi', 0x001F, self.drive.actual))   # bit 4: start
+        self.step(51)                          # the RPDO takes effect at the next SYNC, then 0.5 s: half way
+        self.assertAlmostEqual(self.drive.actual, 10240, delta=1)
+        self.assertEqual(self.sdo.read(0x606C, 0, '<i'), -300)
+        self.step(51)
+        self.assertEqual(self.drive.actual, 0)
+        sw = self.sdo.read(0x6041, 0, '<H')
+        self.assertEqual(sw & (1 << 12 | 1 << 10), 1 << 12 | 1 << 10, f'statusword 0x{sw:04X}')
