@@ -4,13 +4,15 @@
 # processes.
 #   vcan-peer-run.sh SCENARIO CANMOTIOND [PEER_OPTION...]
 # SCENARIO is boot_enable_move, fault_recovery, vanish, nmt_preop,
-# boot_late, power_cycle, link_down or never_heard (scenarios/*.script).
+# boot_late, power_cycle, link_down, never_heard or units_rpm (scenarios/*.script).
 # 1. the peer powers up (/usr/bin/python3 cia402_peer.py -i vcan0 -n 5
 #    --position 123456 --heartbeat-ms 100 --control FIFO -v PEER_OPTION...),
 #    then canmotiond
 #    --config vcan.yaml --script scenarios/SCENARIO.script --csv, real time;
 #    never_heard: --config vcan-two.yaml (a second axis, on node 6, where
 #    nothing answers);
+#    units_rpm: --config vcan-units.yaml with tests/units/rpm-drive.eds (the
+#    peer gets --velocity-unit rpm --encoder-increments 4096 from ctest);
 #    boot_late: the peer process starts first but --powered-off (silent);
 # 2. fault_recovery: after canmotiond printed the `X.JogStatus` line, the
 #    peer gets `fault 0xFF00` on its control FIFO; nmt_preop: `nmt preop`
@@ -38,8 +40,11 @@ script="$here/scenarios/$scenario.script"
 [[ -f "$script" ]] || fail "no scenario '$scenario' ($script)"
 config=vcan.yaml
 [[ $scenario == never_heard ]] && config=vcan-two.yaml
-rm -f "$art/vcan.yaml" "$art/vcan-two.yaml"
+[[ $scenario == units_rpm ]] && config=vcan-units.yaml
+rm -f "$art/vcan.yaml" "$art/vcan-two.yaml" "$art/vcan-units.yaml"
 cp "$here/$config" "$art/$config"
+# units_rpm: the drive's units come from its EDS (next to the configuration).
+[[ $scenario == units_rpm ]] && cp "$here/../units/rpm-drive.eds" "$art/rpm-drive.eds"
 ctl_dir="$(mktemp -d)"            # VM-local: a FIFO cannot live on the shared build tree, and a log polled there can be seen stale
 ctl="$ctl_dir/peer.ctl"
 rm -f "$art/events.log"

@@ -104,7 +104,8 @@ class Check:
         """A write the peer may refuse with 0602 0000h, its right answer:
         disabling a PDO it does not have (it has 2 + 2), 0x1006 = 0 or 0x1019
         (optional objects it lacks)."""
-        return x[4] == 0x06020000 and ((x[2] == 1 and x[3] >> 31 and (0x1400 <= x[1] <= 0x15FF or 0x1800 <= x[1] <= 0x19FF))
+        return x[4] == 0x06020000 and ((0x2010 <= x[1] <= 0x2022)   # optional MDS objects (units_rpm)
+                                       or (x[2] == 1 and x[3] >> 31 and (0x1400 <= x[1] <= 0x15FF or 0x1800 <= x[1] <= 0x19FF))
                                        or (x[1] == 0x1006 and x[2] == 0 and x[3] == 0) or (x[1] == 0x1019 and x[2] == 0))
 
     def printed(self, tag):
@@ -553,6 +554,31 @@ class Check:
         self.item(fault[-1:] == ['0'] and self.printed('X.DriveEnableStatus')[-1:] == ['1'], 'X still enabled, no fault',
                   f'X.AxisFault {fault}, X.DriveEnableStatus {self.printed("X.DriveEnableStatus")}')
 
+    def units_rpm(self, t_start):
+        """The peer in rpm (4096 counts per revolution, one user unit): the
+        homing speeds as SDO writes (5 and 1 rev/s = 300 and 60 rpm), the MDS
+        target in RPDO2 (0x60FF, 15 rev/s = 900 rpm), 0x606C in TPDO2 in rpm
+        and canmotiond's X.ActualVelocity in user units. In counts/s these
+        would be 20480, 4096 and 61440."""
+        xs = [x for x in self.sdo_transfers() if x[0] >= t_start and x[4] == 0]
+        w = {(i, s): v for _, i, s, v, _ in xs}
+        self.item(w.get((0x6099, 1)) == 300 and w.get((0x6099, 2)) == 60, '0x6099 homing speeds in rpm',
+                  f'0x6099:1 = {w.get((0x6099, 1))}, 0x6099:2 = {w.get((0x6099, 2))} (want 300 and 60 rpm)')
+        m = re.search(r'homing started: method (\d+), speeds 0x6099:1 = (\d+) 0x6099:2 = (\d+) rpm', self.peer_log)
+        self.item(bool(m) and m.group(2) == '300', 'peer: homing at 300 rpm', m.group(0) if m else 'no homing line in peer.log')
+        self.item('homing attained' in self.peer_log, 'peer: homing attained', 'homing attained' in self.peer_log)
+        got = self.printed('X.ActualPosition')
+        self.item(got[:1] == ['0'], 'X.ActualPosition after MAH', f'{got[:1]} (want 0)')
+        r2 = [struct.unpack('<ihb', d[:7]) for _, _, d in self.t.of(0x300 + self.a.node, t_start) if len(d) >= 7]
+        vels = sorted({v for v, _, m in r2 if m == 9})
+        self.item(bool(vels) and max(vels) == 900, 'RPDO2 0x60FF in rpm (CSV)',
+                  f'0x60FF values with 0x6060 = 9: {vels[-4:]} (want up to 900 rpm)')
+        t2 = [struct.unpack('<ihb', d[:7]) for _, _, d in self.t.of(0x280 + self.a.node, t_start) if len(d) >= 7]
+        fb = [v for v, _, m in t2 if m == 9]
+        self.item(900 in fb and max(fb) == 900, 'TPDO2 0x606C in rpm', f'max 0x606C in CSV {max(fb) if fb else None} (want 900)')
+        got = self.printed('X.ActualVelocity')
+        self.item(got[:1] == ['15'], 'X.ActualVelocity during MDS', f'{got[:1]} (want 15 rev/s)')
+
     def vanish(self, t_start):
         peer_ids = {self.TPDO, self.HB, self.EMCY, self.SDO_RSP}
         killed = re.search(r'^(\d+\.\d+) peer killed', self.read('events.log'), re.M)
@@ -594,7 +620,7 @@ def main():
                                  epilog='Environment: CANMOTION_TRACE, CANMOTION_ARTIFACTS, CANMOTION_BUILD_DIR '
                                         '(run-vcan-test); PEER_SYNC_MEAN_MAX (1.5), PEER_VANISH_SLACK_MS (100).')
     ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish', 'nmt_preop', 'boot_late',
-                                         'power_cycle', 'link_down', 'never_heard'))
+                                         'power_cycle', 'link_down', 'never_heard', 'units_rpm'))
     ap.add_argument('--period-ms', type=float, default=10.0)
     ap.add_argument('--node', type=int, default=5)
     ap.add_argument('--start', type=int, default=123456, help='the peer\'s --position')
@@ -623,6 +649,8 @@ def main():
             c.power_cycle(t_start)
         elif a.scenario == 'link_down':
             c.link_down(t_start)
+        elif a.scenario == 'units_rpm':
+            c.units_rpm(t_start)
         else:
             c.vanish(t_start)
     print(f"vcan-peer-check: {a.scenario}: {'FAIL (' + ', '.join(c.failed) + ')' if c.failed else 'PASS'}")
