@@ -230,6 +230,25 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
   };
   one(u::kSiUnitVelocity, false, ds.velocity_unit, ds.velocity_counts, ds.velocity_unknown);
   one(u::kSiUnitAcceleration, true, std::nullopt, ds.acceleration_counts, ds.acceleration_unknown);
+  // The older factor objects (DSP 402 before the SI units): a drive that
+  // scales its velocities (0x6094 velocity encoder factor, 0x6095/0x6096
+  // velocity factors 1/2) or accelerations (0x6097) by a ratio other than
+  // 1:1 has units this master does not interpret: unknown, not guessed.
+  auto older = [&](std::uint16_t index, const char* name, std::optional<double>& counts, std::string& unknown) {
+    if (e.find(index, 1) == nullptr) return;
+    const auto n = file_value(e, index, 1, a.node);
+    const auto d = file_value(e, index, 2, a.node);
+    if (n && d && *n == *d && *n != 0) return;
+    counts.reset();
+    unknown = fmt::format("{}:{} has 0x{:04X} ({}){}: the older factor objects are not interpreted", ds.eds,
+                          e.find(index)->line, index, name,
+                          n && d ? fmt::format(" = {}:{}, not 1:1", *n, *d) : std::string(" without a value"));
+  };
+  for (const auto& [index, name] : {std::pair<std::uint16_t, const char*>{0x6094, "velocity encoder factor"},
+                                    {0x6095, "velocity factor 1"},
+                                    {0x6096, "velocity factor 2"}})
+    if (ds.velocity_counts) older(index, name, ds.velocity_counts, ds.velocity_unknown);
+  if (ds.acceleration_counts) older(0x6097, "acceleration factor", ds.acceleration_counts, ds.acceleration_unknown);
   const std::string axis = fmt::format("axes[{}]", ai);
   auto refuse = [&](Location where, const std::string& key, const std::string& what, bool velocity) {
     const std::string& why = velocity ? ds.velocity_unknown : ds.acceleration_unknown;

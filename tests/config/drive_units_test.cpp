@@ -121,6 +121,20 @@ TEST(DriveUnits, UnknownVelocityUnitIsRefusedBeforeAnyFrame) {
   }
 }
 
+TEST(DriveUnits, OlderFactorObjectsOtherThanOneToOneAreUnknown) {
+  // No 0x60A9, but 0x6094 (velocity encoder factor) 10:1: not interpreted, so
+  // the velocity unit is unknown and MDS and homing are refused.
+  try {
+    (void)load_string(yaml("incs-drive.eds", "older-factor-drive.eds"), kFile);
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("axes[1].direct_control"), std::string::npos) << w;
+    EXPECT_NE(w.find("0x6094 (velocity encoder factor) = 10:1, not 1:1: the older factor objects are not interpreted"),
+              std::string::npos) << w;
+  }
+}
+
 TEST(DriveUnits, CspOnlyAxisWithUnknownVelocityUnitRunsWithoutVelocity) {
   std::string y = yaml("incs-drive.eds", "unknown-velocity-drive.eds");
   // Axis B without MDS and homing on the drive: position only.

@@ -46,4 +46,7 @@ make("incs-drive.eds", "canmotion test drive: velocity in inc/s (0x60A9 = 0x00B5
 make("unknown-velocity-drive.eds",
      "canmotion test drive: velocity in rpm without 0x608F, so its counts per revolution cannot be known",
      [(0x60A9, var(0x60A9, "SI unit velocity", "0x0007", "ro", "0x00B44700"))])
+make("older-factor-drive.eds",
+     "canmotion test drive: no 0x60A9, but 0x6094 velocity encoder factor 10:1 (older factor objects)",
+     [(0x6094, array2(0x6094, "Velocity encoder factor", "Numerator", "Divisor", 10, 1))])
 sys.exit(0)
