@@ -38,6 +38,10 @@ File load_corpus(const std::string& name) {
   return File{path, ss.str(), load(path)};  // a ParseError fails the test
 }
 
+/// The line of `what` at the start of a line of `f` (the comments above
+/// the sections quote the keys too); `nth` > 1 for later ones.
+int at(const File& f, const std::string& what, int nth = 1) { return line_of(f.text, "\n" + what, nth) + 1; }
+
 /// The one warning at `line` whose message holds `what`; its to_string()
 /// starts with "file:line: ".
 std::string warning_at(const File& f, int line, std::string_view what) {
@@ -51,7 +55,8 @@ std::string warning_at(const File& f, int line, std::string_view what) {
   std::string all;
   for (const Diagnostic& w : f.eds.warnings) all += w.to_string() + "\n";
   EXPECT_EQ(found, 1) << "no single warning at line " << line << " with '" << what << "'; warnings:\n" << all;
-  EXPECT_EQ(got.rfind(fmt::format("{}:{}: ", f.name, line), 0), 0u) << got;
+  const std::string prefix = line > 0 ? fmt::format("{}:{}: ", f.name, line) : f.name + ": ";
+  EXPECT_EQ(got.rfind(prefix, 0), 0u) << got;
   return got;
 }
 
@@ -88,11 +93,11 @@ std::string refusals(const CheckResult& r) {
 // maxon's commissioning tool writes Baudrate=0 and NodeId=0 for "not set".
 TEST(EdsDefects, CommissioningValuesAreWarnings) {
   const File f = load_corpus("defect-commissioning.dcf");
-  EXPECT_EQ(warning_at(f, line_of(f.text, "Baudrate=0"), "Baudrate=0 is not a CiA 301 bit rate"),
+  EXPECT_EQ(warning_at(f, at(f, "Baudrate=0"), "Baudrate=0 is not a CiA 301 bit rate"),
             fmt::format("{}:{}: [DeviceComissioning] Baudrate=0 is not a CiA 301 bit rate in kbit/s (10, 20, 50, 125, "
                         "250, 500, 800, 1000; ignored: the bus's configuration gives the bit rate)",
-                        f.name, line_of(f.text, "Baudrate=0")));
-  warning_at(f, line_of(f.text, "NodeId=0"), "NodeId=0 is not a node-ID");
+                        f.name, at(f, "Baudrate=0")));
+  warning_at(f, at(f, "NodeId=0"), "NodeId=0 is not a node-ID");
   ASSERT_TRUE(f.eds.comissioning.has_value());
   EXPECT_EQ(f.eds.comissioning->node_id, 0);
   EXPECT_EQ(f.eds.comissioning->baudrate, 0);
@@ -105,8 +110,8 @@ TEST(EdsDefects, CommissioningValuesAreWarnings) {
 // is left out, the type's range applies.
 TEST(EdsDefects, LimitsOutsideTheTypeAreWarningsAndLeftOut) {
   const File f = load_corpus("defect-limit-range.eds");
-  warning_at(f, line_of(f.text, "HighLimit=65536"), "65536 does not fit UNSIGNED16 (0 .. 65535) (the limit is ignored)");
-  warning_at(f, line_of(f.text, "LowLimit=-1"), "-1 is negative, UNSIGNED32 is unsigned");
+  warning_at(f, at(f, "HighLimit=65536"), "65536 does not fit UNSIGNED16 (0 .. 65535) (the limit is ignored)");
+  warning_at(f, at(f, "LowLimit=-1"), "-1 is negative, UNSIGNED32 is unsigned");
   const SubObject* torque = f.eds.find(0x6072, 0);
   ASSERT_NE(torque, nullptr);
   EXPECT_FALSE(torque->high_limit.has_value());
@@ -126,10 +131,10 @@ TEST(EdsDefects, LimitsOutsideTheTypeAreWarningsAndLeftOut) {
 // two's complement (-128), as python-canopen's _signed_int_from_hex does.
 TEST(EdsDefects, SignedLimitsInTwosComplementHexAreWarnings) {
   const File f = load_corpus("defect-signed-hex.eds");
-  EXPECT_EQ(warning_at(f, line_of(f.text, "LowLimit=0xFF80"), "two's-complement hex"),
+  EXPECT_EQ(warning_at(f, at(f, "LowLimit=0xFF80"), "two's-complement hex"),
             fmt::format("{}:{}: [6071] LowLimit=0xFF80: a signed limit in two's-complement hex, read as -128 (INTEGER16)",
-                        f.name, line_of(f.text, "LowLimit=0xFF80")));
-  warning_at(f, line_of(f.text, "LowLimit=0xFFFFFF80"), "two's complement of more bits than INTEGER8, read as -128");
+                        f.name, at(f, "LowLimit=0xFF80")));
+  warning_at(f, at(f, "LowLimit=0xFFFFFF80"), "two's complement of more bits than INTEGER8, read as -128");
   const SubObject* ip = f.eds.find(0x60C2, 2);
   ASSERT_NE(ip, nullptr);
   ASSERT_TRUE(ip->low_limit.has_value());
@@ -148,8 +153,8 @@ TEST(EdsDefects, SignedLimitsInTwosComplementHexAreWarnings) {
 // python-canopen reads the sub-index sections there are.
 TEST(EdsDefects, SubNumberMismatchesAreWarnings) {
   const File f = load_corpus("defect-subnumber.eds");
-  warning_at(f, line_of(f.text, "SubNumber=5"), "SubNumber=5 but there are 2 sub-index sections");
-  warning_at(f, line_of(f.text, "[60C2]\n"), "has neither SubNumber nor CompactSubObj (its 3 sub-index sections are read)");
+  warning_at(f, at(f, "SubNumber=5"), "SubNumber=5 but there are 2 sub-index sections");
+  warning_at(f, at(f, "[60C2]\n"), "has neither SubNumber nor CompactSubObj (its 3 sub-index sections are read)");
   ASSERT_NE(f.eds.find(0x60C2, 2), nullptr);
   Requirements req = csp_uses();
   req.uses.push_back(use(0x1018, 1, Usage::kRead, 4, "drive.identity"));
@@ -163,9 +168,9 @@ TEST(EdsDefects, SubNumberMismatchesAreWarnings) {
 TEST(EdsDefects, DuplicateAndStrayKeysAreWarnings) {
   const File f = load_corpus("defect-duplicates.eds");
   warning_at(f, 1, "'StrayKey' is outside any [section] (ignored)");
-  warning_at(f, line_of(f.text, "3=0x6040"), "0x6040 is listed again");
-  warning_at(f, line_of(f.text, "DefaultValue=5"), "[607A] DefaultValue is given again (first at line");
-  warning_at(f, line_of(f.text, "[6040]", 2), "section [6040] appears again");
+  warning_at(f, at(f, "3=0x6040"), "0x6040 is listed again");
+  warning_at(f, at(f, "DefaultValue=5"), "[607A] DefaultValue is given again (first at line");
+  warning_at(f, at(f, "[6040]", 2), "section [6040] appears again");
   const SubObject* target = f.eds.find(0x607A, 0);
   ASSERT_NE(target, nullptr);
   ASSERT_TRUE(target->default_value.has_value());
@@ -181,9 +186,9 @@ TEST(EdsDefects, DuplicateAndStrayKeysAreWarnings) {
 TEST(EdsDefects, MissingSectionsAndListDefectsAreWarnings) {
   const File f = load_corpus("defect-lists.eds");
   warning_at(f, 0, "no [DeviceInfo] section");
-  warning_at(f, line_of(f.text, "[OptionalObjects]"), "has no SupportedObjects");
-  warning_at(f, line_of(f.text, "5=0x6099"), "lists 0x6099 but there is no section [6099]");
-  warning_at(f, line_of(f.text, "[6064]"), "[6064] is not in [MandatoryObjects], [OptionalObjects]");
+  warning_at(f, at(f, "[OptionalObjects]"), "has no SupportedObjects");
+  warning_at(f, at(f, "5=0x6099"), "lists 0x6099 but there is no section [6099]");
+  warning_at(f, at(f, "[6064]"), "[6064] is not in [MandatoryObjects], [OptionalObjects]");
   Requirements req = csp_uses();
   req.rpdos = 1;  // 0x1400 and 0x1600 are there
   req.pdo_key = "drives.pdo";
@@ -224,7 +229,7 @@ TEST(EdsDefects, ParameterValueWinsOverDefaultValue) {
   EXPECT_EQ(r.refusals[0].to_string(),
             fmt::format("{}:{}: 0x6502:00 (Supported drive modes) is 0x000003A1 (ParameterValue), it lacks bit 0x2, "
                         "which the master needs (set by drives.pdo)",
-                        f.name, line_of(f.text, "[6502]")));
+                        f.name, at(f, "[6502]")));
 }
 
 // No value at all: the check leaves 0x6502 to the boot, which reads it from
@@ -246,11 +251,11 @@ TEST(EdsDefects, SupportedModesWithoutAValueAreLeftToTheBoot) {
 // use the object; a refusal naming file:line and the object when it does.
 TEST(EdsDefects, DefectsInObjectsTheMasterUsesAreRefused) {
   const File f = load_corpus("defect-used-objects.eds");
-  warning_at(f, line_of(f.text, "DataType=0x0040\nAccessType=rw\n"), "[2000] DataType=0x0040: unknown data type");
-  warning_at(f, line_of(f.text, "AccessType=rx"), "[2001] AccessType=rx: expected ro, wo, rw, rwr, rww or const");
-  warning_at(f, line_of(f.text, "ObjectType=0x3"), "[2002] ObjectType=0x3 is not an object code");
-  warning_at(f, line_of(f.text, "DefaultValue=0xZZ"), "[2003] DefaultValue: '0xZZ' is not a number");
-  warning_at(f, line_of(f.text, "PDOMapping=2"), "[2003] PDOMapping=2 is out of range");
+  warning_at(f, at(f, "DataType=0x0040\nAccessType=rw\n"), "[2000] DataType=0x0040: unknown data type");
+  warning_at(f, at(f, "AccessType=rx"), "[2001] AccessType=rx: expected ro, wo, rw, rwr, rww or const");
+  warning_at(f, at(f, "ObjectType=0x3"), "[2002] ObjectType=0x3 is not an object code");
+  warning_at(f, at(f, "DefaultValue=0xZZ"), "[2003] DefaultValue: '0xZZ' is not a number");
+  warning_at(f, at(f, "PDOMapping=2"), "[2003] PDOMapping=2 is out of range");
   // The master does not use 0x2000..0x2003: accepted as far as it goes.
   Requirements req;
   req.uses = {use(0x1000, 0, Usage::kRead, 4, "drive.identity")};
@@ -267,11 +272,11 @@ TEST(EdsDefects, DefectsInObjectsTheMasterUsesAreRefused) {
             fmt::format("{}:{}: 0x6040:00 (Controlword) cannot be used, the master would map it into an RPDO: [6040] "
                         "AccessType=readwrite: expected ro, wo, rw, rwr, rww or const (the object cannot be used) "
                         "(set by drives.pdo)",
-                        f.name, line_of(f.text, "AccessType=readwrite")));
-  EXPECT_EQ(r.refusals[1].line, line_of(f.text, "DataType=0x0040"));
+                        f.name, at(f, "AccessType=readwrite")));
+  EXPECT_EQ(r.refusals[1].line, at(f, "DataType=0x0040"));
   EXPECT_NE(r.refusals[1].message.find("0x607A:00 (Target position) cannot be used"), std::string::npos)
       << refusals(r);
-  EXPECT_EQ(r.refusals[2].line, line_of(f.text, "DefaultValue=CSP|CSV"));
+  EXPECT_EQ(r.refusals[2].line, at(f, "DefaultValue=CSP|CSV"));
   EXPECT_NE(r.refusals[2].message.find("0x6502:00 (Supported drive modes) cannot be used, the master would read it: "
                                        "[6502] DefaultValue: 'CSP|CSV' is not a number"),
             std::string::npos)
