@@ -231,9 +231,8 @@ std::optional<Value> Builder::value_text(const RawSection& s, const RawKey& k, D
   }
   if (!v) {
     if (const auto b = wide_twos_complement(k.value, t)) {
-      warning(k.line, fmt::format("[{}] {}={}: {} in two's complement of more bits than {}, read as {}", s.name,
-                                  k.name, k.value, canopen::data_type_name(t), canopen::data_type_name(t),
-                                  format_number(t, *b)));
+      warning(k.line, fmt::format("[{}] {}={}: two's complement of more bits than {}, read as {}", s.name, k.name,
+                                  k.value, canopen::data_type_name(t), format_number(t, *b)));
       Value w;
       w.text = k.value;
       w.bits = *b;
