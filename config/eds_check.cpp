@@ -1,5 +1,6 @@
 #include "config/eds_check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -66,21 +67,23 @@ void check_interpolation_index(const Config& cfg, const AxisSettings& a, const s
     return;
   }
   const std::string what = fmt::format("0x60C2:02 ({})", s->name.empty() ? "Interpolation time index" : s->name);
-  if (!s->default_value || s->size() != 1) {
+  const eds::Value* v = s->value();  // ParameterValue, else DefaultValue
+  if (v == nullptr || s->size() != 1) {
     diags.push_back({Severity::kWarning, cfg.path, a.drive.eds_where, a.drive.eds_key,
                      fmt::format("{}: {}:{}: {} is AccessType={} without a DefaultValue: the boot reads the drive's "
                                  "unit and fails if the period {} ({}) is not a whole number 1..255 of it",
                                  who, e.file, s->line, what, eds::access_type_name(s->access), period, key)});
     return;
   }
-  const auto idx = static_cast<std::int8_t>(canopen::sign_extend(s->default_value->resolve(a.node, 1), 8));
+  const auto idx = static_cast<std::int8_t>(canopen::sign_extend(v->resolve(a.node, 1), 8));
   const std::int64_t unit = cia402::interpolation_period_ns(cia402::InterpolationPeriod{1, idx});
   if (unit > 0 && cycle_ns % unit == 0 && cycle_ns / unit >= 1 && cycle_ns / unit <= 255) return;
   diags.push_back({Severity::kError, cfg.path, where, key,
-                   fmt::format("{}: {}:{}: {} is AccessType={} at DefaultValue={} (the drive takes periods in units "
+                   fmt::format("{}: {}:{}: {} is AccessType={} at {}={} (the drive takes periods in units "
                                "of 10^{} s only) and the cycle period {} is not a whole number 1..255 of that unit: "
                                "choose a period the drive can take",
-                               who, e.file, s->line, what, eds::access_type_name(s->access), s->default_value->text,
+                               who, e.file, s->line, what, eds::access_type_name(s->access),
+                               s->parameter_value ? "ParameterValue" : "DefaultValue", v->text,
                                static_cast<int>(idx), period)});
 }
 }  // namespace
@@ -128,8 +131,8 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
     // it already holds the master's value (else refused below, naming the key).
     if (s != nullptr && !eds::writable(s->access) && w.optional &&
         (w.origin == cia402::WriteOrigin::kSyncPeriod ||
-         (w.origin == cia402::WriteOrigin::kSyncCounter && s->default_value &&
-          s->default_value->resolve(a.node, 1) == w.w.value)))
+         (w.origin == cia402::WriteOrigin::kSyncCounter && s->value() != nullptr &&
+          s->value()->resolve(a.node, 1) == w.w.value)))
       continue;
     const bool is_signed = s != nullptr && canopen::data_type_signed(s->type);
     u.value = is_signed ? canopen::sign_extend(w.w.value, 8u * w.w.size) : static_cast<std::int64_t>(w.w.value);
@@ -277,6 +280,14 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
 
 void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
   std::map<std::string, std::pair<std::shared_ptr<const eds::Eds>, std::shared_ptr<const canopen::DeviceDictionary>>> files;
+  // The files' own warnings, once per file (several axes may share one),
+  // after the refusals: a defect that a refusal names is not said again.
+  struct FileWarnings {
+    const eds::Eds* eds;
+    const AxisSettings* axis;  // the first that names the file
+  };
+  std::vector<FileWarnings> file_warnings;
+  std::vector<std::string> refused;  // the refusals' messages
   for (std::size_t ai = 0; ai < cfg.axes.size(); ++ai) {
     AxisSettings& a = cfg.axes[ai];
     DriveSettings& ds = a.drive;
@@ -287,6 +298,7 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
       try {
         auto parsed = std::make_shared<const eds::Eds>(eds::load(ds.eds_path));
         auto dict = std::make_shared<const canopen::DeviceDictionary>(eds::device_dictionary(*parsed));
+        file_warnings.push_back({parsed.get(), &a});
         it = files.emplace(ds.eds_path, std::make_pair(std::move(parsed), std::move(dict))).first;
       } catch (const eds::ParseError& e) {
         diags.push_back({Severity::kError, cfg.path, ds.eds_where, ds.eds_key,
@@ -302,6 +314,7 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
     const BusSettings* bus = cfg.find_bus(a.bus);
     if (bus == nullptr) continue;  // cross_check reported it
     const eds::CheckResult r = eds::check(*ds.eds_data, drive_requirements(a, *bus, cfg.controller.period_s, ai));
+    for (const eds::Refusal& x : r.refusals) refused.push_back(x.message);
     for (const eds::Refusal& x : r.refusals)
       diags.push_back({Severity::kError, cfg.path, ds.eds_where, x.key.empty() ? ds.eds_key : x.key,
                        // "file:line: message"; the key is the diagnostic's own.
@@ -327,7 +340,27 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
                                      "are not checked",
                                      who, ds.eds)});
     }
+    // 0x6502 without a value in the file (a DCF with neither ParameterValue
+    // nor DefaultValue): the boot reads it from the drive and refuses a mode
+    // it lacks, naming 0x6502. Said once per axis.
+    if (!r.deferred.empty()) {
+      const eds::Use& u = r.deferred.front();
+      const eds::SubObject* s = ds.eds_data->find(u.index, u.sub);
+      diags.push_back({Severity::kWarning, cfg.path, ds.eds_where, ds.eds_key,
+                       fmt::format("{}: {}:{}: 0x{:04X}:{:02X} ({}) has neither ParameterValue nor DefaultValue: the "
+                                   "boot reads it from the drive and refuses a mode the drive lacks",
+                                   who, ds.eds_data->file, s != nullptr ? s->line : 0, u.index, u.sub,
+                                   s != nullptr && !s->name.empty() ? s->name : "Supported drive modes")});
+    }
   }
+  for (const FileWarnings& f : file_warnings)
+    for (const eds::Diagnostic& w : f.eds->warnings) {
+      if (std::any_of(refused.begin(), refused.end(),
+                      [&](const std::string& m) { return m.find(w.message) != std::string::npos; }))
+        continue;
+      diags.push_back({Severity::kWarning, cfg.path, f.axis->drive.eds_where, f.axis->drive.eds_key,
+                       fmt::format("{} (read past, as python-canopen does)", w.to_string())});
+    }
 }
 
 }  // namespace canmotion::config

@@ -8,13 +8,14 @@ namespace canmotion::eds {
 
 Eds Builder::build(const IniFile& ini) {
   for (const auto& [line, message] : ini.syntax_errors) error(line, message);
-  for (const auto& [line, name] : ini.outside) error(line, fmt::format("'{}' is outside any [section]", name));
+  for (const auto& [line, name] : ini.outside) warning(line, fmt::format("'{}' is outside any [section] (ignored)", name));
   index_sections(ini);
   if (const RawSection* s = section("FileInfo")) file_info(*s);
   if (const RawSection* s = section("DeviceInfo")) {
     device_info(*s);
   } else {
-    error(0, "no [DeviceInfo] section (CiA 306 requires one: vendor, product, PDO counts, baud rates)");
+    warning(0, "no [DeviceInfo] section (CiA 306 requires one; the PDO counts are taken from the 0x1400.., "
+               "0x1800.. objects)");
   }
   if (const RawSection* s = section("DummyUsage")) dummy_usage(*s);
   const RawSection* dc = section("DeviceComissioning");
@@ -30,6 +31,14 @@ Eds Builder::build(const IniFile& ini) {
   }
   std::stable_sort(eds_.warnings.begin(), eds_.warnings.end(),
                    [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });
+  // Each diagnostic once (a defect of a compact array's type is found once
+  // per sub-index, a section given twice may repeat a key ...).
+  std::vector<Diagnostic> once;
+  for (Diagnostic& d : eds_.warnings)
+    if (std::none_of(once.begin(), once.end(),
+                     [&](const Diagnostic& x) { return x.line == d.line && x.message == d.message; }))
+      once.push_back(std::move(d));
+  eds_.warnings = std::move(once);
   return std::move(eds_);
 }
 
@@ -39,15 +48,16 @@ void Builder::index_sections(const IniFile& ini) {
     const std::string key = to_lower(s.name);
     auto [it, fresh] = by_name_.emplace(key, &s);
     if (!fresh) {
-      error(s.line, fmt::format("section [{}] appears again (first at line {})", s.name, it->second->line));
+      warning(s.line, fmt::format("section [{}] appears again (first at line {}; this one is ignored)", s.name,
+                                  it->second->line));
       continue;
     }
     // Keys given twice.
     for (std::size_t i = 0; i < s.keys.size(); ++i)
       for (std::size_t j = 0; j < i; ++j)
         if (iequals(s.keys[i].name, s.keys[j].name)) {
-          error(s.keys[i].line, fmt::format("[{}] {} is given again (first at line {})", s.name, s.keys[i].name,
-                                            s.keys[j].line));
+          warning(s.keys[i].line, fmt::format("[{}] {} is given again (first at line {}, which is read)", s.name,
+                                              s.keys[i].name, s.keys[j].line));
           break;
         }
   }
@@ -109,14 +119,14 @@ void Builder::dummy_usage(const RawSection& s) {
   for (const RawKey& k : s.keys) {
     const std::string_view n = k.name;
     if (n.size() != 9 || !iequals(n.substr(0, 5), "Dummy") || !is_hex4(n.substr(5))) {
-      error(k.line, fmt::format("[DummyUsage] {}: expected Dummy0001 .. Dummy0007", k.name));
+      warning(k.line, fmt::format("[DummyUsage] {}: expected Dummy0001 .. Dummy0007 (ignored)", k.name));
       continue;
     }
     const std::uint16_t type = hex4(n.substr(5));
     unsigned on = 0;
     if (!number(s, k, on, 1)) continue;
     if (type == 0 || type > 0x1F) {
-      error(k.line, fmt::format("[DummyUsage] {}: not a data type index (0x0001 .. 0x001F)", k.name));
+      warning(k.line, fmt::format("[DummyUsage] {}: not a data type index (0x0001 .. 0x001F; ignored)", k.name));
       continue;
     }
     if (on != 0) eds_.dummy_usage |= std::uint32_t{1} << type;
@@ -124,19 +134,28 @@ void Builder::dummy_usage(const RawSection& s) {
 }
 
 void Builder::comissioning(const RawSection& s) {
+  // Commissioning values are the integrator's (a commissioning tool writes
+  // NodeId=0 or Baudrate=0 for "not set"); the master takes node-ID and bit
+  // rate from its configuration, so a bad one is a warning and left out.
   DeviceComissioning c;
   c.line = s.line;
   if (const RawKey* k = s.get("NodeId")) {
-    if (number(s, *k, c.node_id, 127) && c.node_id == 0)
-      error(k->line, fmt::format("[{}] NodeId=0 is not a node-ID (1 .. 127)", s.name));
+    if (number(s, *k, c.node_id, 0xFF) && (c.node_id == 0 || c.node_id > 127)) {
+      warning(k->line, fmt::format("[{}] NodeId={} is not a node-ID (1 .. 127; ignored: the configuration gives "
+                                   "the node-ID)",
+                                   s.name, k->value));
+      c.node_id = 0;
+    }
   }
   if (const RawKey* k = s.get("Baudrate")) {
-    if (number(s, *k, c.baudrate, 1000)) {
+    if (number(s, *k, c.baudrate, 0xFFFF)) {
       static constexpr std::uint16_t kRates[] = {10, 20, 50, 125, 250, 500, 800, 1000};
-      if (std::find(std::begin(kRates), std::end(kRates), c.baudrate) == std::end(kRates))
-        error(k->line, fmt::format("[{}] Baudrate={} is not a CiA 301 bit rate in kbit/s (10, 20, 50, 125, 250, "
-                                   "500, 800, 1000)",
-                                   s.name, k->value));
+      if (std::find(std::begin(kRates), std::end(kRates), c.baudrate) == std::end(kRates)) {
+        warning(k->line, fmt::format("[{}] Baudrate={} is not a CiA 301 bit rate in kbit/s (10, 20, 50, 125, 250, "
+                                     "500, 800, 1000; ignored: the bus's configuration gives the bit rate)",
+                                     s.name, k->value));
+        c.baudrate = 0;
+      }
     }
   }
   text(s, "NodeName", c.node_name);
@@ -149,41 +168,44 @@ void Builder::comissioning(const RawSection& s) {
 
 // ---- object lists ----------------------------------------------------------
 void Builder::object_list(ObjectList list) {
+  // The lists only say where an object belongs (python-canopen reads every
+  // [xxxx] section): every defect here is a warning, every entry is read.
   const RawSection* s = section(object_list_name(list));
   if (s == nullptr) return;
   eds_.list_lines[static_cast<int>(list)] = s->line;
   const RawKey* count_key = s->get("SupportedObjects");
-  if (count_key == nullptr) {
-    error(s->line, fmt::format("[{}] has no SupportedObjects (the number of entries)", s->name));
-    return;
-  }
   unsigned count = 0;
-  if (!number(*s, *count_key, count, 0xFFFF)) return;
+  bool counted = false;
+  if (count_key == nullptr) {
+    warning(s->line, fmt::format("[{}] has no SupportedObjects (the number of entries)", s->name));
+  } else {
+    counted = number(*s, *count_key, count, 0xFFFF);
+  }
   std::vector<bool> seen(count + 1, false);
   for (const RawKey& k : s->keys) {
     if (&k == count_key) continue;
     const Number n = parse_number(k.name);
     if (!n.ok || n.negative || n.base != 10 || n.magnitude == 0) {
-      error(k.line, fmt::format("[{}] {}: expected SupportedObjects or an entry number 1 .. {}", s->name, k.name, count));
+      warning(k.line, fmt::format("[{}] {}: expected SupportedObjects or an entry number 1 .. {} (ignored)", s->name,
+                                  k.name, count));
       continue;
     }
-    if (n.magnitude > count) {
-      error(k.line, fmt::format("[{}] entry {} is beyond SupportedObjects={}", s->name, k.name, count));
-      continue;
-    }
-    seen[n.magnitude] = true;
+    if (counted && n.magnitude > count)
+      warning(k.line, fmt::format("[{}] entry {} is beyond SupportedObjects={}", s->name, k.name, count));
+    else if (counted)
+      seen[n.magnitude] = true;
     std::uint16_t index = 0;
     if (!number(*s, k, index, 0xFFFF)) continue;
     auto [it, fresh] = listed_.emplace(index, Listed{list, k.line});
     if (!fresh) {
-      error(k.line, fmt::format("[{}] 0x{:04X} is listed again (first in [{}] at line {})", s->name, index,
-                                object_list_name(it->second.list), it->second.line));
+      warning(k.line, fmt::format("[{}] 0x{:04X} is listed again (first in [{}] at line {})", s->name, index,
+                                  object_list_name(it->second.list), it->second.line));
     }
   }
-  for (unsigned i = 1; i <= count; ++i)
-    if (!seen[i])
-      error(count_key->line,
-            fmt::format("[{}] SupportedObjects={} but entry {} is missing", s->name, count, i));
+  if (counted)
+    for (unsigned i = 1; i <= count; ++i)
+      if (!seen[i])
+        warning(count_key->line, fmt::format("[{}] SupportedObjects={} but entry {} is missing", s->name, count, i));
 }
 
 }  // namespace canmotion::eds

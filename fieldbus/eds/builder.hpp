@@ -47,6 +47,11 @@ class Builder {
 
   void error(int line, std::string msg) { errors_.push_back(Diagnostic{eds_.file, line, std::move(msg)}); }
   void warning(int line, std::string msg) { eds_.warnings.push_back(Diagnostic{eds_.file, line, std::move(msg)}); }
+  /// A warning that is also a defect of an object when `defects` is given.
+  void warn(int line, std::string msg, std::vector<Diagnostic>* defects) {
+    if (defects != nullptr) defects->push_back(Diagnostic{eds_.file, line, msg});
+    warning(line, std::move(msg));
+  }
   [[nodiscard]] bool failed() const { return !errors_.empty(); }
 
  private:
@@ -55,16 +60,19 @@ class Builder {
   const RawSection* section(std::string_view name) const;
 
   // ---- numbers -------------------------------------------------------------
-  /// An unsigned number key in [0, max]; false (and an error) when malformed.
+  /// An unsigned number key in [0, max]; false (and a warning, also put in
+  /// `defects` when given) when malformed or out of range.
   template <typename T>
-  bool number(const RawSection& s, const RawKey& k, T& out, std::uint64_t max) {
+  bool number(const RawSection& s, const RawKey& k, T& out, std::uint64_t max,
+              std::vector<Diagnostic>* defects = nullptr, std::string_view then = "ignored") {
     const Number n = parse_number(trim(k.value));
     if (!n.ok || n.negative) {
-      error(k.line, fmt::format("[{}] {}={} is not a number (decimal, 0x hex or 0 octal)", s.name, k.name, k.value));
+      warn(k.line, fmt::format("[{}] {}={} is not a number (decimal, 0x hex or 0 octal; {})", s.name, k.name, k.value, then),
+           defects);
       return false;
     }
     if (n.magnitude > max) {
-      error(k.line, fmt::format("[{}] {}={} is out of range (0 .. {})", s.name, k.name, k.value, max));
+      warn(k.line, fmt::format("[{}] {}={} is out of range (0 .. {}; {})", s.name, k.name, k.value, max, then), defects);
       return false;
     }
     out = static_cast<T>(n.magnitude);
@@ -74,8 +82,9 @@ class Builder {
   bool number(const RawSection& s, std::string_view key, T& out, std::uint64_t max, int* line = nullptr) {
     const RawKey* k = s.get(key);
     if (k == nullptr) return false;
+    if (!number(s, *k, out, max)) return false;
     if (line != nullptr) *line = k->line;
-    return number(s, *k, out, max);
+    return true;
   }
   bool flag(const RawSection& s, std::string_view key, bool& out);
   static void text(const RawSection& s, std::string_view key, std::string& out);
@@ -95,17 +104,22 @@ class Builder {
   /// DataType, AccessType, PDOMapping, ObjFlags, values of one VAR or
   /// sub-index section. `code` is the object's (a DOMAIN may leave out
   /// DataType and AccessType).
-  bool variable(const RawSection& s, ObjectCode code, SubObject& v);
-  void value(const RawSection& s, std::string_view key, const SubObject& v, std::optional<Value>& out);
-  std::optional<Value> value_text(const RawSection& s, const RawKey& k, canopen::DataType t);
-  /// LowLimit <= HighLimit, and DefaultValue / ParameterValue within them.
-  void limits(const RawSection& s, const SubObject& v);
+  /// A defect (unknown type, access ...) is kept in v.defects, and v is
+  /// read on without its values.
+  void variable(const RawSection& s, ObjectCode code, SubObject& v);
+  void value(const RawSection& s, std::string_view key, SubObject& v, std::optional<Value>& out);
+  /// `defects`: where an unreadable value is a defect (DefaultValue,
+  /// ParameterValue); null for limits (read past with a warning).
+  std::optional<Value> value_text(const RawSection& s, const RawKey& k, canopen::DataType t,
+                                  std::vector<Diagnostic>* defects);
+  /// LowLimit <= HighLimit (else both are dropped, with a warning), and
+  /// DefaultValue / ParameterValue within them (else a warning).
+  void limits(const RawSection& s, SubObject& v);
   /// ARRAY with CompactSubObj=N: sub 0 (UNSIGNED8 ro = N) and subs 1..N of the
   /// main section's type; names from [xxxxName], defaults from [xxxxValue].
   void compact(Object& o, const ObjectSections& secs);
   /// ARRAY/RECORD with SubNumber sub-index sections.
   void subs(Object& o, const ObjectSections& secs, const RawKey* subnum_key);
-  bool failed_number(const RawKey& k) const;
 
   Eds eds_;
   std::vector<Diagnostic> errors_;

@@ -28,6 +28,7 @@ std::string_view refusal_kind_name(RefusalKind k) noexcept {
     case RefusalKind::kMissingBits: return "not supported";
     case RefusalKind::kTooFewRpdos: return "not enough RPDOs";
     case RefusalKind::kTooFewTpdos: return "not enough TPDOs";
+    case RefusalKind::kDefect: return "defective";
   }
   return "?";
 }
@@ -67,14 +68,15 @@ class Checker {
   void pdos(bool rx) {
     const DeviceInfo& d = eds_.device_info;
     const std::uint16_t need = rx ? req_.rpdos : req_.tpdos;
+    const int count_line = rx ? d.nr_of_rxpdo_line : d.nr_of_txpdo_line;
     const std::uint16_t have = rx ? d.nr_of_rxpdo : d.nr_of_txpdo;
     const char* what = rx ? "RPDO" : "TPDO";
     const RefusalKind kind = rx ? RefusalKind::kTooFewRpdos : RefusalKind::kTooFewTpdos;
     if (need == 0) return;
-    if (have < need) {
-      const int line = (rx ? d.nr_of_rxpdo_line : d.nr_of_txpdo_line) != 0 ? (rx ? d.nr_of_rxpdo_line : d.nr_of_txpdo_line)
-                                                                             : d.line;
-      refuse(kind, rx ? 0x1400 : 0x1800, 0, line, req_.pdo_key,
+    // Without NrOfRXPDO/NrOfTXPDO (or with one that cannot be read), the PDO
+    // objects the file has decide: each missing one is named below.
+    if (count_line != 0 && have < need) {
+      refuse(kind, rx ? 0x1400 : 0x1800, 0, count_line, req_.pdo_key,
              fmt::format("the master uses {} {}{}, the EDS has {}={}", need, what, need == 1 ? "" : "s",
                          rx ? "NrOfRXPDO" : "NrOfTXPDO", have));
       return;
@@ -124,6 +126,16 @@ class Checker {
       return;
     }
     const std::string what = label(u.index, u.sub);
+    // A defect of the object in the file (unknown type, access ...): the
+    // master cannot know how to use it.
+    for (const std::vector<Diagnostic>* defects : {&o->defects, &s->defects})
+      if (!defects->empty()) {
+        std::string why;
+        for (const Diagnostic& d : *defects) why += fmt::format("{}{}", why.empty() ? "" : "; ", d.message);
+        refuse(RefusalKind::kDefect, u.index, u.sub, defects->front().line, u.key,
+               fmt::format("{} cannot be used, the master would {}: {}", what, usage_verb(u.usage), why));
+        return;
+      }
     switch (u.usage) {
       case Usage::kWrite:
         if (!writable(s->access))
@@ -221,17 +233,18 @@ class Checker {
   }
 
   void bits(const Use& u, const SubObject& s, const std::string& what) {
-    if (!s.default_value || s.size() == 0) {
-      refuse(RefusalKind::kMissingBits, u.index, u.sub, s.line, u.key,
-             fmt::format("{} has no DefaultValue to show bits 0x{:X}, which the master needs", what, u.required_bits));
+    const Value* v = s.value();
+    if (v == nullptr || s.size() == 0 || (v->node_id_relative && node_ == 0)) {
+      r_.deferred.push_back(u);  // the boot reads the object from the device
       return;
     }
-    const std::uint64_t have = s.default_value->resolve(node_, s.size());
+    const std::uint64_t have = v->resolve(node_, s.size());
     const std::uint64_t lacking = u.required_bits & ~have;
     if (lacking != 0)
       refuse(RefusalKind::kMissingBits, u.index, u.sub, s.line, u.key,
-             fmt::format("{} is {} (DefaultValue), it lacks bit{} 0x{:X}, which the master needs", what,
-                         s.default_value->text, (lacking & (lacking - 1)) != 0 ? "s" : "", lacking));
+             fmt::format("{} is {} ({}), it lacks bit{} 0x{:X}, which the master needs", what, v->text,
+                         s.parameter_value ? "ParameterValue" : "DefaultValue", (lacking & (lacking - 1)) != 0 ? "s" : "",
+                         lacking));
   }
 
   const Eds& eds_;

@@ -46,8 +46,11 @@ struct Use {
   /// A value the master writes, checked against LowLimit/HighLimit (read
   /// as the object's type: INTEGERn signed, UNSIGNEDn unsigned).
   std::optional<std::int64_t> value;
-  /// Bits that must be set in the object's DefaultValue (e.g. the mode bits
-  /// of 0x6502 supported drive modes, cia402::supported_mode_bit()).
+  /// Bits that must be set in the object's value (its ParameterValue, else
+  /// its DefaultValue; e.g. the mode bits of 0x6502 supported drive modes,
+  /// cia402::supported_mode_bit()). A file that gives no value leaves the
+  /// bits to the boot, which reads the object from the device
+  /// (CheckResult::deferred).
   std::uint64_t required_bits = 0;
   /// The master can do without it: an object the EDS lacks is reported in
   /// CheckResult::skipped instead of refused (other refusals still apply).
@@ -63,7 +66,7 @@ struct Requirements {
   std::uint16_t rpdos = 0;  ///< RPDOs it configures (numbers 1..rpdos)
   std::uint16_t tpdos = 0;  ///< TPDOs it configures
   std::string pdo_key;      ///< the configuration key that sets the PDO counts
-  /// Node-ID for $NODEID-relative defaults (required_bits); 0: the DCF's
+  /// Node-ID for $NODEID-relative values (required_bits); 0: the DCF's
   /// NodeId, else values are taken without the node-ID.
   std::uint8_t node_id = 0;
 };
@@ -76,9 +79,10 @@ enum class RefusalKind : std::uint8_t {
   kNotMappable,      ///< PDOMapping=0, the access type is the wrong direction, or Granularity does not allow it
   kWrongSize,        ///< the master's size differs from the data type's
   kOutOfRange,       ///< the value is outside LowLimit/HighLimit
-  kMissingBits,      ///< required_bits not all set in the DefaultValue
+  kMissingBits,      ///< required_bits not all set in the value (ParameterValue, else DefaultValue)
   kTooFewRpdos,      ///< NrOfRXPDO (or the 0x1400/0x1600 objects) fewer than needed
   kTooFewTpdos,      ///< NrOfTXPDO (or the 0x1800/0x1A00 objects) fewer than needed
+  kDefect,           ///< the object has a defect in the file (SubObject::defects, Object::defects)
 };
 [[nodiscard]] std::string_view refusal_kind_name(RefusalKind k) noexcept;
 
@@ -100,6 +104,9 @@ struct Refusal {
 struct CheckResult {
   std::vector<Refusal> refusals;  ///< in the order of the uses, PDO counts first
   std::vector<Use> skipped;       ///< optional uses whose object the EDS lacks
+  /// Uses with required_bits whose object the file gives no value for: the
+  /// boot reads the object from the device and refuses it then.
+  std::vector<Use> deferred;
   [[nodiscard]] bool ok() const noexcept { return refusals.empty(); }
 };
 

@@ -17,9 +17,13 @@
 /// the cyclic path (they allocate and throw); the Eds they return is
 /// immutable data that the checker (check.hpp) and, later, the emulator read.
 ///
-/// Every error names the file and line ("drive.eds:42: [6040] DataType=0x0040:
-/// unknown data type ..."); all errors of a file are collected and thrown
-/// together as one ParseError, nothing is half-returned.
+/// Defects that do not change what a master needs are warnings with the
+/// file and line ("drive.eds:42: [6040] DataType=0x0040: unknown data type
+/// ..."), as python-canopen's objectdictionary/eds.py reads past them; a
+/// defect of an object is kept with the object (SubObject::defects) so that
+/// the checker refuses only a use of it. Only a file that is not INI text
+/// (a line without '=' or ']', a NUL, an over-long line) or cannot be read
+/// is an error: all of them are thrown together as one ParseError.
 
 #include <cstdint>
 #include <filesystem>
@@ -63,6 +67,15 @@ enum class ObjectList : std::uint8_t { kNone, kMandatory, kOptional, kManufactur
 /// "MandatoryObjects", "OptionalObjects", "ManufacturerObjects" ("" for kNone).
 [[nodiscard]] std::string_view object_list_name(ObjectList l) noexcept;
 
+/// A file position and what is wrong or notable there.
+struct Diagnostic {
+  std::string file;
+  int line = 0;  ///< 1-based; 0 when the whole file is meant
+  std::string message;
+  /// "file:line: message" ("file: message" for line 0).
+  [[nodiscard]] std::string to_string() const;
+};
+
 /// One value of the file (DefaultValue, ParameterValue, LowLimit, HighLimit)
 /// read for its object's data type.
 struct Value {
@@ -95,6 +108,16 @@ struct SubObject {
   std::string denotation;                ///< DCF
   std::uint32_t obj_flags = 0;
   int line = 0;  ///< its section's header line ([1018sub2], or [1000] for a VAR, [1003] for a compact entry)
+  /// What makes it unusable (an unknown or missing DataType or AccessType, a
+  /// malformed PDOMapping, an unreadable DefaultValue or ParameterValue):
+  /// also in Eds::warnings; check() refuses a use of it naming these.
+  std::vector<Diagnostic> defects;
+
+  /// The value the device holds after configuration: the ParameterValue
+  /// (DCF) when there is one, else the DefaultValue; null when neither.
+  [[nodiscard]] const Value* value() const noexcept {
+    return parameter_value ? &*parameter_value : (default_value ? &*default_value : nullptr);
+  }
 
   /// Mappable into an RPDO (PDOMapping=1 and written by the master: wo, rw, rww).
   [[nodiscard]] bool rpdo_mappable() const noexcept;
@@ -118,6 +141,9 @@ struct Object {
   std::uint32_t obj_flags = 0;
   std::string denotation;  ///< DCF
   int line = 0;            ///< header line of [xxxx]
+  /// What makes the whole object unusable (an unknown ObjectType): also in
+  /// Eds::warnings; check() refuses a use of any of its sub-indices.
+  std::vector<Diagnostic> defects;
   std::vector<SubObject> subs;  ///< ascending sub-index; a VAR or DOMAIN has sub 0 only
 
   [[nodiscard]] const SubObject* find(std::uint8_t sub) const noexcept;
@@ -169,15 +195,6 @@ struct FileInfo {
   std::string modified_by;
 };
 
-/// A file position and what is wrong or notable there.
-struct Diagnostic {
-  std::string file;
-  int line = 0;  ///< 1-based; 0 when the whole file is meant
-  std::string message;
-  /// "file:line: message" ("file: message" for line 0).
-  [[nodiscard]] std::string to_string() const;
-};
-
 /// A malformed file: every error found, in line order. what() is their
 /// to_string()s, one per line.
 class ParseError : public std::runtime_error {
@@ -200,8 +217,11 @@ struct Eds {
   /// Line of each list's header, [0] unused (kNone), [1] Mandatory, [2]
   /// Optional, [3] Manufacturer; 0 when the file has no such list.
   int list_lines[4] = {0, 0, 0, 0};
-  /// Things a tool accepts but that are probably mistakes (an object
-  /// section that no list names, a DOMAIN default that is not hex ...).
+  /// Defects read past, as python-canopen reads past them (commissioning
+  /// values, limits outside the type's range, SubNumber mismatches, keys or
+  /// sections given twice, missing lists ...), each once, in line order.
+  /// Defects of an object (SubObject::defects, Object::defects) are here
+  /// too; check() refuses a use of such an object.
   std::vector<Diagnostic> warnings;
 
   [[nodiscard]] const Object* find(std::uint16_t index) const noexcept;

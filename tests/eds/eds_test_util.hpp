@@ -90,6 +90,23 @@ inline std::vector<Diagnostic> errors_of(const std::string& text, const std::str
   return {};
 }
 
+/// The warnings of reading `text` as `file` (a test failure if it is refused).
+inline std::vector<Diagnostic> warnings_of(const std::string& text, const std::string& file = "bad.eds") {
+  try {
+    return parse(text, file).warnings;
+  } catch (const ParseError& e) {
+    ADD_FAILURE() << "the file was refused:\n" << e.what();
+  }
+  return {};
+}
+
+/// The warnings of `text` as "file:line: message", one per line.
+inline std::string warning_text(const std::string& text, const std::string& file = "bad.eds") {
+  std::string s;
+  for (const Diagnostic& d : warnings_of(text, file)) s += (s.empty() ? "" : "\n") + d.to_string();
+  return s;
+}
+
 /// ParseError::what() of `text`: every error as "file:line: message".
 inline std::string error_text(const std::string& text, const std::string& file = "bad.eds") {
   const auto e = errors_of(text, file);

@@ -21,6 +21,8 @@ using eds::test::eds_text;
 using eds::test::error_text;
 using eds::test::errors_of;
 using eds::test::line_of;
+using eds::test::warning_text;
+using eds::test::warnings_of;
 
 namespace {
 
@@ -340,7 +342,7 @@ TEST(EdsParse, LoadReadsAFileAndNamesIt) {
   const auto path = std::filesystem::temp_directory_path() / fmt::format("canmotion-eds-{}.eds", ::getpid());
   {
     std::ofstream out(path);
-    out << eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\nDefaultValue=300\n", {0x2000});
+    out << eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\nnot a key\n", {0x2000});
   }
   try {
     (void)eds::load(path);
@@ -349,8 +351,7 @@ TEST(EdsParse, LoadReadsAFileAndNamesIt) {
     ASSERT_EQ(e.errors().size(), 1u);
     EXPECT_EQ(e.errors()[0].file, path.string());
     EXPECT_EQ(std::string(e.what()),
-              fmt::format("{}:{}: [2000] DefaultValue: 300 does not fit UNSIGNED8 (0 .. 255)", path.string(),
-                          e.errors()[0].line));
+              fmt::format("{}:{}: not a [section] header or a key=value line", path.string(), e.errors()[0].line));
   }
   std::filesystem::remove(path);
   try {
@@ -361,42 +362,64 @@ TEST(EdsParse, LoadReadsAFileAndNamesIt) {
   }
 }
 
-// ---- malformed files: each error with file:line and what is wrong ----------
+// ---- defects of vendor files: a warning with file:line, the file is read on
+// (as python-canopen reads it); a defect that makes an object unusable is
+// kept with the object (SubObject::defects) for the checker to refuse a use.
 
-TEST(EdsErrors, BadNumber) {
+namespace {
+/// The defects of index:sub as "file:line: message" lines.
+std::string defects_of(const eds::Eds& e, std::uint16_t index, std::uint8_t sub) {
+  const eds::SubObject* s = e.find(index, sub);
+  if (s == nullptr) return "(absent)";
+  std::string out;
+  for (const eds::Diagnostic& d : s->defects) out += (out.empty() ? "" : "\n") + d.to_string();
+  return out;
+}
+}  // namespace
+
+TEST(EdsWarnings, BadNumber) {
   const std::string text = eds_text("[2000]\nParameterName=x\nDataType=0x00G7\nAccessType=ro\n", {0x2000});
-  EXPECT_EQ(error_text(text), fmt::format("bad.eds:{}: [2000] DataType=0x00G7 is not a number (decimal, 0x hex or 0 "
-                                          "octal)",
-                                          line_of(text, "DataType=0x00G7")));
+  const std::string want = fmt::format("bad.eds:{}: [2000] DataType=0x00G7 is not a number (decimal, 0x hex or 0 "
+                                       "octal; the object cannot be used)",
+                                       line_of(text, "DataType=0x00G7"));
+  EXPECT_EQ(warning_text(text), want);
+  EXPECT_EQ(defects_of(eds::parse(text, "bad.eds"), 0x2000, 0), want);
 }
 
-TEST(EdsErrors, UnknownDataType) {
+TEST(EdsWarnings, UnknownDataType) {
   const std::string text = eds_text("[2000]\nParameterName=x\nDataType=0x0040\nAccessType=ro\n", {0x2000});
-  EXPECT_EQ(error_text(text), fmt::format("bad.eds:{}: [2000] DataType=0x0040: unknown data type 0x0040 (the CiA 301 "
-                                          "basic types are 0x0001 BOOLEAN .. 0x001B UNSIGNED64, without 0x000E and "
-                                          "0x0017)",
-                                          line_of(text, "DataType=0x0040")));
+  EXPECT_EQ(warning_text(text), fmt::format("bad.eds:{}: [2000] DataType=0x0040: unknown data type 0x0040 (the CiA 301 "
+                                            "basic types are 0x0001 BOOLEAN .. 0x001B UNSIGNED64, without 0x000E and "
+                                            "0x0017; the object cannot be used)",
+                                            line_of(text, "DataType=0x0040")));
+  EXPECT_FALSE(eds::parse(text, "bad.eds").find(0x2000, 0)->defects.empty());
   const std::string reserved = eds_text("[2000]\nParameterName=x\nDataType=0x0017\nAccessType=ro\n", {0x2000});
-  EXPECT_NE(error_text(reserved).find("unknown data type 0x0017"), std::string::npos);
+  EXPECT_NE(warning_text(reserved).find("unknown data type 0x0017"), std::string::npos);
 }
 
-TEST(EdsErrors, BadAccessTypeAndMissingKeys) {
+TEST(EdsWarnings, BadAccessTypeAndMissingKeys) {
   const std::string text = eds_text(
       "[2000]\nParameterName=x\nDataType=0x0005\nAccessType=rx\n\n"
       "[2001]\nDataType=0x0005\nAccessType=ro\n\n"
       "[2002]\nParameterName=y\nAccessType=ro\n\n"
       "[2003]\nParameterName=z\nDataType=0x0005\n\n",
       {0x2000, 0x2001, 0x2002, 0x2003});
-  const auto e = errors_of(text);
-  ASSERT_EQ(e.size(), 4u) << error_text(text);
-  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [2000] AccessType=rx: expected ro, wo, rw, rwr, rww or const",
+  const auto e = warnings_of(text);
+  ASSERT_EQ(e.size(), 4u) << warning_text(text);
+  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [2000] AccessType=rx: expected ro, wo, rw, rwr, rww or const "
+                                          "(the object cannot be used)",
                                           line_of(text, "AccessType=rx")));
   EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: [2001] has no ParameterName", line_of(text, "[2001]")));
-  EXPECT_EQ(e[2].to_string(), fmt::format("bad.eds:{}: [2002] has no DataType", line_of(text, "[2002]")));
-  EXPECT_EQ(e[3].to_string(), fmt::format("bad.eds:{}: [2003] has no AccessType", line_of(text, "[2003]")));
+  EXPECT_EQ(e[2].to_string(), fmt::format("bad.eds:{}: [2002] has no DataType (the object cannot be used)",
+                                          line_of(text, "[2002]")));
+  EXPECT_EQ(e[3].to_string(), fmt::format("bad.eds:{}: [2003] has no AccessType (the object cannot be used)",
+                                          line_of(text, "[2003]")));
+  const eds::Eds d = eds::parse(text, "bad.eds");
+  EXPECT_TRUE(d.find(0x2001, 0)->defects.empty()) << "a missing name does not make an object unusable";
+  for (std::uint16_t i : {0x2000, 0x2002, 0x2003}) EXPECT_EQ(d.find(i, 0)->defects.size(), 1u) << i;
 }
 
-TEST(EdsErrors, ValueDoesNotFitItsTypeOrLimits) {
+TEST(EdsWarnings, ValueDoesNotFitItsTypeOrLimits) {
   const std::string text = eds_text(
       "[2000]\nParameterName=x\nDataType=0x0002\nAccessType=rw\nDefaultValue=200\n\n"
       "[2001]\nParameterName=y\nDataType=0x0006\nAccessType=rw\nDefaultValue=5\nLowLimit=10\nHighLimit=2\n\n"
@@ -406,46 +429,58 @@ TEST(EdsErrors, ValueDoesNotFitItsTypeOrLimits) {
       "[2004]\nParameterName=v\nDataType=0x0008\nAccessType=rw\nDefaultValue=1e39\n\n"
       "[2005]\nParameterName=u\nDataType=0x000A\nAccessType=rw\nDefaultValue=ABC\n\n",
       {0x2000, 0x2001, 0x2002, 0x2003, 0x2004, 0x2005});
-  const auto e = errors_of(text);
-  ASSERT_EQ(e.size(), 7u) << error_text(text);
-  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [2000] DefaultValue: 200 does not fit INTEGER8 (-128 .. 127)",
+  const auto e = warnings_of(text);
+  ASSERT_EQ(e.size(), 7u) << warning_text(text);
+  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [2000] DefaultValue: 200 does not fit INTEGER8 (-128 .. 127) "
+                                          "(the value is unknown)",
                                           line_of(text, "DefaultValue=200")));
-  EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: [2001] HighLimit=2 is below LowLimit=10",
+  EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: [2001] HighLimit=2 is below LowLimit=10 (both are ignored)",
                                           line_of(text, "HighLimit=2")));
   EXPECT_EQ(e[2].to_string(), fmt::format("bad.eds:{}: [2002] DefaultValue=-20 is below LowLimit=-10",
                                           line_of(text, "DefaultValue=-20")));
   EXPECT_EQ(e[3].to_string(), fmt::format("bad.eds:{}: [2002] ParameterValue=11 is above HighLimit=10",
                                           line_of(text, "ParameterValue=11")));
   EXPECT_EQ(e[4].to_string(), fmt::format("bad.eds:{}: [2003] DefaultValue: '$NODEID+1': $NODEID is only allowed for "
-                                          "UNSIGNED types, not INTEGER32",
+                                          "UNSIGNED types, not INTEGER32 (the value is unknown)",
                                           line_of(text, "DefaultValue=$NODEID+1")));
-  EXPECT_EQ(e[5].to_string(), fmt::format("bad.eds:{}: [2004] DefaultValue: 1e39 does not fit REAL32",
+  EXPECT_EQ(e[5].to_string(), fmt::format("bad.eds:{}: [2004] DefaultValue: 1e39 does not fit REAL32 (the value is "
+                                          "unknown)",
                                           line_of(text, "DefaultValue=1e39")));
   EXPECT_EQ(e[6].to_string(), fmt::format("bad.eds:{}: [2005] DefaultValue: 'ABC' is not hex bytes (two hex digits "
-                                          "per byte) for OCTET_STRING",
+                                          "per byte) for OCTET_STRING (the value is unknown)",
                                           line_of(text, "DefaultValue=ABC")));
+  const eds::Eds d = eds::parse(text, "bad.eds");
+  EXPECT_FALSE(d.find(0x2001, 0)->low_limit.has_value());  // contradicting limits: both left out
+  EXPECT_FALSE(d.find(0x2001, 0)->high_limit.has_value());
+  EXPECT_TRUE(d.find(0x2001, 0)->defects.empty());
+  EXPECT_TRUE(d.find(0x2002, 0)->defects.empty()) << "a value outside the limits is kept";
+  EXPECT_EQ(d.find(0x2002, 0)->value()->text, "11");  // the ParameterValue
+  EXPECT_FALSE(d.find(0x2000, 0)->default_value.has_value());
+  EXPECT_EQ(d.find(0x2000, 0)->defects.size(), 1u) << "an unreadable value of an object the master uses is refused";
 }
 
-TEST(EdsErrors, SubIndexListedButMissing) {
+TEST(EdsWarnings, SubNumberNotCountingTheSubIndexSections) {
   const std::string text = eds_text(
       "[1018]\nParameterName=Identity object\nObjectType=0x9\nSubNumber=3\nObjFlags=1\n\n"
       "[1018sub0]\nParameterName=n\nDataType=0x0005\nAccessType=ro\nDefaultValue=2\n\n"
       "[1018sub2]\nParameterName=Product code\nDataType=0x0007\nAccessType=ro\n\n",
       {}, {0x1018});
-  EXPECT_EQ(error_text(text), fmt::format("bad.eds:{}: [1018] SubNumber=3 but only 2 sub-index sections ([1018subN], "
-                                          "N = 0, 2): a sub-index is missing",
-                                          line_of(text, "SubNumber=3")));
+  EXPECT_EQ(warning_text(text), fmt::format("bad.eds:{}: [1018] SubNumber=3 but there are 2 sub-index sections "
+                                            "([1018subN], N = 0, 2; those are read)",
+                                            line_of(text, "SubNumber=3")));
+  EXPECT_NE(eds::parse(text, "bad.eds").find(0x1018, 2), nullptr);
   const std::string too_many = eds_text(
       "[2000]\nParameterName=a\nObjectType=0x8\nSubNumber=1\n\n"
       "[2000sub0]\nParameterName=n\nDataType=0x0005\nAccessType=ro\n\n"
       "[2000sub1]\nParameterName=e\nDataType=0x0005\nAccessType=ro\n\n",
       {0x2000});
-  EXPECT_EQ(error_text(too_many), fmt::format("bad.eds:{}: [2000] SubNumber=1 but there are 2 sub-index sections (N = "
-                                              "0, 1)",
-                                              line_of(too_many, "SubNumber=1")));
+  EXPECT_EQ(warning_text(too_many), fmt::format("bad.eds:{}: [2000] SubNumber=1 but there are 2 sub-index sections "
+                                                "([2000subN], N = 0, 1; those are read)",
+                                                line_of(too_many, "SubNumber=1")));
+  EXPECT_NE(eds::parse(too_many, "bad.eds").find(0x2000, 1), nullptr);
 }
 
-TEST(EdsErrors, StructureOfArraysAndRecords) {
+TEST(EdsWarnings, StructureOfArraysAndRecords) {
   const std::string text = eds_text(
       "[2000]\nParameterName=no count\nObjectType=0x9\n\n"                                                  // no SubNumber
       "[2001]\nParameterName=no sub 0\nObjectType=0x8\nSubNumber=1\n\n"
@@ -453,68 +488,83 @@ TEST(EdsErrors, StructureOfArraysAndRecords) {
       "[2002]\nParameterName=var\nDataType=0x0005\nAccessType=ro\n\n"
       "[2002sub1]\nParameterName=e\nDataType=0x0005\nAccessType=ro\n\n"                                  // VAR with a sub
       "[2003sub0]\nParameterName=orphan\nDataType=0x0005\nAccessType=ro\n\n"                             // no [2003]
-      "[2004]\nParameterName=bad code\nObjectType=0x3\n\n"
+      "[2004]\nParameterName=bad code\nObjectType=0x3\nDataType=0x0005\nAccessType=ro\n\n"
       "[2005]\nParameterName=r\nObjectType=0x9\nSubNumber=1\n\n"
       "[2005sub0]\nParameterName=n\nObjectType=0x9\nDataType=0x0005\nAccessType=ro\n\n"                   // sub not a VAR
       "[2006]\nParameterName=c\nObjectType=0x8\nCompactSubObj=2\nDataType=0x0005\nAccessType=ro\n\n"
       "[2006Name]\nNrOfEntries=3\n1=a\n5=b\n\n",                                                            // count, range
       {0x2000, 0x2001, 0x2002, 0x2004, 0x2005, 0x2006});
-  const auto e = errors_of(text);
-  ASSERT_EQ(e.size(), 8u) << error_text(text);
-  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [2000] (RECORD) has neither SubNumber nor CompactSubObj",
-                                          line_of(text, "[2000]")));
-  EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: [2001] has no sub-index 0 ([2001sub0], the highest sub-index "
-                                          "supported)",
-                                          line_of(text, "[2001]")));
-  EXPECT_EQ(e[2].to_string(), fmt::format("bad.eds:{}: [2002sub1]: 0x2002 is a VAR (ObjectType), it has no sub-indices",
-                                          line_of(text, "[2002sub1]")));
-  EXPECT_EQ(e[3].to_string(), fmt::format("bad.eds:{}: [2003sub0]: there is no object section [2003]",
-                                          line_of(text, "[2003sub0]")));
-  EXPECT_EQ(e[4].to_string(), fmt::format("bad.eds:{}: [2004] ObjectType=0x3 is not an object code (0x2 DOMAIN, 0x5 "
-                                          "DEFTYPE, 0x6 DEFSTRUCT, 0x7 VAR, 0x8 ARRAY, 0x9 RECORD)",
-                                          line_of(text, "ObjectType=0x3")));
-  EXPECT_EQ(e[5].to_string(), fmt::format("bad.eds:{}: [2005sub0] ObjectType=0x9: a sub-index is a VAR (0x7)",
-                                          line_of(text, "ObjectType=0x9", 3)));
-  EXPECT_EQ(e[6].to_string(), fmt::format("bad.eds:{}: [2006Name] NrOfEntries=3 but 1 entries are given",
-                                          line_of(text, "NrOfEntries=3")));
-  EXPECT_EQ(e[7].to_string(), fmt::format("bad.eds:{}: [2006Name] 5: expected NrOfEntries or a sub-index 1 .. 2 "
-                                          "(CompactSubObj of [2006])",
-                                          line_of(text, "5=b")));
+  const auto e = warnings_of(text);
+  std::vector<std::string> got;
+  for (const eds::Diagnostic& d : e) got.push_back(d.to_string());
+  const std::vector<std::string> want = {
+      fmt::format("bad.eds:{}: [2000] (RECORD) has neither SubNumber nor CompactSubObj (its 0 sub-index sections are "
+                  "read)",
+                  line_of(text, "[2000]")),
+      fmt::format("bad.eds:{}: [2001] has no sub-index 0 ([2001sub0], the highest sub-index supported)",
+                  line_of(text, "[2001]")),
+      fmt::format("bad.eds:{}: [2002sub1]: 0x2002 is a VAR (ObjectType), it has no sub-indices (ignored)",
+                  line_of(text, "[2002sub1]")),
+      fmt::format("bad.eds:{}: [2003sub0]: there is no object section [2003] (ignored)", line_of(text, "[2003sub0]")),
+      fmt::format("bad.eds:{}: [2004] ObjectType=0x3 is not an object code (0x2 DOMAIN, 0x5 DEFTYPE, 0x6 DEFSTRUCT, "
+                  "0x7 VAR, 0x8 ARRAY, 0x9 RECORD; read as a VAR)",
+                  line_of(text, "ObjectType=0x3")),
+      fmt::format("bad.eds:{}: [2005sub0] ObjectType=0x9: a sub-index is a VAR (0x7; read as one)",
+                  line_of(text, "ObjectType=0x9", 3)),
+      fmt::format("bad.eds:{}: [2006Name] NrOfEntries=3 but 1 entries are given", line_of(text, "NrOfEntries=3")),
+      fmt::format("bad.eds:{}: [2006Name] 5: expected NrOfEntries or a sub-index 1 .. 2 (CompactSubObj of [2006]; "
+                  "ignored)",
+                  line_of(text, "5=b")),
+  };
+  EXPECT_EQ(got, want);
+  const eds::Eds d = eds::parse(text, "bad.eds");
+  ASSERT_NE(d.find(0x2004), nullptr);
+  EXPECT_EQ(d.find(0x2004)->code, eds::ObjectCode::kVar);
+  EXPECT_EQ(d.find(0x2004)->defects.size(), 1u) << "a use of an object of unknown ObjectType is refused";
+  EXPECT_EQ(d.find(0x2002, 1), nullptr);
 }
 
-TEST(EdsErrors, DuplicateSectionsAndKeys) {
+TEST(EdsWarnings, DuplicateSectionsAndKeys) {
   const std::string text = eds_text(
       "[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\nAccessType=rw\n\n"
       "[2000]\nParameterName=again\n\n",
       {0x2000});
-  const auto e = errors_of(text);
-  ASSERT_EQ(e.size(), 2u) << error_text(text);
-  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [2000] AccessType is given again (first at line {})",
+  const auto e = warnings_of(text);
+  ASSERT_EQ(e.size(), 2u) << warning_text(text);
+  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [2000] AccessType is given again (first at line {}, which is "
+                                          "read)",
                                           line_of(text, "AccessType=rw"), line_of(text, "AccessType=ro\nAccessType=rw")));
-  EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: section [2000] appears again (first at line {})",
+  EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: section [2000] appears again (first at line {}; this one is "
+                                          "ignored)",
                                           line_of(text, "[2000]", 2), line_of(text, "[2000]")));
+  const eds::Eds d = eds::parse(text, "bad.eds");
+  EXPECT_EQ(d.find(0x2000, 0)->access, eds::AccessType::kRo);
+  EXPECT_EQ(d.find(0x2000, 0)->name, "x");
   // An empty duplicate section is seen too, and names are case-insensitive.
   const std::string empty_again = eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\n\n[deviceinfo]\n",
                                            {0x2000});
-  EXPECT_EQ(error_text(empty_again), fmt::format("bad.eds:{}: section [deviceinfo] appears again (first at line {})",
-                                                 line_of(empty_again, "[deviceinfo]"), line_of(empty_again, "[DeviceInfo]")));
+  EXPECT_EQ(warning_text(empty_again),
+            fmt::format("bad.eds:{}: section [deviceinfo] appears again (first at line {}; this one is ignored)",
+                        line_of(empty_again, "[deviceinfo]"), line_of(empty_again, "[DeviceInfo]")));
 }
 
-TEST(EdsErrors, ObjectListsMustMatchTheSections) {
+TEST(EdsWarnings, ObjectListsThatDoNotMatchTheSections) {
   const std::string text = eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\n\n", {0x2000, 0x2001},
                                     {0x6041});
-  const auto e = errors_of(text);
-  ASSERT_EQ(e.size(), 2u) << error_text(text);
-  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [OptionalObjects] lists 0x6041 but there is no section [6041]",
+  const auto e = warnings_of(text);
+  ASSERT_EQ(e.size(), 2u) << warning_text(text);
+  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [OptionalObjects] lists 0x6041 but there is no section [6041] "
+                                          "(the object is taken as absent)",
                                           line_of(text, "1=0x6041")));
-  EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: [ManufacturerObjects] lists 0x2001 but there is no section [2001]",
+  EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: [ManufacturerObjects] lists 0x2001 but there is no section "
+                                          "[2001] (the object is taken as absent)",
                                           line_of(text, "2=0x2001")));
 
   std::string counts = eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\n\n", {0x2000});
   const std::string list = "[ManufacturerObjects]\nSupportedObjects=1\n1=0x2000\n";
   counts.replace(counts.find(list), list.size(), "[ManufacturerObjects]\nSupportedObjects=3\n1=0x2000\n2=0x1000\n4=0x2000\n");
-  const auto c = errors_of(counts);
-  ASSERT_EQ(c.size(), 3u) << error_text(counts);
+  const auto c = warnings_of(counts);
+  ASSERT_EQ(c.size(), 4u) << warning_text(counts);
   EXPECT_EQ(c[0].to_string(), fmt::format("bad.eds:{}: [ManufacturerObjects] SupportedObjects=3 but entry 3 is missing",
                                           line_of(counts, "SupportedObjects=3")));
   EXPECT_EQ(c[1].to_string(), fmt::format("bad.eds:{}: [ManufacturerObjects] 0x1000 is listed again (first in "
@@ -522,6 +572,9 @@ TEST(EdsErrors, ObjectListsMustMatchTheSections) {
                                           line_of(counts, "2=0x1000"), line_of(counts, "1=0x1000")));
   EXPECT_EQ(c[2].to_string(), fmt::format("bad.eds:{}: [ManufacturerObjects] entry 4 is beyond SupportedObjects=3",
                                           line_of(counts, "4=0x2000")));
+  EXPECT_EQ(c[3].to_string(), fmt::format("bad.eds:{}: [ManufacturerObjects] 0x2000 is listed again (first in "
+                                          "[ManufacturerObjects] at line {})",
+                                          line_of(counts, "4=0x2000"), line_of(counts, "1=0x2000")));
 }
 
 // Every line inih cannot read is reported, not the first only (in line
@@ -559,44 +612,66 @@ TEST(EdsErrors, IniSyntaxAndFileLevelProblems) {
   const std::string text = "ParameterName=before any section\n" +
                            eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\n  continued\n", {0x2000});
   const auto e = errors_of(text);
-  ASSERT_EQ(e.size(), 2u) << error_text(text);
-  EXPECT_EQ(e[0].to_string(), "bad.eds:1: 'ParameterName' is outside any [section]");
-  EXPECT_EQ(e[1].to_string(),
+  ASSERT_EQ(e.size(), 1u) << error_text(text);
+  EXPECT_EQ(e[0].to_string(),
             fmt::format("bad.eds:{}: not a [section] header or a key=value line", line_of(text, "  continued")));
+  // Without the syntax error: a key before any section is a warning.
+  const std::string stray = "ParameterName=before any section\n" +
+                            eds_text("[2000]\nParameterName=x\nDataType=0x0005\nAccessType=ro\n", {0x2000});
+  EXPECT_EQ(warning_text(stray), "bad.eds:1: 'ParameterName' is outside any [section] (ignored)");
 
-  EXPECT_EQ(error_text("[FileInfo]\nFileName=x\n"),
-            "bad.eds: no [DeviceInfo] section (CiA 306 requires one: vendor, product, PDO counts, baud rates)");
+  EXPECT_EQ(warning_text("[FileInfo]\nFileName=x\n"),
+            "bad.eds: no [DeviceInfo] section (CiA 306 requires one; the PDO counts are taken from the 0x1400.., "
+            "0x1800.. objects)");
   EXPECT_EQ(error_text(eds_text("") + std::string(70000, 'x') + "\n"),
             fmt::format("bad.eds:{}: line is longer than 65536 characters", line_of(eds_text(""), "PDOMapping=0") + 2));
   EXPECT_EQ(error_text(std::string("[DeviceInfo]\nVendorName=a\0b\n", 28)), "bad.eds:2: NUL character (not a text file?)");
   const std::string info = eds_text("");
   std::string bad_info = info;
   bad_info.replace(bad_info.find("NrOfRXPDO=2"), 11, "NrOfRXPDO=600");
-  EXPECT_EQ(error_text(bad_info), fmt::format("bad.eds:{}: [DeviceInfo] NrOfRXPDO=600 is out of range (0 .. 512)",
-                                              line_of(bad_info, "NrOfRXPDO")));
+  EXPECT_EQ(warning_text(bad_info), fmt::format("bad.eds:{}: [DeviceInfo] NrOfRXPDO=600 is out of range (0 .. 512; "
+                                                "ignored)",
+                                                line_of(bad_info, "NrOfRXPDO")));
+  EXPECT_EQ(eds::parse(bad_info, "bad.eds").device_info.nr_of_rxpdo_line, 0) << "taken as absent";
 }
 
-TEST(EdsErrors, DeviceComissioning) {
+// A commissioning tool's values (NodeId=0, Baudrate=0 for "not set"): the
+// master takes node-ID and bit rate from its configuration.
+TEST(EdsWarnings, DeviceComissioning) {
   const std::string text = eds_text("") + "[DeviceComissioning]\nNodeId=0\nBaudrate=300\n";
-  const auto e = errors_of(text);
-  ASSERT_EQ(e.size(), 2u) << error_text(text);
-  EXPECT_EQ(e[0].to_string(),
-            fmt::format("bad.eds:{}: [DeviceComissioning] NodeId=0 is not a node-ID (1 .. 127)", line_of(text, "NodeId=0")));
+  const auto e = warnings_of(text);
+  ASSERT_EQ(e.size(), 2u) << warning_text(text);
+  EXPECT_EQ(e[0].to_string(), fmt::format("bad.eds:{}: [DeviceComissioning] NodeId=0 is not a node-ID (1 .. 127; "
+                                          "ignored: the configuration gives the node-ID)",
+                                          line_of(text, "NodeId=0")));
   EXPECT_EQ(e[1].to_string(), fmt::format("bad.eds:{}: [DeviceComissioning] Baudrate=300 is not a CiA 301 bit rate in "
-                                          "kbit/s (10, 20, 50, 125, 250, 500, 800, 1000)",
+                                          "kbit/s (10, 20, 50, 125, 250, 500, 800, 1000; ignored: the bus's "
+                                          "configuration gives the bit rate)",
                                           line_of(text, "Baudrate=300")));
   const std::string high = eds_text("") + "[DeviceComissioning]\nNodeId=128\n";
-  EXPECT_EQ(error_text(high), fmt::format("bad.eds:{}: [DeviceComissioning] NodeId=128 is out of range (0 .. 127)",
-                                          line_of(high, "NodeId=128")));
+  EXPECT_EQ(warning_text(high), fmt::format("bad.eds:{}: [DeviceComissioning] NodeId=128 is not a node-ID (1 .. 127; "
+                                            "ignored: the configuration gives the node-ID)",
+                                            line_of(high, "NodeId=128")));
+  EXPECT_EQ(eds::parse(high, "bad.eds").comissioning->node_id, 0);
 }
 
 TEST(EdsErrors, AllErrorsOfAFileInLineOrder) {
   const std::string text = eds_text(
-      "[2000]\nParameterName=x\nDataType=0x0040\nAccessType=ro\n\n"
-      "[2001]\nParameterName=y\nDataType=0x0005\nAccessType=bad\n\n",
+      "[2000]\nParameterName=x\nDataType=0x0040\nAccessType=ro\nfirst bad line\n\n"
+      "[2001]\nParameterName=y\nDataType=0x0005\nAccessType=bad\nsecond bad line\n\n",
       {0x2001, 0x2000});
   const auto e = errors_of(text);
   ASSERT_EQ(e.size(), 2u);
   EXPECT_LT(e[0].line, e[1].line);
   EXPECT_EQ(std::string(eds::ParseError(e).what()), e[0].to_string() + "\n" + e[1].to_string());
+}
+
+TEST(EdsWarnings, AllWarningsOfAFileInLineOrderEachOnce) {
+  const std::string text = eds_text(
+      "[2001]\nParameterName=y\nDataType=0x0005\nAccessType=bad\n\n"
+      "[2000]\nParameterName=x\nDataType=0x0040\nAccessType=ro\n\n",
+      {0x2001, 0x2000});
+  const auto e = warnings_of(text);
+  ASSERT_EQ(e.size(), 2u) << warning_text(text);
+  EXPECT_LT(e[0].line, e[1].line);
 }
