@@ -416,7 +416,7 @@ TEST(EdsWarnings, BadAccessTypeAndMissingKeys) {
                                           line_of(text, "[2003]")));
   const eds::Eds d = eds::parse(text, "bad.eds");
   EXPECT_TRUE(d.find(0x2001, 0)->defects.empty()) << "a missing name does not make an object unusable";
-  for (std::uint16_t i : {0x2000, 0x2002, 0x2003}) EXPECT_EQ(d.find(i, 0)->defects.size(), 1u) << i;
+  for (const std::uint16_t i : {std::uint16_t{0x2000}, std::uint16_t{0x2002}, std::uint16_t{0x2003}}) EXPECT_EQ(d.find(i, 0)->defects.size(), 1u) << i;
 }
 
 TEST(EdsWarnings, ValueDoesNotFitItsTypeOrLimits) {
