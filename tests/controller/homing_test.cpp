@@ -17,9 +17,8 @@
 namespace canmotion::rt {
 namespace {
 
-struct HomingRig : test::SimController {
-  using test::SimController::SimController;
-  std::unique_ptr<ControllerHost> host = std::make_unique<ControllerHost>(*ctl);
+struct HomingRig : test::SimHost {
+  using test::SimHost::SimHost;
   bool saw_bit4 = false;
   bool saw_mode6 = false;
   void after_cycle() override {
@@ -27,18 +26,6 @@ struct HomingRig : test::SimController {
     const AxisSnapshot& x = s.axes[1];
     saw_bit4 = saw_bit4 || (x.controlword & 0x10) != 0;
     saw_mode6 = saw_mode6 || x.mode_display == 6;
-  }
-  double read(const std::string& tag) {
-    std::string e;
-    auto v = host->read(tag, &e);
-    EXPECT_TRUE(v) << tag << ": " << e;
-    return v.value_or(-1);
-  }
-  void exec(const std::string& call) {
-    std::string name;
-    const auto err = host->execute(call, &name);
-    ASSERT_FALSE(err) << call << ": " << *err;
-    ASSERT_TRUE(run_until([&](const Status&) { return host->settled(); }, 10)) << call;
   }
   bool done_or_error(const std::string& tag, int max_cycles) {
     return run_until([&](const Status&) { return read(tag + ".PC") != 0.0 || read(tag + ".ER") != 0.0; }, max_cycles);

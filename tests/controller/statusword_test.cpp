@@ -18,9 +18,8 @@ namespace {
 
 constexpr std::uint32_t kTpdo1 = 0x180 + test::SimController::kNode;
 
-struct Rig : test::SimController {
-  using test::SimController::SimController;
-  std::unique_ptr<ControllerHost> host = std::make_unique<ControllerHost>(*ctl);
+struct Rig : test::SimHost {
+  using test::SimHost::SimHost;
   std::vector<Event> events = std::vector<Event>(4096);  ///< every event, in order (room reserved: no allocation in a cycle)
   std::size_t nevents = 0;
   void after_cycle() override {
@@ -28,17 +27,7 @@ struct Rig : test::SimController {
     while (ctl->pop_event(e))
       if (nevents < events.size()) events[nevents++] = e;
   }
-  double read(const std::string& tag) {
-    std::string e;
-    auto v = host->read(tag, &e);
-    EXPECT_TRUE(v) << tag << ": " << e;
-    return v.value_or(-1);
-  }
-  void exec(const std::string& call) {
-    std::string name;
-    const auto err = host->execute(call, &name);
-    ASSERT_FALSE(err) << call << ": " << *err;
-  }
+  void exec(const std::string& call) { SimHost::exec(call, /*settle=*/false); }
   void operational() {
     ASSERT_TRUE(run_until([](const Status& s) { return s.axes[1].phase == cia402::Phase::kOperational; }, 5000));
   }

@@ -9,8 +9,12 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
+
+#include <gtest/gtest.h>
 
 #include "rt/controller/controller.hpp"
+#include "rt/controller/host.hpp"
 #include "rt/controller/sim_world.hpp"
 
 namespace canmotion::test {
@@ -92,6 +96,28 @@ struct SimController {
   }
   void cycles(int n) {
     for (int i = 0; i < n; ++i) step();
+  }
+};
+
+/// SimController with a ControllerHost: tags and ST calls as a user gives them.
+struct SimHost : SimController {
+  using SimController::SimController;
+  std::unique_ptr<rt::ControllerHost> host = std::make_unique<rt::ControllerHost>(*ctl);
+  /// A tag's value (a failed read fails the test and gives -1).
+  double read(const std::string& tag) {
+    std::string e;
+    auto v = host->read(tag, &e);
+    EXPECT_TRUE(v) << tag << ": " << e;
+    return v.value_or(-1);
+  }
+  /// Execute an ST call; `settle`: then run until the planner took it (at most 10 cycles).
+  void exec(const std::string& call, bool settle = true) {
+    std::string name;
+    const auto err = host->execute(call, &name);
+    ASSERT_FALSE(err) << call << ": " << *err;
+    if (settle) {
+      ASSERT_TRUE(run_until([&](const rt::Status&) { return host->settled(); }, 10)) << call;
+    }
   }
 };
 
