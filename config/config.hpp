@@ -184,12 +184,16 @@ struct DriveSettings {
   /// the EDS/DCF (ParameterValue before DefaultValue) and `units:`: counts/s
   /// per unit of the drive's velocity values (0x60FF, 0x60B1, 0x606C, 0x6099,
   /// 0x607F, 0x6080) and counts/s^2 per unit of its acceleration values
-  /// (0x6083..0x6085, 0x609A). 1 without an EDS or for an EDS without the
-  /// object (increments); nothing when the unit cannot be known, with why.
+  /// (0x6083..0x6085, 0x609A). 1 for an EDS without the object
+  /// (increments); nothing when the file cannot tell: then either
+  /// `units_at_boot` (no EDS, or the drive has what the file lacks: read at
+  /// boot) or the unit cannot be known (`*_unknown` says why, and what needs
+  /// it is refused).
   std::optional<double> velocity_counts = 1.0;
   std::string velocity_unknown;
   std::optional<double> acceleration_counts = 1.0;
   std::string acceleration_unknown;
+  bool units_at_boot = false;
 };
 
 /// An axis's `direct_control:` block (MDS, seed 002): the direct command's

@@ -195,7 +195,11 @@ std::optional<std::uint64_t> file_value(const eds::Eds& e, std::uint16_t index, 
 
 /// Drive units (README "Drive units"): the counts per unit of the drive's
 /// velocity (0x60A9) and acceleration (0x60AA) values from its EDS/DCF and
-/// `units.velocity`, and what needs them refused when they cannot be known.
+/// `units.velocity`, and what needs them refused when they cannot be known
+/// (`velocity_unknown`, `acceleration_unknown` say why). A value the file
+/// lacks but the drive has (0x60A9/0x60AA, 0x608F, 0x6091 without a value)
+/// is read at boot (`units_at_boot`), and the boot fails when what it gives
+/// cannot be interpreted and is needed.
 void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::string& who,
                  std::vector<Diagnostic>& diags) {
   namespace u = cia402::units;
@@ -208,8 +212,12 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
   // without a gear between (0x6091 absent or 1:1): else not known, not guessed.
   const auto g1 = file_value(e, u::kGearRatio, 1, a.node);
   const auto g2 = file_value(e, u::kGearRatio, 2, a.node);
-  const bool gear_other = e.find(u::kGearRatio, 1) != nullptr && !(g1 && g2 && *g1 == *g2 && *g1 != 0);
-  if (gear_other) res = {};
+  const bool has_gear = e.find(u::kGearRatio, 1) != nullptr;
+  const bool gear_other = has_gear && g1 && g2 && !(*g1 == *g2 && *g1 != 0);
+  const bool gear_unvalued = has_gear && !(g1 && g2);  // the drive has it: read at boot
+  const bool resolution_unvalued = e.find(u::kPositionEncoderResolution, 1) != nullptr &&
+                                   e.find(u::kPositionEncoderResolution, 2) != nullptr && !res.known();
+  if (gear_other || gear_unvalued) res = {};
   auto one = [&](std::uint16_t index, bool acceleration, std::optional<std::uint32_t> configured,
                  std::optional<double>& counts, std::string& unknown) {
     const eds::SubObject* s = e.find(index, 0);
@@ -218,13 +226,20 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
       counts = 1.0;
       return;
     }
-    if (!si) {
+    if (!si) {  // the drive has the object, the file no value: read at boot
       counts.reset();
-      unknown = fmt::format("{}:{} 0x{:04X} ({}) has no value (nor ParameterValue nor DefaultValue)", ds.eds, s->line,
-                            index, acceleration ? "SI unit acceleration" : "SI unit velocity");
+      ds.units_at_boot = true;
       return;
     }
     counts = u::counts_per_unit(static_cast<std::uint32_t>(*si), res, acceleration);
+    // Revolutions with a 0x608F (and no gear other than 1:1) whose values the
+    // file lacks: the drive has them, read at boot.
+    const bool revolutions = ((*si >> 16) & 0xFFu) == 0xB4u;
+    if (!counts && revolutions && !gear_other && (resolution_unvalued || gear_unvalued) &&
+        u::counts_per_unit(static_cast<std::uint32_t>(*si), u::EncoderResolution{1, 1}, acceleration)) {
+      ds.units_at_boot = true;
+      return;
+    }
     if (!counts)
       unknown = fmt::format("0x{:04X} = 0x{:08X}{}: {}{}", index, *si,
                             configured ? fmt::format(" ({})", ds.units_key) : fmt::format(" ({}:{})", ds.eds, s->line),
@@ -250,8 +265,8 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
   for (const auto& [index, name] : {std::pair<std::uint16_t, const char*>{0x6094, "velocity encoder factor"},
                                     {0x6095, "velocity factor 1"},
                                     {0x6096, "velocity factor 2"}})
-    if (ds.velocity_counts) older(index, name, ds.velocity_counts, ds.velocity_unknown);
-  if (ds.acceleration_counts) older(0x6097, "acceleration factor", ds.acceleration_counts, ds.acceleration_unknown);
+    if (ds.velocity_unknown.empty()) older(index, name, ds.velocity_counts, ds.velocity_unknown);
+  if (ds.acceleration_unknown.empty()) older(0x6097, "acceleration factor", ds.acceleration_counts, ds.acceleration_unknown);
   const std::string axis = fmt::format("axes[{}]", ai);
   auto refuse = [&](Location where, const std::string& key, const std::string& what, bool velocity) {
     const std::string& why = velocity ? ds.velocity_unknown : ds.acceleration_unknown;
@@ -264,15 +279,15 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
   if (a.direct.present) {
     const bool torque = a.axis.direct_mode == motion::AxisConfig::DirectMode::Torque;
     const std::string what = fmt::format("MDS ({}.direct_control, {})", axis, torque ? "CST" : "CSV");
-    if (!ds.velocity_counts) refuse(a.direct.where, axis + ".direct_control", what, true);
-    if (!ds.acceleration_counts && (a.direct.ramp_acceleration || a.direct.ramp_deceleration))
+    if (!ds.velocity_unknown.empty()) refuse(a.direct.where, axis + ".direct_control", what, true);
+    if (!ds.acceleration_unknown.empty() && (a.direct.ramp_acceleration || a.direct.ramp_deceleration))
       refuse(a.direct.where, axis + ".direct_control.ramp", what + " ramps (0x6083/0x6084)", false);
   }
   if (a.axis.homing.mode == motion::HomingConfig::Mode::Active &&
       a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate) {
     const std::string what = fmt::format("homing on the drive ({}.homing: speeds 0x6099, acceleration 0x609A)", axis);
-    if (!ds.velocity_counts) refuse(ds.eds_where, axis + ".homing", what, true);
-    if (!ds.acceleration_counts) refuse(ds.eds_where, axis + ".homing", what, false);
+    if (!ds.velocity_unknown.empty()) refuse(ds.eds_where, axis + ".homing", what, true);
+    if (!ds.acceleration_unknown.empty()) refuse(ds.eds_where, axis + ".homing", what, false);
   }
 }
 
@@ -291,7 +306,13 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
   for (std::size_t ai = 0; ai < cfg.axes.size(); ++ai) {
     AxisSettings& a = cfg.axes[ai];
     DriveSettings& ds = a.drive;
-    if (a.axis.type != motion::AxisType::CipDrive || ds.eds_path.empty()) continue;
+    if (a.axis.type != motion::AxisType::CipDrive) continue;
+    if (ds.eds_path.empty()) {  // no file to tell the units: the drive tells at boot (README "Drive units")
+      ds.units_at_boot = true;
+      ds.velocity_counts.reset();
+      ds.acceleration_counts.reset();
+      continue;
+    }
     const std::string who = fmt::format("axis '{}' (node {})", a.name, a.node);
     auto it = files.find(ds.eds_path);
     if (it == files.end()) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -59,23 +60,40 @@ std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
   using cia402::MdsObject;
   // In the drive's units (README "Drive units"); a unit that cannot be known
   // refuses the configuration (check_drive_descriptions): 0 then.
+  // Units read at boot (`units_at_boot`): the value in counts, which the
+  // drive proxy writes in the unit it read (SdoWrite::per).
   const double conv = a.axis.conversion_constant;
-  const double vel = a.drive.velocity_counts ? conv / *a.drive.velocity_counts : 0.0;
-  const double acc = a.drive.acceleration_counts ? conv / *a.drive.acceleration_counts : 0.0;
-  auto in_units = [](double v, double f) { return static_cast<std::uint32_t>(std::llround(v * f)); };
-  auto velocity = [&](double v) { return in_units(v, vel); };
-  auto acceleration = [&](double v) { return in_units(v, acc); };
-  auto standard = [&](cia402::SdoWrite x, std::uint32_t value, const char* key) {
-    x.value = value;
+  const bool at_boot = a.drive.units_at_boot;
+  const double vel = at_boot ? conv : a.drive.velocity_counts ? conv / *a.drive.velocity_counts : 0.0;
+  const double acc = at_boot ? conv : a.drive.acceleration_counts ? conv / *a.drive.acceleration_counts : 0.0;
+  using Per = cia402::SdoWrite::Per;
+  struct Value {
+    std::uint32_t value;
+    Per per;
+    double counts;
+  };
+  auto in_units = [&](double v, double f, Per per) {
+    return Value{static_cast<std::uint32_t>(std::llround(v * f)), at_boot ? per : Per::kNone, v * conv};
+  };
+  auto velocity = [&](double v) { return in_units(v, vel, Per::kVelocity); };
+  auto acceleration = [&](double v) { return in_units(v, acc, Per::kAcceleration); };
+  auto plain = [](std::uint32_t v) { return Value{v, Per::kNone, 0.0}; };
+  auto standard = [&](cia402::SdoWrite x, Value v, const char* key) {
+    x.value = v.value;
+    x.per = v.per;
+    x.counts = v.counts;
     w.push_back(KeyedWrite{x, std::string(key)});
   };
   // An object CiA 402 lacks, where this drive keeps it (drive.mds_objects).
-  auto mds = [&](MdsObject o, std::uint32_t value, const char* key) {
+  auto mds = [&](MdsObject o, Value v, const char* key) {
     const cia402::ObjectAddress at = a.drive.mds_objects[o];
     const std::string& placed = a.drive.mds_object_keys[static_cast<std::size_t>(o)];
     std::string k = key;
     if (!placed.empty()) k += fmt::format(" (written to 0x{:04X}:{}, placed by {})", at.index, at.sub, placed);
-    w.push_back(KeyedWrite{cia402::SdoWrite{at.index, at.sub, cia402::info(o).size, value}, std::move(k)});
+    cia402::SdoWrite x{at.index, at.sub, cia402::info(o).size, v.value};
+    x.per = v.per;
+    x.counts = v.counts;
+    w.push_back(KeyedWrite{x, std::move(k)});
   };
   if (d.ramp_acceleration)
     standard(od_write(obj::kProfileAcceleration, 0), acceleration(*d.ramp_acceleration), "direct_control.ramp.acceleration");
@@ -85,7 +103,7 @@ std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
     mds(MdsObject::kRampVelocityPositive, velocity(*d.ramp_velocity_positive), "direct_control.ramp.velocity_positive");
   if (d.ramp_velocity_negative)
     mds(MdsObject::kRampVelocityNegative, velocity(*d.ramp_velocity_negative), "direct_control.ramp.velocity_negative");
-  if (d.ramp_jerk_control) mds(MdsObject::kRampJerkControl, *d.ramp_jerk_control, "direct_control.ramp.jerk_control");
+  if (d.ramp_jerk_control) mds(MdsObject::kRampJerkControl, plain(*d.ramp_jerk_control), "direct_control.ramp.jerk_control");
   // The SLAT objects are vendor-area (cia402.hpp): written always, so that a
   // drive keeps no SLAT from an earlier configuration, but without `slat:`
   // in the file (SLAT disabled) a drive that lacks them is fine (it has no
@@ -94,9 +112,9 @@ std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
   // naming the key: MDS is validated only if the drive supports the ramp
   // attributes the configuration asks for [seed 002].
   const std::size_t slat_first = w.size();
-  mds(MdsObject::kSlatConfiguration, d.slat_configuration, "direct_control.slat.configuration");
+  mds(MdsObject::kSlatConfiguration, plain(d.slat_configuration), "direct_control.slat.configuration");
   mds(MdsObject::kSlatSetPoint, velocity(d.slat_set_point), "direct_control.slat.set_point");
-  mds(MdsObject::kSlatTimeDelay, d.slat_time_delay_ms, "direct_control.slat.time_delay_ms");
+  mds(MdsObject::kSlatTimeDelay, plain(d.slat_time_delay_ms), "direct_control.slat.time_delay_ms");
   for (std::size_t i = slat_first; i < w.size(); ++i) w[i].write.optional = !d.slat_set;
   return w;
 }
@@ -176,9 +194,28 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   }
   d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
   d.homing_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.homing_ms) * 1'000'000;
-  if (a.drive.velocity_unit) {  // `units.velocity`: before any value in that unit
-    d.extra_writes.push_back(cia402::SdoWrite{cia402::units::kSiUnitVelocity, 0, 4, *a.drive.velocity_unit});
-    d.hints.extra.push_back(fmt::format("{} (line {}; needs a writable 0x60A9)", a.drive.units_key, a.drive.units_where.line));
+  // Drive units (README "Drive units"): as the file tells them, or read at
+  // boot; `units.velocity` is written before that read and any value in it.
+  d.units.read_at_boot = a.drive.units_at_boot;
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  d.units.velocity_counts = a.drive.units_at_boot ? 1.0 : a.drive.velocity_counts.value_or(unknown);
+  d.units.acceleration_counts = a.drive.units_at_boot ? 1.0 : a.drive.acceleration_counts.value_or(unknown);
+  if (a.drive.velocity_unit) {
+    d.units.has_write_velocity = true;
+    d.units.write_velocity = *a.drive.velocity_unit;
+    d.hints.velocity_unit = fmt::format("{} (line {}; needs a writable 0x60A9)", a.drive.units_key, a.drive.units_where.line);
+  }
+  auto need = [](std::string& to, const std::string& what) { to += (to.empty() ? "" : " and ") + what; };
+  if (a.direct.present) {
+    const bool torque = a.axis.direct_mode == motion::AxisConfig::DirectMode::Torque;
+    need(d.units.velocity_needed_by, fmt::format("{}.direct_control (MDS in {})", axis, torque ? "CST" : "CSV"));
+    if (a.direct.ramp_acceleration || a.direct.ramp_deceleration)
+      need(d.units.acceleration_needed_by, fmt::format("{}.direct_control.ramp (0x6083/0x6084)", axis));
+  }
+  if (a.axis.homing.mode == motion::HomingConfig::Mode::Active &&
+      a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate) {
+    need(d.units.velocity_needed_by, fmt::format("{}.homing (speeds, 0x6099)", axis));
+    need(d.units.acceleration_needed_by, fmt::format("{}.homing (acceleration, 0x609A)", axis));
   }
   for (const KeyedWrite& k : keyed_direct_control_writes(a)) {
     d.extra_writes.push_back(k.write);
@@ -242,9 +279,6 @@ rt::AxisSpec axis_spec(const Config& cfg, const AxisSettings& a, std::size_t ind
   while (bi < cfg.buses.size() && cfg.buses[bi].name != a.bus) ++bi;
   as.bus = static_cast<int>(bi);
   as.drive = drive_config(a, cfg.buses[bi], cfg.controller.period_s, index);
-  const double conv = a.axis.conversion_constant;
-  as.velocity_factor = a.drive.velocity_counts ? conv / *a.drive.velocity_counts : std::nan("");
-  as.acceleration_factor = a.drive.acceleration_counts ? conv / *a.drive.acceleration_counts : std::nan("");
   as.config.drive_wait_limit = drive_wait_limit_s(a.drive.timeouts);
   return as;
 }

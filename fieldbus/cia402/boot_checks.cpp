@@ -4,6 +4,7 @@
 #include <array>
 #include <cinttypes>
 #include <cstdio>
+#include <limits>
 
 #include "fieldbus/canopen/sdo_abort.hpp"
 #include "fieldbus/cia402/boot_plan.hpp"
@@ -199,6 +200,52 @@ int describe_sync_counter(const Failure& f, std::span<char> out, double) noexcep
                        key_or(f, "the master's SYNC counter overflow"), f.read_value, f.expected);
 }
 
+// ---- the factor group, read when the configuration cannot tell the units ----------------
+CheckVerdict verify_unit_factor(const CheckInput& in) noexcept {
+  if (in.units == nullptr) return {};
+  if (in.index == units::kPositionEncoderResolution) (in.sub == 1 ? in.units->res.increments : in.units->res.revolutions) = in.value;
+  if (in.index == units::kGearRatio) (in.sub == 1 ? in.units->gear_motor : in.units->gear_shaft) = in.value;
+  return {};
+}
+
+/// 0x60A9 / 0x60AA as read: the counts per unit, or (not interpretable) a
+/// failure when the configuration needs the unit, else NaN and said once.
+CheckVerdict unit(const CheckInput& in, bool acceleration) noexcept {
+  CheckVerdict c;
+  if (in.units == nullptr) return c;
+  const auto counts = units::counts_per_unit(in.value, in.units->motor_resolution(), acceleration);
+  double& kept = acceleration ? in.units->acceleration_counts : in.units->velocity_counts;
+  if (counts) {
+    kept = *counts;
+    return c;
+  }
+  kept = std::numeric_limits<double>::quiet_NaN();
+  const std::string& needed = acceleration ? in.drive.units.acceleration_needed_by : in.drive.units.velocity_needed_by;
+  if (!needed.empty()) {
+    c.is = Is::kFail;
+    c.key = &needed;
+    return c;
+  }
+  c.held = true;  // nothing needs it: said once (BootNotes::held)
+  c.detail = static_cast<std::int32_t>(in.value);
+  return c;
+}
+CheckVerdict verify_velocity_unit(const CheckInput& in) noexcept { return unit(in, false); }
+CheckVerdict verify_acceleration_unit(const CheckInput& in) noexcept { return unit(in, true); }
+
+int describe_unit(const Failure& f, std::span<char> out, double) noexcept {
+  const bool acc = f.check == BootCheck::kAccelerationUnit;
+  const auto why = units::unknown_reason(f.read_value, f.unit_res, acc);
+  return std::snprintf(out.data(), out.size(),
+                       "node %u: 0x%04X (%s) is 0x%08" PRIX32 ": %.*s; %s needs the drive's %s unit, and nothing is "
+                       "guessed: give the drive a unit canmotiond interprets (README \"Drive units\")%s",
+                       f.node, acc ? units::kSiUnitAcceleration : units::kSiUnitVelocity,
+                       eds_name_or(f.dictionary, acc ? units::kSiUnitAcceleration : units::kSiUnitVelocity, 0,
+                                   acc ? "SI unit acceleration" : "SI unit velocity"),
+                       f.read_value, static_cast<int>(why.size()), why.data(), key_or(f, "the configuration"),
+                       acc ? "acceleration" : "velocity", acc ? "" : ", or set drive.units.velocity (a writable 0x60A9)");
+}
+
 // ---- no check ------------------------------------------------------------------------
 CheckVerdict verify_nothing(const CheckInput&) noexcept { return {}; }
 int describe_nothing(const Failure& f, std::span<char> out, double) noexcept {
@@ -206,7 +253,7 @@ int describe_nothing(const Failure& f, std::span<char> out, double) noexcept {
 }
 
 /// Indexed by BootCheck.
-constexpr std::array<BootCheckRule, 9> kRules{{
+constexpr std::array<BootCheckRule, 12> kRules{{
     {verify_nothing, describe_nothing},                               // kNone
     {verify_device_type, describe_device_type},                       // kDeviceType
     {verify_vendor_id, describe_identity},                            // kVendorId
@@ -216,8 +263,11 @@ constexpr std::array<BootCheckRule, 9> kRules{{
     {verify_mode_display, describe_mode_display},                     // kModeDisplay
     {verify_interpolation_index, describe_interpolation_index},       // kInterpolationIndex
     {verify_sync_counter, describe_sync_counter},                     // kSyncCounter
+    {verify_unit_factor, describe_nothing},                           // kUnitFactor (always passes)
+    {verify_velocity_unit, describe_unit},                            // kVelocityUnit
+    {verify_acceleration_unit, describe_unit},                        // kAccelerationUnit
 }};
-static_assert(kRules.size() == static_cast<std::size_t>(BootCheck::kSyncCounter) + 1, "one rule per BootCheck");
+static_assert(kRules.size() == static_cast<std::size_t>(BootCheck::kAccelerationUnit) + 1, "one rule per BootCheck");
 
 }  // namespace
 

@@ -59,6 +59,7 @@ constexpr OnAbort kAbsentSaid{.absent = Then::kNotice};
 constexpr OnAbort kAbsentQuiet{.absent = Then::kQuiet};
 
 // ---- values -------------------------------------------------------------------------
+bool read_units(const BootInputs& b) { return b.drive.units.read_at_boot; }
 InterpolationPeriod period(const BootInputs& b) { return *encode_interpolation_period(b.drive.cycle_ns); }
 std::uint8_t mode_byte(Mode m) { return static_cast<std::uint8_t>(static_cast<std::int8_t>(m)); }
 
@@ -186,6 +187,30 @@ constexpr BootRow kBootPlan[] = {
      },
      .key = &WriteHints::consumer_heartbeat, .hint = kConsumerHeartbeatHint,
      .notes = {.absent = "the drive does not watch the master's heartbeat (a lost master is not detected by the drive)"}},
+    // Drive units (README "Drive units"): `units.velocity` first, then, when
+    // the configuration cannot tell them, the factor group is read (every
+    // object optional) before the writes whose values are in those units.
+    {.origin = WriteOrigin::kExtra, .index = units::kSiUnitVelocity, .size = 4,
+     .applies = [](const BootInputs& b) { return b.drive.units.has_write_velocity; },
+     .value = [](const BootInputs& b) { return b.drive.units.write_velocity; },
+     .key = &WriteHints::velocity_unit, .hint = kExtraHint},
+    {.origin = WriteOrigin::kCheck, .index = units::kPositionEncoderResolution, .sub = 1, .check = BootCheck::kUnitFactor,
+     .need = Need::kOptional, .on_abort = kAbsentQuiet, .applies = read_units, .hint = kCheckHint},
+    {.origin = WriteOrigin::kCheck, .index = units::kPositionEncoderResolution, .sub = 2, .check = BootCheck::kUnitFactor,
+     .need = Need::kOptional, .on_abort = kAbsentQuiet, .applies = read_units, .hint = kCheckHint},
+    {.origin = WriteOrigin::kCheck, .index = units::kGearRatio, .sub = 1, .check = BootCheck::kUnitFactor,
+     .need = Need::kOptional, .on_abort = kAbsentQuiet, .applies = read_units, .hint = kCheckHint},
+    {.origin = WriteOrigin::kCheck, .index = units::kGearRatio, .sub = 2, .check = BootCheck::kUnitFactor,
+     .need = Need::kOptional, .on_abort = kAbsentQuiet, .applies = read_units, .hint = kCheckHint},
+    {.origin = WriteOrigin::kCheck, .index = units::kSiUnitVelocity, .check = BootCheck::kVelocityUnit,
+     .need = Need::kOptional, .on_abort = kAbsentSaid, .applies = read_units, .hint = kCheckHint,
+     .notes = {.absent = "its velocity values are taken in increments/s (CiA 402 without the factor group)",
+               .held = "its velocity unit 0x%08X is not one canmotiond interprets; nothing configured needs it, "
+                       "so velocities of this axis are not shown"}},
+    {.origin = WriteOrigin::kCheck, .index = units::kSiUnitAcceleration, .check = BootCheck::kAccelerationUnit,
+     .need = Need::kOptional, .on_abort = kAbsentSaid, .applies = read_units, .hint = kCheckHint,
+     .notes = {.absent = "its acceleration values are taken in increments/s^2 (CiA 402 without the factor group)",
+               .held = "its acceleration unit 0x%08X is not one canmotiond interprets; nothing configured needs it"}},
     {.origin = WriteOrigin::kExtra, .need = Need::kConfigured, .on_abort = kAbsentSaid,
      .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) {
        out.insert(out.end(), b.drive.extra_writes.begin(), b.drive.extra_writes.end());
@@ -348,6 +373,13 @@ const char* boot_note_text(std::uint8_t id, std::uint16_t index) noexcept {
     case Fallback::kHeld: return row.notes.held;
   }
   return nullptr;
+}
+
+bool boot_note_of_read(std::uint8_t id) noexcept {
+  if (id == 0 || id > std::size(kBootPlan) * kFallbacks) return false;
+  const BootRow& row = kBootPlan[(id - 1u) / kFallbacks];
+  return static_cast<Fallback>((id - 1u) % kFallbacks) == Fallback::kHeld && row.check != BootCheck::kNone &&
+         row.falls_back_from == 0;
 }
 
 const char* boot_note(const BootWrite& w, Fallback f) noexcept { return boot_note_text(boot_note_id(w, f), w.w.index); }

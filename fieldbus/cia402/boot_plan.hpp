@@ -27,6 +27,7 @@
 #include "fieldbus/canopen/master.hpp"  // MasterConfig
 #include "fieldbus/canopen/sdo_abort.hpp"
 #include "fieldbus/cia402/drive_pdos.hpp"
+#include "fieldbus/cia402/units.hpp"
 
 namespace canmotion::cia402 {
 
@@ -43,6 +44,15 @@ struct SdoWrite {
   /// 0x06020000 / 0x06090011 accepted and said once: DriveProxy::poll_notice), e.g. a
   /// default the configuration did not ask for.
   bool optional = false;
+  /// A value in the drive's velocity or acceleration unit that the
+  /// configuration could not give in it (the unit is read at boot:
+  /// DriveUnits::read_at_boot): `counts` holds it in counts/s (counts/s^2),
+  /// and the proxy writes counts / DriveProxy::velocity_counts() (or
+  /// acceleration_counts()), rounded, as UNSIGNED. `value` holds `counts`
+  /// rounded (what an inc/s drive gets). kNone: `value` is written as it is.
+  enum class Per : std::uint8_t { kNone, kVelocity, kAcceleration };
+  Per per = Per::kNone;
+  double counts = 0.0;
 };
 
 /// Configuration keys to name when the drive refuses a boot configuration
@@ -58,6 +68,7 @@ struct WriteHints {
   std::string mode_switch_timeout;   ///< e.g. "axes[0].drive.timeouts.mode_switch_ms"
   std::string sync_counter;          ///< 0x1019, e.g. "buses[0].sync_counter_overflow"
   std::string sync_watch;            ///< 0x1006, e.g. "axes[0].drive.sync_watch"
+  std::string velocity_unit;         ///< 0x60A9 written (DriveUnits::write_velocity), e.g. "axes[0].drive.units.velocity"
 };
 
 /// What a boot transfer is for (a label of its BootRow: Failure::sdo_origin).
@@ -93,6 +104,16 @@ enum class BootCheck : std::uint8_t {
   /// overflow value (`read_value` the drive's, `expected` the master's,
   /// `sdo_abort` the write's abort).
   kSyncCounter,
+  /// 0x608F:1/2 position encoder resolution, 0x6091:1/2 gear ratio, read when
+  /// the units are read at boot (DriveUnits::read_at_boot): kept for the
+  /// unit checks below (absent: not known / no gear). Always passes.
+  kUnitFactor,
+  /// 0x60A9 SI unit velocity read at boot: the counts per unit (units.hpp)
+  /// with the 0x608F/0x6091 read before; a unit that cannot be interpreted
+  /// fails the boot when the configuration needs it
+  /// (DriveUnits::velocity_needed_by), else the velocity is not known (NaN).
+  kVelocityUnit,
+  kAccelerationUnit,  ///< 0x60AA SI unit acceleration, as kVelocityUnit
 };
 
 /// What the boot does with one outcome of a transfer.
@@ -244,6 +265,10 @@ enum class Fallback : std::uint8_t { kAbsent, kReadOnly, kHeld };
 /// nullptr (none: "not written; the drive keeps its own setting").
 /// Realtime-safe.
 [[nodiscard]] const char* boot_note_text(std::uint8_t id, std::uint16_t index) noexcept;
+/// True when note `id` is the kHeld note of a read that falls back from
+/// nothing (e.g. a unit read at boot that nothing needs): no write was left
+/// out. Realtime-safe.
+[[nodiscard]] bool boot_note_of_read(std::uint8_t id) noexcept;
 /// boot_note_text(boot_note_id(w, f), w.w.index). Realtime-safe.
 [[nodiscard]] const char* boot_note(const BootWrite& w, Fallback f) noexcept;
 /// The sentence after a refused transfer of `origin` (the rows of one origin
@@ -251,12 +276,34 @@ enum class Fallback : std::uint8_t { kAbsent, kReadOnly, kHeld };
 [[nodiscard]] const BootHint& boot_hint(WriteOrigin origin) noexcept;
 
 // ---- checks ------------------------------------------------------------------
+/// The drive's factor group as read at boot (BootCheck::kUnitFactor ..
+/// kAccelerationUnit) and the counts per unit it gives (DriveProxy).
+struct UnitReadings {
+  units::EncoderResolution res;  ///< 0x608F:1/2 (0: not read, or absent)
+  std::uint32_t gear_motor = 0;  ///< 0x6091:1 (0: absent)
+  std::uint32_t gear_shaft = 0;  ///< 0x6091:2
+  /// counts/s per unit of the velocity values, counts/s^2 per unit of the
+  /// acceleration values; NaN: not known.
+  double velocity_counts = 1.0;
+  double acceleration_counts = 1.0;
+  /// The resolution that holds for the velocity unit: 0x608F, unless a gear
+  /// other than 1:1 (0x6091) stands between motor and shaft (then unknown).
+  [[nodiscard]] constexpr units::EncoderResolution motor_resolution() const noexcept {
+    if (gear_motor != 0 || gear_shaft != 0)
+      if (gear_motor != gear_shaft) return {};
+    return res;
+  }
+};
+
 /// What a check sees of a value read at boot.
 struct CheckInput {
   const DriveConfig& drive;
   std::uint32_t value = 0;    ///< what the drive has
   std::uint32_t written = 0;  ///< the value of the write the row falls back from (0: none)
   std::int8_t* mode_display = nullptr;  ///< Feedback::mode_display: a check of the running mode confirms it
+  std::uint16_t index = 0;    ///< the object read
+  std::uint8_t sub = 0;
+  UnitReadings* units = nullptr;  ///< the unit checks keep what they read here
 };
 
 /// A check's verdict.

@@ -5,6 +5,7 @@
 // it, the reads checked by their BootCheck rule), NMT start and the first
 // TPDO; a reboot or restart from the beginning. Sans-IO and, apart from
 // build_configuration(), realtime-safe.
+#include <cmath>
 #include <string>
 
 #include "fieldbus/canopen/sdo_abort.hpp"
@@ -49,7 +50,8 @@ DriveProxy::Taken DriveProxy::check_read(std::size_t i, std::uint32_t v, std::in
   const BootWrite& bw = writes_[i];
   const bool fallback = bw.after >= 0;
   const std::uint32_t trigger_abort = fallback ? transfer_[static_cast<std::size_t>(bw.after)].abort : 0;
-  const CheckInput in{cfg_, v, fallback ? writes_[static_cast<std::size_t>(bw.after)].w.value : 0u, &fb_.mode_display};
+  const CheckInput in{cfg_,         v,           fallback ? writes_[static_cast<std::size_t>(bw.after)].w.value : 0u,
+                      &fb_.mode_display, bw.w.index, bw.w.sub, &units_};
   const CheckVerdict c = boot_check_rule(bw.check).verify(in);
   std::int64_t waited = 0, timeout = 0;
   switch (c.is) {
@@ -70,6 +72,7 @@ DriveProxy::Taken DriveProxy::check_read(std::size_t i, std::uint32_t v, std::in
   failure_.check = bw.check;
   failure_.read_value = v;
   failure_.expected = c.expected;
+  failure_.unit_res = units_.motor_resolution();
   failure_.sdo_index = bw.w.index;
   failure_.sdo_sub = bw.w.sub;
   failure_.sdo_origin = WriteOrigin::kCheck;
@@ -94,6 +97,9 @@ void DriveProxy::forget_drive(std::int64_t now_ns) noexcept {
   for (TransferState& t : transfer_) t.fell_back = false;  // (a notice stays said)
   in_fault_ = emcy_in_fault_ = error_code_asked_ = false;
   again_since_ns_ = -1;
+  if (cfg_.units.read_at_boot) {  // read again by this boot (1: a drive without 0x60A9 / 0x60AA)
+    units_ = UnitReadings{};
+  }
   master_.sdo(cfg_.node).cancel_all();
   // A rebooted drive sends no heartbeat until 0x1017 is written again: the
   // consumer is armed again when the configuration is done.
@@ -163,6 +169,16 @@ DriveProxy::Taken DriveProxy::take_result(const canopen::SdoResult& r, std::int6
   return Taken::kDone;
 }
 
+std::uint32_t DriveProxy::in_drive_unit(const SdoWrite& w) const noexcept {
+  if (w.per == SdoWrite::Per::kNone) return w.value;
+  const double per = w.per == SdoWrite::Per::kVelocity ? units_.velocity_counts : units_.acceleration_counts;
+  // counts / (counts per unit), rounded half away from 0 (the values are
+  // magnitudes); an unknown unit (NaN: the boot failed before, when needed) 0.
+  const double u = std::floor(std::fabs(w.counts) / per + 0.5);
+  const double top = w.size >= 4 ? 4294967295.0 : static_cast<double>((1ull << (8u * w.size)) - 1u);
+  return !(u == u) ? 0u : static_cast<std::uint32_t>(u > top ? top : u);
+}
+
 void DriveProxy::queue_transfers(canopen::SdoClient& sdo) noexcept {
   if (reread_ >= 0) {
     if (!sdo.upload(writes_[static_cast<std::size_t>(reread_)].w.index, writes_[static_cast<std::size_t>(reread_)].w.sub,
@@ -183,12 +199,15 @@ void DriveProxy::queue_transfers(canopen::SdoClient& sdo) noexcept {
       }
     }
     const SdoWrite& w = bw.w;
+    // A value in the drive's unit waits for the answers before it (the unit reads).
+    if (w.per != SdoWrite::Per::kNone && done_writes_ < next_write_) break;
     const auto tag = static_cast<std::uint32_t>(next_write_);
     if (bw.is_read()) {
       if (!sdo.upload(w.index, w.sub, tag)) break;
     } else {
+      const std::uint32_t value = in_drive_unit(w);
       std::uint8_t b[4];
-      for (int i = 0; i < 4; ++i) b[i] = static_cast<std::uint8_t>(w.value >> (8 * i));
+      for (int i = 0; i < 4; ++i) b[i] = static_cast<std::uint8_t>(value >> (8 * i));
       if (!sdo.download(w.index, w.sub, std::span<const std::uint8_t>(b, w.size), tag)) break;
     }
     ++next_write_;

@@ -23,6 +23,11 @@ std::string describe_notice(const canopen::NodeEvent& e, const canopen::DeviceDi
   if (const char* note = boot_note_text(e.note, e.index); note != nullptr)
     std::snprintf(fallback, sizeof fallback, note, static_cast<int>(e.detail));
   char out[512];
+  if (e.abort == 0 && boot_note_of_read(e.note)) {  // a read at boot that passed, with something to say
+    std::snprintf(out, sizeof out, "node %u: 0x%04X:%u (%.*s) read at boot: %s", e.node, e.index, e.sub,
+                  static_cast<int>(name.size()), name.data(), fallback);
+    return out;
+  }
   if (e.abort == 0) {  // no transfer: the drive's EDS has it read-only (DriveProxy leaves the write out)
     std::snprintf(out, sizeof out, "node %u: optional object 0x%04X:%u (%.*s) read-only in the drive's EDS (not written): %s",
                   e.node, e.index, e.sub, static_cast<int>(name.size()), name.data(), fallback);

@@ -28,6 +28,8 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
                                 " ns cannot be written to 0x60C2");
   }
   mode_ = cfg_.mode;
+  units_.velocity_counts = cfg_.units.velocity_counts;
+  units_.acceleration_counts = cfg_.units.acceleration_counts;
   pdos_ = default_drive_pdos(cfg_.pdo_profile, cfg_.node);
   auto find = [this](bool rx, std::uint16_t index) {
     Slot s;

@@ -92,6 +92,30 @@ enum class HomingResult : std::uint8_t {
   kRefused,    ///< the drive refused a homing parameter write (homing_abort())
 };
 
+/// Drive units (units.hpp, README "Drive units"): what one unit of the
+/// drive's velocity and acceleration values is, as the configuration knows
+/// it (from the EDS/DCF or `units.velocity`), or to be read at boot.
+struct DriveUnits {
+  /// counts/s per unit of the drive's velocity values (0x60FF, 0x606C,
+  /// 0x6099, 0x60B1, ...) and counts/s^2 per unit of its acceleration values
+  /// (0x6083, 0x6084, 0x609A, ...); NaN: not known.
+  double velocity_counts = 1.0;
+  double acceleration_counts = 1.0;
+  /// The configuration cannot tell (no EDS, or one without the values):
+  /// 0x608F:1/2, 0x6091:1/2, 0x60A9 and 0x60AA are read at boot (each
+  /// optional; a drive without 0x60A9 / 0x60AA works in increments, CiA 402
+  /// without the factor group), and what they give replaces the two above.
+  bool read_at_boot = false;
+  /// 0x60A9 written at boot before those reads (`units.velocity`): set.
+  bool has_write_velocity = false;
+  std::uint32_t write_velocity = 0;
+  /// What needs each unit (e.g. "axes[0].direct_control (MDS in CSV)"); a
+  /// unit read at boot that cannot be interpreted then fails the boot naming
+  /// it (nothing is guessed). Empty: nothing needs it (the value is NaN).
+  std::string velocity_needed_by;
+  std::string acceleration_needed_by;
+};
+
 struct DriveConfig {
   std::uint8_t node = 1;
   Mode mode = Mode::kCsp;                  ///< written to 0x6060 at boot
@@ -101,6 +125,7 @@ struct DriveConfig {
   std::uint16_t consumer_heartbeat_ms = 300;  ///< drive's 0x1016:1, watching the master (0 = not written: 0x1016 is optional)
   std::int64_t heartbeat_timeout_ns = 0;      ///< master-side consumer; 0 = 3 x producer period
   std::vector<SdoWrite> extra_writes;         ///< written after the standard configuration
+  DriveUnits units;                           ///< the velocity and acceleration units (read at boot if unknown)
   std::int64_t boot_timeout_ns = 2'000'000'000;     ///< wait for boot-up/heartbeat before resetting the node
   std::int64_t sdo_timeout_ns = 200'000'000;        ///< per SDO response
   std::int64_t start_timeout_ns = 1'000'000'000;    ///< NMT start -> first TPDO
@@ -211,6 +236,9 @@ struct Failure {
   BootCheck check = BootCheck::kNone;  ///< kBootCheck: what did not match
   std::uint32_t read_value = 0;        ///< kBootCheck: what the drive has
   std::uint32_t expected = 0;          ///< kBootCheck: what the configuration expects (kSupportedModes: the missing mode)
+  /// kBootCheck kVelocityUnit / kAccelerationUnit: the position encoder
+  /// resolution that held (0x608F with a 1:1 gear; unknown otherwise).
+  units::EncoderResolution unit_res{};
   /// The drive's EDS (DriveConfig::dictionary), or nullptr: describe() names
   /// objects by it where it has a name. Like `hint`, valid while the
   /// DriveProxy lives.
@@ -384,6 +412,13 @@ class DriveProxy {
   /// Realtime-safe.
   [[nodiscard]] bool leaving_enabled() const noexcept { return leaving_enabled_ && state_ == State::kOperationEnabled; }
   [[nodiscard]] const Feedback& feedback() const noexcept { return fb_; }
+  /// counts/s per unit of the drive's velocity values (targets, 0x606C,
+  /// homing speeds) and counts/s^2 per unit of its acceleration values:
+  /// DriveUnits's, or with DriveUnits::read_at_boot what this boot read
+  /// (1 until then, and for a drive without 0x60A9 / 0x60AA). NaN: not known.
+  [[nodiscard]] double velocity_counts() const noexcept { return units_.velocity_counts; }
+  [[nodiscard]] double acceleration_counts() const noexcept { return units_.acceleration_counts; }
+  [[nodiscard]] const UnitReadings& unit_readings() const noexcept { return units_; }
   [[nodiscard]] Mode mode() const noexcept { return mode_; }
   [[nodiscard]] std::int64_t target_position() const noexcept { return target_position_; }
   [[nodiscard]] std::int32_t target_velocity() const noexcept { return target_velocity_; }
@@ -440,6 +475,8 @@ class DriveProxy {
   Taken take_result(const canopen::SdoResult& r, std::int64_t now_ns) noexcept;
   Taken check_read(std::size_t i, std::uint32_t v, std::int64_t now_ns) noexcept;
   void fail_transfer(std::size_t i, const canopen::SdoResult& r, bool as_trigger, std::int64_t now_ns) noexcept;
+  // A boot write's value as written: SdoWrite::per in the drive's unit.
+  [[nodiscard]] std::uint32_t in_drive_unit(const SdoWrite& w) const noexcept;
   void queue_transfers(canopen::SdoClient& sdo) noexcept;
   void step_state_machine(std::int64_t now_ns) noexcept;
   void hold_state(State target) noexcept;            // step_state_machine(): the controlword in the wanted state
@@ -531,6 +568,7 @@ class DriveProxy {
   std::int32_t target_velocity_ = 0;
   std::int16_t target_torque_ = 0;
   Feedback fb_{};
+  UnitReadings units_{};  // velocity_counts(), acceleration_counts(); read at boot with DriveUnits::read_at_boot
   bool pos_base_ = false;  // fb_.position has a base (false: the next 0x6064 sets it)
   bool got_tpdo_ = false;
   bool expect_tpdo_ = false;

@@ -45,7 +45,8 @@ std::string_view unknown_reason(std::uint32_t si, const EncoderResolution& res, 
   if (p.reserved != 0 || p.prefix < -9 || p.prefix > 9) return "not a unit code (byte 0 must be 0, the prefix -9 .. 9)";
   if (p.num != 0xB5 && p.num != 0xB4) return "its numerator is neither increments (0xB5) nor revolutions (0xB4)";
   if (p.num == 0xB4 && !res.known())
-    return "revolutions need the counts per motor revolution, and 0x608F (position encoder resolution) has no value";
+    return "revolutions need the counts per motor revolution, and 0x608F (position encoder resolution) gives none "
+           "(no value, absent, or behind a 0x6091 gear ratio other than 1:1)";
   if (acceleration) return "its denominator is not s^2 (0x57)";
   return "its denominator is neither s (0x03) nor min (0x47)";
 }

@@ -95,8 +95,8 @@ Controller::Controller(ControllerSpec spec)
     if (!planner_.configure_axis(static_cast<motion::AxisId>(a), s.config))
       throw std::invalid_argument("axis '" + s.name + "': the planner rejected its configuration");
     axes_[a].conv = s.config.conversion_constant;
-    axes_[a].vel = s.velocity_factor == 0.0 ? s.config.conversion_constant : s.velocity_factor;
-    axes_[a].acc = s.acceleration_factor == 0.0 ? s.config.conversion_constant : s.acceleration_factor;
+    axes_[a].vel = s.config.conversion_constant / s.drive.units.velocity_counts;
+    axes_[a].acc = s.config.conversion_constant / s.drive.units.acceleration_counts;
     if (s.config.type == motion::AxisType::CipDrive) {
       if (s.bus < 0 || static_cast<std::size_t>(s.bus) >= buses_.size())
         throw std::invalid_argument("axis '" + s.name + "' (AXIS_CIP_DRIVE) has no valid bus");
@@ -256,6 +256,8 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   const cia402::DriveProxy& p = *ax.proxy;
   const cia402::Feedback& d = p.feedback();
   const bool operational = p.phase() == cia402::Phase::kOperational;
+  ax.vel = ax.conv / p.velocity_counts();  // as known now (read at boot when the configuration could not tell)
+  ax.acc = ax.conv / p.acceleration_counts();
   f.position = static_cast<double>(d.position) / ax.conv;  // 64-bit counts (DriveProxy unwraps 0x6064)
   // 0x606C in the drive's velocity unit; a unit that cannot be known is not read.
   const bool vel_mapped = p.pdos().tpdo_count > 1 && ax.vel == ax.vel;

@@ -74,14 +74,10 @@ struct AxisSpec {
   motion::AxisConfig config{};
   int bus = -1;
   cia402::DriveConfig drive{};
-  /// Drive units (README "Drive units"): the drive's velocity units per user
-  /// unit/s (0x60FF, 0x60B1, 0x606C, 0x6099) and acceleration units per user
-  /// unit/s^2 (0x609A). NaN when the unit cannot be known: velocities are then
-  /// sent as 0 and 0x606C is not read (the velocity is differentiated from
-  /// the position); the configuration refuses what needs them. Torque needs
-  /// no factor: 0x6071/0x60B2/0x6077 are per mille of 0x6076 rated torque.
-  double velocity_factor = 0.0;      ///< 0: conversion_constant (inc/s)
-  double acceleration_factor = 0.0;  ///< 0: conversion_constant (inc/s^2)
+  // Drive units (README "Drive units"): drive.units, as the proxy knows them
+  // (DriveProxy::velocity_counts(), read at boot when the configuration
+  // cannot tell). Torque needs no factor: 0x6071/0x60B2/0x6077 are per mille
+  // of 0x6076 rated torque.
 };
 
 /// A cam profile declared in the configuration: computed (MCCP) when the
@@ -410,8 +406,14 @@ class Controller {
     int bus = -1;
     cia402::DriveProxy* proxy = nullptr;
     double conv = 1.0;
-    double vel = 1.0;  ///< AxisSpec::velocity_factor (NaN: unknown)
-    double acc = 1.0;  ///< AxisSpec::acceleration_factor (NaN: unknown)
+    /// The drive's velocity units per user unit/s (0x60FF, 0x60B1, 0x606C,
+    /// 0x6099) and acceleration units per user unit/s^2 (0x609A): conv /
+    /// DriveProxy::velocity_counts(), each cycle. NaN when the unit is not
+    /// known: velocities are then sent as 0 and 0x606C is not read (the
+    /// velocity is differentiated from the position); what needs them is
+    /// refused by the configuration or fails the drive's boot.
+    double vel = 1.0;
+    double acc = 1.0;
     bool have_prev = false;
     std::int64_t prev_counts = 0;
     std::uint8_t status_bits = 0;  ///< statusword bits 7, 11, 13 last cycle (1, 2, 4): kDriveStatusBit on rising edges

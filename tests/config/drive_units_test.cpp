@@ -8,6 +8,11 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
+#include <unistd.h>
+#include <sstream>
+#include <fstream>
+#include <filesystem>
 
 #include "config/runtime.hpp"
 #include "fieldbus/cia402/units.hpp"
@@ -20,12 +25,14 @@ const std::string kFile = std::string(CANMOTION_UNITS_DIR) + "/units.yaml";
 
 // 4096 counts per user unit (one motor revolution): 15 units/s = 61440 counts/s
 // = 900 rpm exactly, 5 units/s = 300 rpm.
-std::string yaml(const std::string& eds_a, const std::string& eds_b) {
-  auto axis = [](const char* name, const char* bus, const std::string& eds) {
+// An empty `eds` leaves `drive:` out (the units are then read at boot).
+std::string yaml(const std::string& eds_a, const std::string& eds_b,
+                 const std::string& direct = "{mode: velocity}") {
+  auto axis = [&](const char* name, const char* bus, const std::string& eds) {
     return std::string("  - name: ") + name + "\n    type: AXIS_CIP_DRIVE\n    bus: " + bus +
            "\n    node: 2\n    conversion_constant: 4096\n    max_speed: 100\n    max_accel: 1000\n    max_decel: 1000\n"
            "    homing: {mode: Active, sequence: Switch, method: 19, speed_search: 5, speed_zero: 1, accel: 200}\n"
-           "    direct_control: {mode: velocity}\n    drive: {eds: " + eds + "}\n";
+           "    direct_control: " + direct + "\n" + (eds.empty() ? std::string() : "    drive: {eds: " + eds + "}\n");
   };
   return "controller: {period_ms: 1}\nbuses:\n  - {name: can0, interface: sim}\n  - {name: can1, interface: sim}\n"
          "drives:\n  pdo: csp_csv_cst\naxes:\n" +
@@ -56,6 +63,155 @@ struct Rig : test::RuntimeRig {
     cycle();
   }
 };
+
+/// The master runs `master` (no EDS: it knows nothing of the drives' units)
+/// while the emulated drives are those of `drives` (each from its EDS): the
+/// default drives are detached and the described ones put in their place.
+struct ReadAtBootRig : test::RuntimeRig {
+  ReadAtBootRig(const Config& master, const Config& drives) : RuntimeRig(master) {
+    const std::size_t n = rt.sim->drive_count();
+    for (std::size_t i = 0; i < n; ++i) rt.sim->disconnect(i);
+    for (std::size_t i = 0; i < drives.axes.size(); ++i) rt.sim->add_drive(i, emulator_config(drives.axes[i]));
+    first = n;
+    rt.sim->power_on(0);
+  }
+  emulator::Emulator& emu(std::size_t bus) { return rt.sim->drive(first + bus); }
+  const cia402::DriveProxy& proxy(std::size_t bus) { return *ctl().network(bus).drive(2); }
+  void exec(const std::string& call) {
+    ASSERT_TRUE(execute(call));
+    cycle();
+  }
+  std::size_t first = 0;
+};
+
+TEST(DriveUnits, ReadAtBootWithoutAnEds) {
+  // The same axes without `drive.eds`: the master reads 0x608F, 0x6091, 0x60A9
+  // and 0x60AA at boot and sends every velocity in the unit the drive has.
+  const std::string direct = "{mode: velocity, ramp: {acceleration: 100, deceleration: 100, velocity_positive: 50}}";
+  const Config master = load_string(yaml("", "", direct), kFile);
+  EXPECT_TRUE(master.axes[1].drive.units_at_boot);
+  EXPECT_FALSE(master.axes[1].drive.velocity_counts);
+  const Config drives = load_string(yaml("incs-drive.eds", "rpm-drive.eds", direct), kFile);
+  ReadAtBootRig r(master, drives);
+  r.cycles(300);
+  ASSERT_EQ(r.proxy(0).phase(), cia402::Phase::kOperational) << r.proxy(0).failure().to_string();
+  ASSERT_EQ(r.proxy(1).phase(), cia402::Phase::kOperational) << r.proxy(1).failure().to_string();
+  EXPECT_DOUBLE_EQ(r.proxy(0).velocity_counts(), 1.0);
+  EXPECT_DOUBLE_EQ(r.proxy(1).velocity_counts(), 4096.0 / 60.0);
+  EXPECT_EQ(r.proxy(1).unit_readings().res.increments, 4096u);
+  // The boot writes in the drive's unit: 50 units/s = 204800 counts/s = 3000 rpm.
+  EXPECT_EQ(r.emu(0).read_int(0x2010, 1), 204800);
+  EXPECT_EQ(r.emu(1).read_int(0x2010, 1), 3000);
+  EXPECT_EQ(r.emu(0).read_int(0x6083), 409600);  // neither has 0x60AA: inc/s^2
+  EXPECT_EQ(r.emu(1).read_int(0x6083), 409600);
+  r.exec("MDS(A, ma, 15, UnitsPerSec)");
+  r.exec("MDS(B, mb, 15, UnitsPerSec)");
+  r.cycles(2000);
+  ASSERT_EQ(r.read("mb.IP"), 1.0) << r.read("mb.ERR");
+  EXPECT_EQ(r.emu(0).read_int(0x60FF), 61440);
+  EXPECT_EQ(r.emu(1).read_int(0x60FF), 900);
+  EXPECT_DOUBLE_EQ(r.emu(0).velocity(), 61440.0);  // the same shaft speed
+  EXPECT_DOUBLE_EQ(r.emu(1).velocity(), 61440.0);
+  EXPECT_NEAR(r.read("B.ActualVelocity"), 15.0, 1e-9);
+  r.exec("MAS(B, sb, All, No, 0, UnitsPerSec2, No, 0, UnitsPerSec3)");
+  r.cycles(500);
+  r.exec("MSO(B, ob)");
+  r.cycles(300);
+  r.exec("MAH(B, hb)");
+  r.cycles(200);
+  EXPECT_EQ(r.emu(1).read_int(0x6099, 1), 300);  // 5 units/s in rpm
+  EXPECT_EQ(r.emu(1).read_int(0x6099, 2), 60);
+}
+
+/// `y` with axis B's homing and direct_control left out (B is the last axis):
+/// nothing of it needs the drive's velocity unit.
+std::string without_b_motion(std::string y) {
+  const auto at = y.find("    homing:", y.find("name: B"));
+  const auto end = y.find("    drive:", at);
+  y.erase(at, end == std::string::npos ? std::string::npos : end - at);
+  return y;
+}
+
+TEST(DriveUnits, UnitUnknownAtBootFailsTheBootNamingTheObject) {
+  // The drive says rpm and has no 0x608F: its counts per revolution cannot be
+  // known. MDS and homing need the unit: the boot fails naming 0x60A9 and the
+  // keys, before NMT start (no PDO, no motion). Nothing is guessed.
+  const Config drives = load_string(without_b_motion(yaml("incs-drive.eds", "unknown-velocity-drive.eds")), kFile);
+  ReadAtBootRig r(load_string(yaml("", ""), kFile), drives);
+  r.cycles(400);
+  const cia402::DriveProxy& p = r.proxy(1);
+  ASSERT_TRUE(p.failed());
+  EXPECT_EQ(p.failure().kind, cia402::FailureKind::kBootCheck);
+  const std::string why = p.failure().to_string();
+  for (const char* part : {"node 2: 0x60A9", "is 0x00B44700", "0x608F", "axes[1].direct_control (MDS in CSV)",
+                           "axes[1].homing (speeds, 0x6099)", "nothing is guessed"})
+    EXPECT_NE(why.find(part), std::string::npos) << part << " in: " << why;
+  EXPECT_EQ(r.emu(1).counters().rpdos, 0u);
+  EXPECT_EQ(r.emu(1).nmt_state(), canopen::NmtState::kPreOperational);
+  EXPECT_EQ(r.proxy(0).phase(), cia402::Phase::kOperational);  // the other drive is fine
+  // MSO on it is refused with the drive's failure.
+  r.exec("MSO(B, ob)");
+  r.cycles(5);
+  EXPECT_EQ(r.read("ob.ER"), 1.0);
+  // Without MDS and homing nothing needs the unit: the drive boots and runs
+  // on positions, its velocity not known (0x606C not read, 0x60FF sent 0).
+  ReadAtBootRig c(load_string(without_b_motion(yaml("", "")), kFile), drives);
+  c.cycles(400);
+  ASSERT_EQ(c.proxy(1).phase(), cia402::Phase::kOperational) << c.proxy(1).failure().to_string();
+  EXPECT_TRUE(std::isnan(c.proxy(1).velocity_counts()));
+  c.exec("MSO(B, ob)");
+  c.cycles(300);
+  ASSERT_EQ(c.read("ob.DN"), 1.0) << c.read("ob.ERR");
+  c.exec("MAJ(B, jb, Forward, 2, UnitsPerSec, 100, UnitsPerSec2, 100, UnitsPerSec2, Trapezoidal, 0, 0, UnitsPerSec3, Disabled, Programmed, 0, None)");
+  c.cycles(200);
+  const std::int64_t p0 = c.emu(1).position_counts();
+  c.cycles(1000);
+  EXPECT_EQ(c.emu(1).read_int(0x60FF), 0);
+  EXPECT_NEAR(static_cast<double>(c.emu(1).position_counts() - p0), 2.0 * 4096, 2.0);
+}
+
+/// rpm-drive.eds with the DefaultValue of each of `sections` left out (the
+/// drive has the object, the file no value), written to a temporary file;
+/// returns its path.
+std::string rpm_drive_without(const std::string& name, const std::vector<std::string>& sections) {
+  std::ifstream in(std::string(CANMOTION_UNITS_DIR) + "/rpm-drive.eds");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string t = ss.str();
+  for (const std::string& sec : sections) {
+    const std::size_t at = t.find("[" + sec + "]\n");
+    EXPECT_NE(at, std::string::npos) << sec;
+    const std::size_t v = t.find("DefaultValue=", at);
+    t.erase(v, t.find('\n', v) + 1 - v);
+  }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("canmotion-" + name + "-" + std::to_string(::getpid()) + ".eds")).string();
+  std::ofstream(path) << t;
+  return path;
+}
+
+TEST(DriveUnits, ValuesTheFileLacksAreReadAtBoot) {
+  // 0x60A9 without a value, then 0x608F without values: not refused at load;
+  // read from the drive at boot (which has rpm, 4096 increments per revolution).
+  const Config drives = load_string(yaml("incs-drive.eds", "rpm-drive.eds"), kFile);
+  for (const auto& [name, sections] :
+       {std::pair<std::string, std::vector<std::string>>{"no-60a9-value", {"60A9"}},
+        {"no-608f-values", {"608Fsub1", "608Fsub2"}}}) {
+    SCOPED_TRACE(name);
+    const std::string eds = rpm_drive_without(name, sections);
+    const Config master = load_string(yaml("incs-drive.eds", eds), kFile);
+    EXPECT_FALSE(master.axes[0].drive.units_at_boot);
+    EXPECT_TRUE(master.axes[1].drive.units_at_boot);
+    ReadAtBootRig r(master, drives);
+    r.cycles(300);
+    ASSERT_EQ(r.proxy(1).phase(), cia402::Phase::kOperational) << r.proxy(1).failure().to_string();
+    r.exec("MDS(B, mb, 15, UnitsPerSec)");
+    r.cycles(2000);
+    EXPECT_EQ(r.emu(1).read_int(0x60FF), 900);
+    EXPECT_DOUBLE_EQ(r.emu(1).velocity(), 61440.0);
+    std::filesystem::remove(eds);
+  }
+}
 
 TEST(DriveUnits, SameShaftSpeedInIncPerSecondAndRpm) {
   const Config c = load_string(yaml("incs-drive.eds", "rpm-drive.eds"), kFile);

@@ -138,7 +138,13 @@ TEST(OptionalObjects, PeriodTheDrivesUnitCannotExpressFailsNamingObjectValueAndP
 }
 
 /// The SDO frames of node 2 about 0x60C2 while the rig boots, as "ID#DATA".
-std::vector<std::string> ip_sdo_frames(SimRig& rig) {
+/// The SDO frames (8 bytes) to and from kNode about the objects in
+/// [lo, hi], in order, until the drive is operational or failed.
+std::vector<std::string> sdo_frames(SimRig& rig, std::uint16_t lo, std::uint16_t hi);
+
+std::vector<std::string> ip_sdo_frames(SimRig& rig) { return sdo_frames(rig, 0x60C2, 0x60C2); }
+
+std::vector<std::string> sdo_frames(SimRig& rig, std::uint16_t lo, std::uint16_t hi) {
   can::SimBus::Endpoint& spy = rig.bus().add_endpoint("spy");
   std::vector<std::string> sdo;
   std::array<can::TimedFrame, 256> buf{};
@@ -148,8 +154,8 @@ std::vector<std::string> ip_sdo_frames(SimRig& rig) {
     for (std::size_t k; (k = spy.receive(buf)) > 0;)
       for (std::size_t j = 0; j < k; ++j) {
         const can::Frame& f = buf[j].frame;
-        if ((f.id != 0x600u + kNode && f.id != 0x580u + kNode) || f.len != 8 || f.data[1] != 0xC2 || f.data[2] != 0x60)
-          continue;
+        const auto index = static_cast<std::uint16_t>(f.data[1] | (f.data[2] << 8));
+        if ((f.id != 0x600u + kNode && f.id != 0x580u + kNode) || f.len != 8 || index < lo || index > hi) continue;
         char s[40];
         std::snprintf(s, sizeof s, "%03X#%02X%02X%02X%02X%02X%02X%02X%02X", f.id, f.data[0], f.data[1], f.data[2],
                       f.data[3], f.data[4], f.data[5], f.data[6], f.data[7]);
@@ -295,6 +301,66 @@ TEST(OptionalObjects, FailuresNameObjectsByTheDrivesEds) {
     EXPECT_NE(plain.to_string().find("0x2100:0 (an object canmotion does not know)"), std::string::npos)
         << plain.to_string();
   }
+}
+
+}  // namespace
+}  // namespace canmotion
+
+namespace canmotion {
+namespace {
+
+// Drive units read at boot (README "Drive units"; DriveUnits::read_at_boot):
+// 0x608F:1/2, 0x6091:1/2, 0x60A9, 0x60AA, byte for byte. The strict drive
+// has none of them: each abort is taken, the drive works in increments, and
+// the two unit objects are said once each.
+TEST(OptionalObjects, DriveUnitsReadAtBootFromADriveWithoutThem) {
+  SimRigConfig c = one_drive();
+  c.drive.units.read_at_boot = true;
+  c.drive.units.velocity_needed_by = "axes[0].direct_control (MDS in CSV)";
+  SimRig rig(c);
+  const std::vector<std::string> sdo = sdo_frames(rig, 0x608F, 0x60AA);
+  ASSERT_TRUE(rig.network().all_operational()) << rig.drive(kNode).failure().to_string();
+  const std::vector<std::string> golden = {
+      "602#408F600100000000", "582#808F600100000206",  // upload 0x608F:1: abort 0x06020000
+      "602#408F600200000000", "582#808F600200000206",  // 0x608F:2
+      "602#4091600100000000", "582#8091600100000206",  // 0x6091:1
+      "602#4091600200000000", "582#8091600200000206",  // 0x6091:2
+      "602#40A9600000000000", "582#80A9600000000206",  // 0x60A9
+      "602#40AA600000000000", "582#80AA600000000206",  // 0x60AA
+  };
+  EXPECT_EQ(sdo, golden);
+  EXPECT_DOUBLE_EQ(rig.drive(kNode).velocity_counts(), 1.0);
+  EXPECT_DOUBLE_EQ(rig.drive(kNode).acceleration_counts(), 1.0);
+  const std::vector<canopen::NodeEvent> n = notices(rig);
+  EXPECT_EQ(count(n, 0x608F, 1) + count(n, 0x6091, 1), 0u);  // quiet: only the units are said
+  ASSERT_EQ(count(n, 0x60A9, 0), 1u);
+  ASSERT_EQ(count(n, 0x60AA, 0), 1u);
+  for (const auto& e : n)
+    if (e.index == 0x60A9)
+      EXPECT_NE(cia402::describe_notice(e).find("0x60A9:0 (SI unit velocity) absent (SDO abort 0x06020000"),
+                std::string::npos) << cia402::describe_notice(e);
+}
+
+// A unit read at boot that nothing needs and canmotiond cannot interpret is
+// said once as read, with its code, not as a left-out write.
+TEST(OptionalObjects, UninterpretedUnitNothingNeedsIsSaidAsRead) {
+  const cia402::BootRow* row = nullptr;
+  for (const cia402::BootRow& r : cia402::boot_plan())
+    if (r.check == cia402::BootCheck::kVelocityUnit) row = &r;
+  ASSERT_NE(row, nullptr);
+  cia402::BootWrite w;
+  w.row = row;
+  w.w.index = 0x60A9;
+  canopen::NodeEvent e;
+  e.kind = canopen::NodeEvent::Kind::kObjectAbsent;
+  e.node = kNode;
+  e.index = 0x60A9;
+  e.detail = static_cast<std::int32_t>(0xFD010300u);  // mm/s: not interpreted here
+  e.note = cia402::boot_note_id(w, cia402::Fallback::kHeld);
+  EXPECT_TRUE(cia402::boot_note_of_read(e.note));
+  EXPECT_EQ(cia402::describe_notice(e),
+            "node 2: 0x60A9:0 (SI unit velocity) read at boot: its velocity unit 0xFD010300 is not one canmotiond "
+            "interprets; nothing configured needs it, so velocities of this axis are not shown");
 }
 
 }  // namespace

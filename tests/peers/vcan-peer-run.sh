@@ -4,7 +4,8 @@
 # processes.
 #   vcan-peer-run.sh SCENARIO CANMOTIOND [PEER_OPTION...]
 # SCENARIO is boot_enable_move, fault_recovery, vanish, nmt_preop,
-# boot_late, power_cycle, link_down, never_heard or units_rpm (scenarios/*.script).
+# boot_late, power_cycle, link_down, never_heard, units_rpm or units_rpm_boot
+# (scenarios/*.script; units_rpm_boot runs units_rpm.script).
 # 1. the peer powers up (/usr/bin/python3 cia402_peer.py -i vcan0 -n 5
 #    --position 123456 --heartbeat-ms 100 --control FIFO -v PEER_OPTION...),
 #    then canmotiond
@@ -13,6 +14,8 @@
 #    nothing answers);
 #    units_rpm: --config vcan-units.yaml with tests/units/rpm-drive.eds (the
 #    peer gets --velocity-unit rpm --encoder-increments 4096 from ctest);
+#    units_rpm_boot: --config vcan-units-boot.yaml, no EDS (the units are
+#    read from the peer at boot);
 #    boot_late: the peer process starts first but --powered-off (silent);
 # 2. fault_recovery: after canmotiond printed the `X.JogStatus` line, the
 #    peer gets `fault 0xFF00` on its control FIFO; nmt_preop: `nmt preop`
@@ -28,7 +31,8 @@
 #    fails on anything but 0, after its analysis of the trace); then the
 #    peer is stopped (SIGTERM: it prints its summary); run-vcan-test lets
 #    the trace settle. This script fails only when the processes cannot be run.
-# Artefacts: vcan.yaml (never_heard: vcan-two.yaml), canmotiond.log,
+# Artefacts: vcan.yaml (never_heard: vcan-two.yaml, units_rpm: vcan-units.yaml,
+# units_rpm_boot: vcan-units-boot.yaml), canmotiond.log,
 # canmotiond.csv, canmotiond.status, peer.log, events.log.
 set -euo pipefail
 scenario="$1" daemon="$2"; shift 2
@@ -36,12 +40,13 @@ peer_opts=("$@")
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)"
 art="$CANMOTION_ARTIFACTS" trace="$CANMOTION_TRACE"
 fail() { echo "vcan-peer-run: $*" >&2; exit 1; }
-script="$here/scenarios/$scenario.script"
+script="$here/scenarios/${scenario%_boot}.script"
 [[ -f "$script" ]] || fail "no scenario '$scenario' ($script)"
 config=vcan.yaml
 [[ $scenario == never_heard ]] && config=vcan-two.yaml
 [[ $scenario == units_rpm ]] && config=vcan-units.yaml
-rm -f "$art/vcan.yaml" "$art/vcan-two.yaml" "$art/vcan-units.yaml"
+[[ $scenario == units_rpm_boot ]] && config=vcan-units-boot.yaml
+rm -f "$art/vcan.yaml" "$art/vcan-two.yaml" "$art/vcan-units.yaml" "$art/vcan-units-boot.yaml"
 cp "$here/$config" "$art/$config"
 # units_rpm: the drive's units come from its EDS (next to the configuration).
 [[ $scenario == units_rpm ]] && cp "$here/../units/rpm-drive.eds" "$art/rpm-drive.eds"

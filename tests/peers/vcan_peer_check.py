@@ -81,15 +81,22 @@ class Check:
     def rpdos(self, t0=None, t1=None):
         return [(t, *struct.unpack('<Hi', d[:6])) for t, _, d in self.t.of(self.RPDO, t0, t1) if len(d) >= 6]
 
-    def sdo_transfers(self):
-        """Expedited downloads by the master: (t, index, sub, value, abort or 0 or None)."""
+    def sdo_pairs(self):
+        """Each SDO request of the master with the drive's next answer (None:
+        none): (t, request data, response data or None). The drive answers
+        one transfer at a time (CiA 301)."""
         reqs, rsps = self.t.of(self.SDO_REQ), self.t.of(self.SDO_RSP)
-        out, j = [], 0
+        j = 0
         for t, _, d in reqs:
             while j < len(rsps) and rsps[j][0] < t:
                 j += 1
-            rsp = rsps[j][2] if j < len(rsps) else None
+            yield t, d, (rsps[j][2] if j < len(rsps) else None)
             j += 1
+
+    def sdo_transfers(self):
+        """Expedited downloads by the master: (t, index, sub, value, abort or 0 or None)."""
+        out = []
+        for t, d, rsp in self.sdo_pairs():
             if d[0] >> 5 != 1:
                 continue
             index, sub = struct.unpack_from('<HB', d, 1)
@@ -554,6 +561,36 @@ class Check:
         self.item(fault[-1:] == ['0'] and self.printed('X.DriveEnableStatus')[-1:] == ['1'], 'X still enabled, no fault',
                   f'X.AxisFault {fault}, X.DriveEnableStatus {self.printed("X.DriveEnableStatus")}')
 
+    def sdo_uploads(self):
+        """Expedited uploads by the master: (t, index, sub, value or None, abort or 0 or None)."""
+        out = []
+        for t, d, rsp in self.sdo_pairs():
+            if d[0] != 0x40:
+                continue
+            index, sub = struct.unpack_from('<HB', d, 1)
+            if rsp is None or struct.unpack_from('<HB', rsp, 1) != (index, sub):
+                out.append((t, index, sub, None, None))
+            elif rsp[0] == 0x80:
+                out.append((t, index, sub, None, struct.unpack_from('<I', rsp, 4)[0]))
+            elif rsp[0] >> 5 == 2 and rsp[0] & 2:   # expedited upload response
+                n = (rsp[0] >> 2) & 3 if rsp[0] & 1 else 0
+                out.append((t, index, sub, int.from_bytes(rsp[4:8 - n], 'little'), 0))
+        return out
+
+    def units_read_at_boot(self, t_start):
+        """No EDS: the master reads 0x608F:1/2, 0x6091:1/2, 0x60A9 and 0x60AA
+        from the peer at boot, before NMT start, and before any value in
+        those units (0x6099) is written."""
+        ups = [x for x in self.sdo_uploads() if x[0] < t_start]
+        got = {(i, s): (v, r) for _, i, s, v, r in ups}
+        self.item(got.get((0x60A9, 0)) == (0x00B44700, 0), '0x60A9 read at boot: rpm',
+                  f'0x60A9 upload: {got.get((0x60A9, 0))} (want 0x00B44700)')
+        self.item(got.get((0x608F, 1)) == (4096, 0) and got.get((0x608F, 2)) == (1, 0), '0x608F read at boot',
+                  f'0x608F:1 {got.get((0x608F, 1))}, :2 {got.get((0x608F, 2))} (want 4096 and 1)')
+        self.item(got.get((0x6091, 1), (None, 0))[1] == 0x06020000 and got.get((0x60AA, 0), (None, 0))[1] == 0x06020000,
+                  '0x6091 and 0x60AA absent (abort 0x06020000), boot goes on',
+                  f'0x6091:1 {got.get((0x6091, 1))}, 0x60AA {got.get((0x60AA, 0))}')
+
     def units_rpm(self, t_start):
         """The peer in rpm (4096 counts per revolution, one user unit): the
         homing speeds as SDO writes (5 and 1 rev/s = 300 and 60 rpm), the MDS
@@ -620,7 +657,8 @@ def main():
                                  epilog='Environment: CANMOTION_TRACE, CANMOTION_ARTIFACTS, CANMOTION_BUILD_DIR '
                                         '(run-vcan-test); PEER_SYNC_MEAN_MAX (1.5), PEER_VANISH_SLACK_MS (100).')
     ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish', 'nmt_preop', 'boot_late',
-                                         'power_cycle', 'link_down', 'never_heard', 'units_rpm'))
+                                         'power_cycle', 'link_down', 'never_heard', 'units_rpm',
+                                         'units_rpm_boot'))
     ap.add_argument('--period-ms', type=float, default=10.0)
     ap.add_argument('--node', type=int, default=5)
     ap.add_argument('--start', type=int, default=123456, help='the peer\'s --position')
@@ -649,7 +687,9 @@ def main():
             c.power_cycle(t_start)
         elif a.scenario == 'link_down':
             c.link_down(t_start)
-        elif a.scenario == 'units_rpm':
+        elif a.scenario in ('units_rpm', 'units_rpm_boot'):
+            if a.scenario == 'units_rpm_boot':
+                c.units_read_at_boot(t_start)
             c.units_rpm(t_start)
         else:
             c.vanish(t_start)
