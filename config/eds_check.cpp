@@ -205,19 +205,22 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
   namespace u = cia402::units;
   DriveSettings& ds = a.drive;
   const eds::Eds& e = *ds.eds_data;
-  u::EncoderResolution res;
-  if (auto i = file_value(e, u::kPositionEncoderResolution, 1, a.node)) res.increments = static_cast<std::uint32_t>(*i);
-  if (auto r = file_value(e, u::kPositionEncoderResolution, 2, a.node)) res.revolutions = static_cast<std::uint32_t>(*r);
-  // Revolutions of the motor (0x608F) are those of the velocity unit only
-  // without a gear between (0x6091 absent or 1:1): else not known, not guessed.
-  const auto g1 = file_value(e, u::kGearRatio, 1, a.node);
-  const auto g2 = file_value(e, u::kGearRatio, 2, a.node);
-  const bool has_gear = e.find(u::kGearRatio, 1) != nullptr;
-  const bool gear_other = has_gear && g1 && g2 && !(*g1 == *g2 && *g1 != 0);
-  const bool gear_unvalued = has_gear && !(g1 && g2);  // the drive has it: read at boot
-  const bool resolution_unvalued = e.find(u::kPositionEncoderResolution, 1) != nullptr &&
-                                   e.find(u::kPositionEncoderResolution, 2) != nullptr && !res.known();
-  if (gear_other || gear_unvalued) res = {};
+  // The factor group as the file has it; an object the drive has but whose
+  // value the file lacks is read at boot (`units_at_boot`).
+  u::FactorGroup f;
+  bool unvalued = false;  // an object of the group present without a value
+  auto take = [&](std::uint16_t index, std::uint8_t sub, std::uint32_t& to) {
+    if (e.find(index, sub) == nullptr) return;
+    if (auto v = file_value(e, index, sub, a.node)) to = static_cast<std::uint32_t>(*v);
+    else unvalued = true;
+  };
+  take(u::kSiUnitPosition, 0, f.position);
+  take(u::kPositionEncoderResolution, 1, f.res.increments);
+  take(u::kPositionEncoderResolution, 2, f.res.revolutions);
+  take(u::kGearRatio, 1, f.gear_motor);
+  take(u::kGearRatio, 2, f.gear_shaft);
+  take(u::kFeedConstant, 1, f.feed);
+  take(u::kFeedConstant, 2, f.feed_shaft);
   auto one = [&](std::uint16_t index, bool acceleration, std::optional<std::uint32_t> configured,
                  std::optional<double>& counts, std::string& unknown) {
     const eds::SubObject* s = e.find(index, 0);
@@ -231,20 +234,16 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
       ds.units_at_boot = true;
       return;
     }
-    counts = u::counts_per_unit(static_cast<std::uint32_t>(*si), res, acceleration);
-    // Revolutions with a 0x608F (and no gear other than 1:1) whose values the
-    // file lacks: the drive has them, read at boot.
-    const bool revolutions = ((*si >> 16) & 0xFFu) == 0xB4u;
-    if (!counts && revolutions && !gear_other && (resolution_unvalued || gear_unvalued) &&
-        u::counts_per_unit(static_cast<std::uint32_t>(*si), u::EncoderResolution{1, 1}, acceleration)) {
+    counts = u::counts_per_unit(static_cast<std::uint32_t>(*si), f, acceleration);
+    // Factors the drive has but the file gives no value for: read at boot.
+    if (!counts && unvalued) {
       ds.units_at_boot = true;
       return;
     }
     if (!counts)
-      unknown = fmt::format("0x{:04X} = 0x{:08X}{}: {}{}", index, *si,
+      unknown = fmt::format("0x{:04X} = 0x{:08X}{}: {}", index, *si,
                             configured ? fmt::format(" ({})", ds.units_key) : fmt::format(" ({}:{})", ds.eds, s->line),
-                            u::unknown_reason(static_cast<std::uint32_t>(*si), res, acceleration),
-                            gear_other ? " (0x6091 gear ratio is not 1:1: revolutions of which shaft is not known)" : "");
+                            u::unknown_reason(static_cast<std::uint32_t>(*si), f, acceleration));
   };
   one(u::kSiUnitVelocity, false, ds.velocity_unit, ds.velocity_counts, ds.velocity_unknown);
   one(u::kSiUnitAcceleration, true, std::nullopt, ds.acceleration_counts, ds.acceleration_unknown);

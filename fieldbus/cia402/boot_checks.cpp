@@ -203,8 +203,14 @@ int describe_sync_counter(const Failure& f, std::span<char> out, double) noexcep
 // ---- the factor group, read when the configuration cannot tell the units ----------------
 CheckVerdict verify_unit_factor(const CheckInput& in) noexcept {
   if (in.units == nullptr) return {};
-  if (in.index == units::kPositionEncoderResolution) (in.sub == 1 ? in.units->res.increments : in.units->res.revolutions) = in.value;
-  if (in.index == units::kGearRatio) (in.sub == 1 ? in.units->gear_motor : in.units->gear_shaft) = in.value;
+  units::FactorGroup& f = in.units->factors;
+  switch (in.index) {
+    case units::kSiUnitPosition: f.position = in.value; break;
+    case units::kPositionEncoderResolution: (in.sub == 1 ? f.res.increments : f.res.revolutions) = in.value; break;
+    case units::kGearRatio: (in.sub == 1 ? f.gear_motor : f.gear_shaft) = in.value; break;
+    case units::kFeedConstant: (in.sub == 1 ? f.feed : f.feed_shaft) = in.value; break;
+    default: break;
+  }
   return {};
 }
 
@@ -213,7 +219,7 @@ CheckVerdict verify_unit_factor(const CheckInput& in) noexcept {
 CheckVerdict unit(const CheckInput& in, bool acceleration) noexcept {
   CheckVerdict c;
   if (in.units == nullptr) return c;
-  const auto counts = units::counts_per_unit(in.value, in.units->motor_resolution(), acceleration);
+  const auto counts = units::counts_per_unit(in.value, in.units->factors, acceleration);
   double& kept = acceleration ? in.units->acceleration_counts : in.units->velocity_counts;
   if (counts) {
     kept = *counts;
@@ -235,15 +241,15 @@ CheckVerdict verify_acceleration_unit(const CheckInput& in) noexcept { return un
 
 int describe_unit(const Failure& f, std::span<char> out, double) noexcept {
   const bool acc = f.check == BootCheck::kAccelerationUnit;
-  const auto why = units::unknown_reason(f.read_value, f.unit_res, acc);
+  const auto why = units::unknown_reason(f.read_value, f.unit_factors, acc);
   return std::snprintf(out.data(), out.size(),
-                       "node %u: 0x%04X (%s) is 0x%08" PRIX32 ": %.*s; %s needs the drive's %s unit, and nothing is "
-                       "guessed: give the drive a unit canmotiond interprets (README \"Drive units\")%s",
+                       "node %u: 0x%04X (%s) is 0x%08" PRIX32 ": %.*s; the drive's %s unit is needed by %s, and "
+                       "nothing is guessed: give the drive a unit canmotiond interprets (README \"Drive units\")%s",
                        f.node, acc ? units::kSiUnitAcceleration : units::kSiUnitVelocity,
                        eds_name_or(f.dictionary, acc ? units::kSiUnitAcceleration : units::kSiUnitVelocity, 0,
                                    acc ? "SI unit acceleration" : "SI unit velocity"),
-                       f.read_value, static_cast<int>(why.size()), why.data(), key_or(f, "the configuration"),
-                       acc ? "acceleration" : "velocity", acc ? "" : ", or set drive.units.velocity (a writable 0x60A9)");
+                       f.read_value, static_cast<int>(why.size()), why.data(), acc ? "acceleration" : "velocity",
+                       key_or(f, "the configuration"), acc ? "" : ", or set drive.units.velocity (a writable 0x60A9)");
 }
 
 // ---- no check ------------------------------------------------------------------------

@@ -104,9 +104,10 @@ enum class BootCheck : std::uint8_t {
   /// overflow value (`read_value` the drive's, `expected` the master's,
   /// `sdo_abort` the write's abort).
   kSyncCounter,
-  /// 0x608F:1/2 position encoder resolution, 0x6091:1/2 gear ratio, read when
-  /// the units are read at boot (DriveUnits::read_at_boot): kept for the
-  /// unit checks below (absent: not known / no gear). Always passes.
+  /// 0x60A8 SI unit position, 0x608F:1/2 position encoder resolution,
+  /// 0x6091:1/2 gear ratio, 0x6092:1/2 feed constant, read when the units are
+  /// read at boot (DriveUnits::read_at_boot): kept for the unit checks below
+  /// (absent: increments / not known / no gear / no feed). Always passes.
   kUnitFactor,
   /// 0x60A9 SI unit velocity read at boot: the counts per unit (units.hpp)
   /// with the 0x608F/0x6091 read before; a unit that cannot be interpreted
@@ -279,20 +280,12 @@ enum class Fallback : std::uint8_t { kAbsent, kReadOnly, kHeld };
 /// The drive's factor group as read at boot (BootCheck::kUnitFactor ..
 /// kAccelerationUnit) and the counts per unit it gives (DriveProxy).
 struct UnitReadings {
-  units::EncoderResolution res;  ///< 0x608F:1/2 (0: not read, or absent)
-  std::uint32_t gear_motor = 0;  ///< 0x6091:1 (0: absent)
-  std::uint32_t gear_shaft = 0;  ///< 0x6091:2
+  /// 0x60A8, 0x608F:1/2, 0x6091:1/2, 0x6092:1/2 as read (0: not read, or absent).
+  units::FactorGroup factors;
   /// counts/s per unit of the velocity values, counts/s^2 per unit of the
   /// acceleration values; NaN: not known.
   double velocity_counts = 1.0;
   double acceleration_counts = 1.0;
-  /// The resolution that holds for the velocity unit: 0x608F, unless a gear
-  /// other than 1:1 (0x6091) stands between motor and shaft (then unknown).
-  [[nodiscard]] constexpr units::EncoderResolution motor_resolution() const noexcept {
-    if (gear_motor != 0 || gear_shaft != 0)
-      if (gear_motor != gear_shaft) return {};
-    return res;
-  }
 };
 
 /// What a check sees of a value read at boot.

@@ -72,7 +72,7 @@ DriveProxy::Taken DriveProxy::check_read(std::size_t i, std::uint32_t v, std::in
   failure_.check = bw.check;
   failure_.read_value = v;
   failure_.expected = c.expected;
-  failure_.unit_res = units_.motor_resolution();
+  failure_.unit_factors = units_.factors;
   failure_.sdo_index = bw.w.index;
   failure_.sdo_sub = bw.w.sub;
   failure_.sdo_origin = WriteOrigin::kCheck;

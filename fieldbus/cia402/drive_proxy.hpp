@@ -102,7 +102,7 @@ struct DriveUnits {
   double velocity_counts = 1.0;
   double acceleration_counts = 1.0;
   /// The configuration cannot tell (no EDS, or one without the values):
-  /// 0x608F:1/2, 0x6091:1/2, 0x60A9 and 0x60AA are read at boot (each
+  /// 0x60A8, 0x608F:1/2, 0x6091:1/2, 0x6092:1/2, 0x60A9 and 0x60AA are read at boot (each
   /// optional; a drive without 0x60A9 / 0x60AA works in increments, CiA 402
   /// without the factor group), and what they give replaces the two above.
   bool read_at_boot = false;
@@ -236,9 +236,8 @@ struct Failure {
   BootCheck check = BootCheck::kNone;  ///< kBootCheck: what did not match
   std::uint32_t read_value = 0;        ///< kBootCheck: what the drive has
   std::uint32_t expected = 0;          ///< kBootCheck: what the configuration expects (kSupportedModes: the missing mode)
-  /// kBootCheck kVelocityUnit / kAccelerationUnit: the position encoder
-  /// resolution that held (0x608F with a 1:1 gear; unknown otherwise).
-  units::EncoderResolution unit_res{};
+  /// kBootCheck kVelocityUnit / kAccelerationUnit: the factor group read.
+  units::FactorGroup unit_factors{};
   /// The drive's EDS (DriveConfig::dictionary), or nullptr: describe() names
   /// objects by it where it has a name. Like `hint`, valid while the
   /// DriveProxy lives.

@@ -196,12 +196,22 @@ void Emulator::advance_motor(double dt) noexcept {
 }
 
 void Emulator::refresh_units() noexcept {
-  const std::uint64_t key[4] = {get(cia402::units::kSiUnitVelocity), get(cia402::units::kSiUnitAcceleration),
-                                get(cia402::units::kPositionEncoderResolution, 1),
-                                get(cia402::units::kPositionEncoderResolution, 2)};
-  if (key[0] == units_key_[0] && key[1] == units_key_[1] && key[2] == units_key_[2] && key[3] == units_key_[3]) return;
-  for (int i = 0; i < 4; ++i) units_key_[i] = key[i];
-  const cia402::units::EncoderResolution res{static_cast<std::uint32_t>(key[2]), static_cast<std::uint32_t>(key[3])};
+  namespace u = cia402::units;
+  // (get() is 0 for an object the drive lacks: absent in the factor group)
+  const std::uint64_t key[kUnitKeys] = {get(u::kSiUnitVelocity),          get(u::kSiUnitAcceleration),
+                                        get(u::kPositionEncoderResolution, 1), get(u::kPositionEncoderResolution, 2),
+                                        get(u::kSiUnitPosition),          get(u::kGearRatio, 1),
+                                        get(u::kGearRatio, 2),            get(u::kFeedConstant, 1),
+                                        get(u::kFeedConstant, 2)};
+  if (std::equal(std::begin(key), std::end(key), std::begin(units_key_))) return;
+  std::copy(std::begin(key), std::end(key), std::begin(units_key_));
+  u::FactorGroup res;
+  res.res = {static_cast<std::uint32_t>(key[2]), static_cast<std::uint32_t>(key[3])};
+  res.position = static_cast<std::uint32_t>(key[4]);
+  res.gear_motor = static_cast<std::uint32_t>(key[5]);
+  res.gear_shaft = static_cast<std::uint32_t>(key[6]);
+  res.feed = static_cast<std::uint32_t>(key[7]);
+  res.feed_shaft = static_cast<std::uint32_t>(key[8]);
   // A drive without 0x60A9/0x60AA works in increments (CiA 402 without the
   // factor group); a code this model does not know leaves increments too
   // (the master refuses such a drive before it commands a velocity).

@@ -648,13 +648,15 @@ class Emulator final : public canopen::SdoServerBackend {
   std::int64_t slat_held_ns_ = 0;   // CST SLAT: time the torque->speed condition has held
   double torque_ = 0;               // motor torque at the last SYNC (per mille)
   double torque_per_acc_ = 0;       // 1000 / cfg_.max_acceleration: torque (per mille) of an acceleration
-  // Drive units (README "Drive units"): counts/s per unit of 0x60FF, 0x60B1,
-  // 0x606C, 0x6099, 0x607F (0x60A9 with 0x608F) and counts/s^2 per unit of
-  // 0x6083..0x6085, 0x609A (0x60AA); 1 without those objects (inc/s, inc/s^2).
-  // Refreshed on SYNC from the dictionary (the master may write 0x60A9).
+  // Drive units (README "Drive units"): counts (position units) /s per unit
+  // of 0x60FF, 0x60B1, 0x606C, 0x6099, 0x607F (0x60A9 with 0x60A8, 0x608F,
+  // 0x6091, 0x6092) and counts/s^2 per unit of 0x6083..0x6085, 0x609A
+  // (0x60AA); 1 without those objects (inc/s, inc/s^2). Refreshed on SYNC
+  // from the dictionary (the master may write 0x60A9) when one of them changed.
   double vel_scale_ = 1.0;
   double acc_scale_ = 1.0;
-  std::uint64_t units_key_[4] = {~0ull, ~0ull, ~0ull, ~0ull};
+  static constexpr std::size_t kUnitKeys = 9;
+  std::uint64_t units_key_[kUnitKeys] = {~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull};
   void refresh_units() noexcept;
   static constexpr std::size_t kMaxLag = 64;  // bound of lag_cycles
   struct Setpoint {

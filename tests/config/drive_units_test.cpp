@@ -41,16 +41,49 @@ std::string yaml(const std::string& eds_a, const std::string& eds_b,
 
 TEST(DriveUnits, Decoding) {
   namespace u = cia402::units;
-  const u::EncoderResolution res{4096, 1};
-  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond, {}, false), 1.0);
+  u::FactorGroup res;  // position in increments, 4096 per motor revolution
+  res.res = {4096, 1};
+  const u::FactorGroup none;
+  u::FactorGroup r3;
+  r3.res = {10000, 3};
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond, none, false), 1.0);
   EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kRpm, res, false), 4096.0 / 60.0);
   EXPECT_DOUBLE_EQ(*u::counts_per_unit(0xFFB44700u, res, false), 4096.0 / 600.0);  // 0.1 rpm
-  EXPECT_DOUBLE_EQ(*u::counts_per_unit(0x00B44700u, {10000, 3}, false), 10000.0 / 3.0 / 60.0);
-  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond2, {}, true), 1.0);
-  EXPECT_FALSE(u::counts_per_unit(u::kRpm, {}, false));              // revolutions without 0x608F
-  EXPECT_FALSE(u::counts_per_unit(u::kIncPerSecond, {}, true));      // a velocity code is no acceleration
-  EXPECT_FALSE(u::counts_per_unit(0xFD010300u, res, false));         // mm/s: no feed known here
-  EXPECT_FALSE(u::counts_per_unit(0x00B50301u, res, false));         // byte 0 not 0
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(0x00B44700u, r3, false), 10000.0 / 3.0 / 60.0);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond2, none, true), 1.0);
+  EXPECT_FALSE(u::counts_per_unit(u::kRpm, none, false));             // revolutions without 0x608F
+  EXPECT_FALSE(u::counts_per_unit(u::kIncPerSecond, none, true));     // a velocity code is no acceleration
+  EXPECT_FALSE(u::counts_per_unit(0xFD010300u, res, false));          // mm/s with the position in increments
+  EXPECT_FALSE(u::counts_per_unit(0x00B50301u, res, false));          // byte 0 not 0
+  u::FactorGroup geared = res;  // a 3:1 gear: revolutions of which shaft?
+  geared.gear_motor = 3;
+  geared.gear_shaft = 1;
+  EXPECT_FALSE(u::counts_per_unit(u::kRpm, geared, false));
+  EXPECT_NE(u::unknown_reason(u::kRpm, geared, false).find("0x6091"), std::string_view::npos);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond, geared, false), 1.0);  // increments are the encoder's
+  // Position in 0.1 degree (0x60A8 = 0xFF410000, Nanotec's default) with the
+  // feed constant 3600 per driving shaft revolution (0x6092) and no gear:
+  // rpm = 3600 / 60 = 60 position units/s; 1 degree/s = 10; inc/s = 3600/4096.
+  u::FactorGroup deg;
+  deg.position = 0xFF410000u;
+  deg.res = {4096, 1};
+  deg.feed = 3600;
+  deg.feed_shaft = 1;
+  EXPECT_FALSE(deg.position_in_increments());
+  EXPECT_DOUBLE_EQ(*deg.per_motor_revolution(), 3600.0);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kRpm, deg, false), 60.0);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(0x00410300u, deg, false), 10.0);  // degree/s
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond, deg, false), 3600.0 / 4096.0);
+  deg.gear_motor = 2;  // 2 motor revolutions per driving shaft revolution: 1800 per motor revolution
+  deg.gear_shaft = 1;
+  EXPECT_DOUBLE_EQ(*deg.per_motor_revolution(), 1800.0);
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(u::kIncPerSecond, deg, false), 1800.0 / 4096.0);
+  EXPECT_FALSE(u::counts_per_unit(u::kRpm, deg, false));
+  u::FactorGroup mm;  // position in mm, velocity in m/s: 1000 mm/s per unit, no mechanics needed
+  mm.position = 0xFD010000u;
+  EXPECT_DOUBLE_EQ(*u::counts_per_unit(0x00010300u, mm, false), 1000.0);
+  EXPECT_FALSE(u::counts_per_unit(u::kRpm, mm, false));  // no feed constant
+  EXPECT_NE(u::unknown_reason(u::kRpm, mm, false).find("0x6092"), std::string_view::npos);
   EXPECT_EQ(*u::velocity_unit_code("rpm"), u::kRpm);
   EXPECT_FALSE(u::velocity_unit_code("rps"));
 }
@@ -98,7 +131,7 @@ TEST(DriveUnits, ReadAtBootWithoutAnEds) {
   ASSERT_EQ(r.proxy(1).phase(), cia402::Phase::kOperational) << r.proxy(1).failure().to_string();
   EXPECT_DOUBLE_EQ(r.proxy(0).velocity_counts(), 1.0);
   EXPECT_DOUBLE_EQ(r.proxy(1).velocity_counts(), 4096.0 / 60.0);
-  EXPECT_EQ(r.proxy(1).unit_readings().res.increments, 4096u);
+  EXPECT_EQ(r.proxy(1).unit_readings().factors.res.increments, 4096u);
   // The boot writes in the drive's unit: 50 units/s = 204800 counts/s = 3000 rpm.
   EXPECT_EQ(r.emu(0).read_int(0x2010, 1), 204800);
   EXPECT_EQ(r.emu(1).read_int(0x2010, 1), 3000);
@@ -211,6 +244,41 @@ TEST(DriveUnits, ValuesTheFileLacksAreReadAtBoot) {
     EXPECT_DOUBLE_EQ(r.emu(1).velocity(), 61440.0);
     std::filesystem::remove(eds);
   }
+}
+
+TEST(DriveUnits, PositionInTenthsOfADegree) {
+  // Nanotec's defaults (tests/units/degree-drive.eds): 0x607A/0x6064 in 0.1
+  // degree (0x60A8 = 0xFF410000), feed 3600 per revolution (0x6092), velocity
+  // in rpm. User unit: degree, conversion_constant 10. 90 degree/s = 15 rpm
+  // = 900 position units/s. From the EDS, and read at boot without it.
+  std::string y = yaml("degree-drive.eds", "degree-drive.eds");
+  for (std::size_t at; (at = y.find("conversion_constant: 4096")) != std::string::npos;)
+    y.replace(at, 25, "conversion_constant: 10");
+  const Config drives = load_string(y, kFile);
+  EXPECT_DOUBLE_EQ(*drives.axes[0].drive.velocity_counts, 60.0);  // position units/s per rpm
+  std::string no_eds = y;
+  const std::string line = "    drive: {eds: degree-drive.eds}\n";
+  no_eds.erase(no_eds.find(line), line.size());  // axis A's
+  const Config master = load_string(no_eds, kFile);
+  ASSERT_EQ(master.axes[0].drive.eds, "");
+  ASSERT_EQ(master.axes[1].drive.eds, "degree-drive.eds");
+  ReadAtBootRig r(master, drives);  // A without the EDS (read at boot), B with it
+  r.cycles(300);
+  ASSERT_EQ(r.proxy(0).phase(), cia402::Phase::kOperational) << r.proxy(0).failure().to_string();
+  EXPECT_DOUBLE_EQ(r.proxy(0).velocity_counts(), 60.0);
+  EXPECT_EQ(r.proxy(0).unit_readings().factors.position, 0xFF410000u);
+  EXPECT_EQ(r.proxy(0).unit_readings().factors.feed, 3600u);
+  r.exec("MDS(A, ma, 90, UnitsPerSec)");
+  r.exec("MDS(B, mb, 90, UnitsPerSec)");
+  r.cycles(2000);
+  for (std::size_t bus = 0; bus < 2; ++bus) {
+    SCOPED_TRACE(bus);
+    EXPECT_EQ(r.emu(bus).read_int(0x60FF), 15);            // rpm
+    EXPECT_DOUBLE_EQ(r.emu(bus).velocity(), 900.0);        // 0.1 degree/s
+    EXPECT_EQ(r.emu(bus).read_int(0x606C), 15);
+  }
+  EXPECT_NEAR(r.read("A.ActualVelocity"), 90.0, 1e-9);
+  EXPECT_NEAR(r.read("B.ActualVelocity"), 90.0, 1e-9);
 }
 
 TEST(DriveUnits, SameShaftSpeedInIncPerSecondAndRpm) {

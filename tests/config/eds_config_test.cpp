@@ -145,14 +145,15 @@ TEST(EdsConfig, BootWritesLeaveOutOptionalObjectsTheEdsLacks) {
   // 0x1019 and the read of 0x1019 made only if the drive refuses it are left out.
   EXPECT_EQ(optional, 9);
   // Without an EDS the drive units are read at boot too (README "Drive
-  // units"): 0x608F:1/2, 0x6091:1/2, 0x60A9, 0x60AA, each optional.
+  // units"): 0x60A8, 0x608F:1/2, 0x6091:1/2, 0x6092:1/2, 0x60A9, 0x60AA,
+  // each optional.
   const auto unit_reads = std::count_if(all.begin(), all.end(), [](const cia402::BootWrite& b) {
     return b.is_read() && b.optional &&
            (b.check == cia402::BootCheck::kUnitFactor || b.check == cia402::BootCheck::kVelocityUnit ||
             b.check == cia402::BootCheck::kAccelerationUnit);
   });
-  EXPECT_EQ(unit_reads, 6);
-  EXPECT_EQ(all.size(), w.size() + 8 + 6);
+  EXPECT_EQ(unit_reads, 9);
+  EXPECT_EQ(all.size(), w.size() + 8 + 9);
   // The boot's optional reads (0x6502, 0x6061) stay: the minimal drive has
   // both; so does the read of 0x60C2:2 made only if the drive refuses it.
   const auto optional_reads = std::count_if(w.begin(), w.end(), [](const cia402::BootWrite& b) { return b.optional && b.is_read() && !b.is_fallback(); });

@@ -310,7 +310,7 @@ namespace canmotion {
 namespace {
 
 // Drive units read at boot (README "Drive units"; DriveUnits::read_at_boot):
-// 0x608F:1/2, 0x6091:1/2, 0x60A9, 0x60AA, byte for byte. The strict drive
+// 0x60A8, 0x608F:1/2, 0x6091:1/2, 0x6092:1/2, 0x60A9, 0x60AA, byte for byte. The strict drive
 // has none of them: each abort is taken, the drive works in increments, and
 // the two unit objects are said once each.
 TEST(OptionalObjects, DriveUnitsReadAtBootFromADriveWithoutThem) {
@@ -321,10 +321,13 @@ TEST(OptionalObjects, DriveUnitsReadAtBootFromADriveWithoutThem) {
   const std::vector<std::string> sdo = sdo_frames(rig, 0x608F, 0x60AA);
   ASSERT_TRUE(rig.network().all_operational()) << rig.drive(kNode).failure().to_string();
   const std::vector<std::string> golden = {
-      "602#408F600100000000", "582#808F600100000206",  // upload 0x608F:1: abort 0x06020000
+      "602#40A8600000000000", "582#80A8600000000206",  // upload 0x60A8: abort 0x06020000
+      "602#408F600100000000", "582#808F600100000206",  // 0x608F:1
       "602#408F600200000000", "582#808F600200000206",  // 0x608F:2
       "602#4091600100000000", "582#8091600100000206",  // 0x6091:1
       "602#4091600200000000", "582#8091600200000206",  // 0x6091:2
+      "602#4092600100000000", "582#8092600100000206",  // 0x6092:1
+      "602#4092600200000000", "582#8092600200000206",  // 0x6092:2
       "602#40A9600000000000", "582#80A9600000000206",  // 0x60A9
       "602#40AA600000000000", "582#80AA600000000206",  // 0x60AA
   };

@@ -49,4 +49,10 @@ make("unknown-velocity-drive.eds",
 make("older-factor-drive.eds",
      "canmotion test drive: no 0x60A9, but 0x6094 velocity encoder factor 10:1 (older factor objects)",
      [(0x6094, array2(0x6094, "Velocity encoder factor", "Numerator", "Divisor", 10, 1))])
+make("degree-drive.eds",
+     "canmotion test drive: position in 0.1 degree (0x60A8 = 0xFF410000), feed constant 3600 per revolution, "
+     "velocity in rpm (Nanotec's defaults)",
+     [RES, (0x6092, array2(0x6092, "Feed constant", "Feed", "Driving shaft revolutions", 3600, 1)),
+      (0x60A8, var(0x60A8, "SI unit position", "0x0007", "rw", "0xFF410000")),
+      (0x60A9, var(0x60A9, "SI unit velocity", "0x0007", "rw", "0x00B44700"))])
 sys.exit(0)
