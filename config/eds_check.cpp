@@ -193,6 +193,9 @@ std::optional<std::uint64_t> file_value(const eds::Eds& e, std::uint16_t index, 
   return v->resolve(node, s->size());
 }
 
+void unit_needs(const Config& cfg, const AxisSettings& a, std::size_t ai, const std::string& who,
+                std::vector<Diagnostic>& diags);
+
 /// Drive units (README "Drive units"): the counts per unit of the drive's
 /// velocity (0x60A9) and acceleration (0x60AA) values from its EDS/DCF and
 /// `units.velocity`, and what needs them refused when they cannot be known
@@ -266,6 +269,15 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
                                     {0x6096, "velocity factor 2"}})
     if (ds.velocity_unknown.empty()) older(index, name, ds.velocity_counts, ds.velocity_unknown);
   if (ds.acceleration_unknown.empty()) older(0x6097, "acceleration factor", ds.acceleration_counts, ds.acceleration_unknown);
+  unit_needs(cfg, a, ai, who, diags);
+}
+
+/// What needs a drive unit (MDS, homing on the drive, the MDS ramps): refused
+/// when the unit cannot be known, and the ramps checked in the drive's unit
+/// where the file tells it.
+void unit_needs(const Config& cfg, const AxisSettings& a, std::size_t ai, const std::string& who,
+                std::vector<Diagnostic>& diags) {
+  const DriveSettings& ds = a.drive;
   const std::string axis = fmt::format("axes[{}]", ai);
   auto refuse = [&](Location where, const std::string& key, const std::string& what, bool velocity) {
     const std::string& why = velocity ? ds.velocity_unknown : ds.acceleration_unknown;
@@ -281,6 +293,24 @@ void drive_units(const Config& cfg, AxisSettings& a, std::size_t ai, const std::
     if (!ds.velocity_unknown.empty()) refuse(a.direct.where, axis + ".direct_control", what, true);
     if (!ds.acceleration_unknown.empty() && (a.direct.ramp_acceleration || a.direct.ramp_deceleration))
       refuse(a.direct.where, axis + ".direct_control.ramp", what + " ramps (0x6083/0x6084)", false);
+    // The ramps in the drive's unit, where the file tells it (load_axis
+    // checked them in counts): a whole 1 .. 4294967295 of it, never 0.
+    const double conv = a.axis.conversion_constant;
+    auto fits = [&](const std::optional<double>& v, const char* key, const char* object, bool velocity) {
+      const std::optional<double>& per = velocity ? ds.velocity_counts : ds.acceleration_counts;
+      if (!v || !per || ds.units_at_boot) return;
+      const double u = std::round(*v * conv / *per);
+      if (u >= 1 && u <= 4294967295.0) return;
+      diags.push_back({Severity::kError, cfg.path, a.direct.where, axis + ".direct_control.ramp." + key,
+                       fmt::format("{}: {} {} x conversion_constant {} = {} in the drive's {} unit ({} counts per "
+                                   "unit), which does not fit {} (UNSIGNED32, 1 .. 4294967295)",
+                                   who, *v, velocity ? "units/s" : "units/s^2", conv, u,
+                                   velocity ? "velocity" : "acceleration", *per, object)});
+    };
+    fits(a.direct.ramp_acceleration, "acceleration", "0x6083 profile acceleration", false);
+    fits(a.direct.ramp_deceleration, "deceleration", "0x6084 profile deceleration", false);
+    fits(a.direct.ramp_velocity_positive, "velocity_positive", "0x2010:1 ramp velocity - positive", true);
+    fits(a.direct.ramp_velocity_negative, "velocity_negative", "0x2010:2 ramp velocity - negative", true);
   }
   if (a.axis.homing.mode == motion::HomingConfig::Mode::Active &&
       a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate) {

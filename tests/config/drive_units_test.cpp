@@ -281,6 +281,22 @@ TEST(DriveUnits, PositionInTenthsOfADegree) {
   EXPECT_NEAR(r.read("B.ActualVelocity"), 90.0, 1e-9);
 }
 
+TEST(DriveUnits, RampThatRoundsToZeroInTheDrivesUnitIsRefused) {
+  // 0.005 units/s = 20.48 counts/s fits 0x2010:1 in counts, but is 0.3 rpm:
+  // 0 in the rpm drive's unit, which would be a ramp limit of 0.
+  try {
+    (void)load_string(yaml("incs-drive.eds", "rpm-drive.eds", "{mode: velocity, ramp: {velocity_positive: 0.005}}"),
+                      kFile);
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("axes[1].direct_control.ramp.velocity_positive"), std::string::npos) << w;
+    EXPECT_NE(w.find("= 0 in the drive's velocity unit"), std::string::npos) << w;
+    EXPECT_NE(w.find("0x2010:1"), std::string::npos) << w;
+    EXPECT_EQ(w.find("axes[0]"), std::string::npos) << w;  // 20 inc/s is fine
+  }
+}
+
 TEST(DriveUnits, SameShaftSpeedInIncPerSecondAndRpm) {
   const Config c = load_string(yaml("incs-drive.eds", "rpm-drive.eds"), kFile);
   EXPECT_DOUBLE_EQ(*c.axes[0].drive.velocity_counts, 1.0);
