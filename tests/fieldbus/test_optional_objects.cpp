@@ -338,10 +338,11 @@ TEST(OptionalObjects, DriveUnitsReadAtBootFromADriveWithoutThem) {
   EXPECT_EQ(count(n, 0x608F, 1) + count(n, 0x6091, 1), 0u);  // quiet: only the units are said
   ASSERT_EQ(count(n, 0x60A9, 0), 1u);
   ASSERT_EQ(count(n, 0x60AA, 0), 1u);
-  for (const auto& e : n)
-    if (e.index == 0x60A9)
-      EXPECT_NE(cia402::describe_notice(e).find("0x60A9:0 (SI unit velocity) absent (SDO abort 0x06020000"),
-                std::string::npos) << cia402::describe_notice(e);
+  for (const auto& e : n) {
+    if (e.index != 0x60A9) continue;
+    EXPECT_NE(cia402::describe_notice(e).find("0x60A9:0 (SI unit velocity) absent (SDO abort 0x06020000"),
+              std::string::npos) << cia402::describe_notice(e);
+  }
 }
 
 // A unit read at boot that nothing needs and canmotiond cannot interpret is
