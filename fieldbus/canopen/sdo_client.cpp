@@ -17,11 +17,12 @@ can::Frame sdo_frame(std::uint8_t node, std::uint8_t b0, std::uint16_t index, st
 SdoClient::SdoClient(std::uint8_t node, std::int64_t timeout_ns)
     : node_(node), timeout_ns_(timeout_ns), queue_(kQueueCapacity), results_(kResultCapacity) {}
 
-bool SdoClient::download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
-                         std::uint32_t tag) noexcept {
+bool SdoClient::download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data, std::uint32_t tag,
+                         std::int64_t timeout_ns) noexcept {
   if (queue_count_ == kQueueCapacity || data.empty() || data.size() > kSdoMaxDownload) return false;
   Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
   r.tag = tag;
+  r.timeout_ns = timeout_ns;
   r.index = index;
   r.sub = sub;
   r.upload = false;
@@ -31,10 +32,11 @@ bool SdoClient::download(std::uint16_t index, std::uint8_t sub, std::span<const 
   return true;
 }
 
-bool SdoClient::upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag) noexcept {
+bool SdoClient::upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag, std::int64_t timeout_ns) noexcept {
   if (queue_count_ == kQueueCapacity) return false;
   Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
   r.tag = tag;
+  r.timeout_ns = timeout_ns;
   r.index = index;
   r.sub = sub;
   r.upload = true;
@@ -117,18 +119,26 @@ void SdoClient::send_next_download_segment() noexcept {
 void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
   if (f.id != cob::sdo_tx(node_) || f.extended() || f.remote()) return;
   if (phase_ == Phase::kIdle) return;  // late or unsolicited response
-  if (f.len != 8) {
+  if (f.len == 0 || f.len > 8) {
     abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
     return;
   }
-  const sdo::SdoFrame s = sdo::decode(f, true);
+  // A reply shorter than 8 bytes is taken as lely takes it: the bytes it
+  // lacks read as 0, as long as it carries what its command needs (checked
+  // below: the data an expedited or segment reply announces; an abort
+  // without its code is a general error).
+  can::Frame padded = f;
+  std::fill(padded.data.begin() + f.len, padded.data.begin() + 8, std::uint8_t{0});
+  padded.len = 8;
+  const sdo::SdoFrame s = sdo::decode(padded, true);
   if (s.kind == sdo::SdoFrameKind::kAbort) {
+    const SdoAbort code = f.len >= 8 ? static_cast<SdoAbort>(s.abort_code) : SdoAbort::kGeneral;
     // One transfer at a time per server: an abort now is for it, whatever
     // index/sub it names (some servers name another or none). Its code is
     // the answer, not a timeout later; what it named is kept.
     res_.abort_index = s.index;
     res_.abort_sub = s.sub;
-    finish(static_cast<SdoAbort>(s.abort_code), true, now_ns);
+    finish(code, true, now_ns);
     return;
   }
   // An initiate answer naming another object while this transfer waits for
@@ -138,7 +148,7 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
   const bool late = (phase_ == Phase::kInitDownload || phase_ == Phase::kInitUpload) &&
                     (s.kind == sdo::SdoFrameKind::kInitiateDownloadResponse ||
                      s.kind == sdo::SdoFrameKind::kInitiateUploadResponse) &&
-                    (s.index != cur_.index || s.sub != cur_.sub);
+                    f.len >= 4 && (s.index != cur_.index || s.sub != cur_.sub);  // (a shorter one names nothing)
   if (late) return;
   switch (phase_) {
     case Phase::kInitDownload:
@@ -158,7 +168,9 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
     case Phase::kInitUpload:
       if (s.kind != sdo::SdoFrameKind::kInitiateUploadResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
       if (s.expedited) {
-        res_.size = s.data_len;
+        // The bytes it announces must be there (without a size: up to 4, as many as it has).
+        if (f.len < 4 + (s.size_indicated ? s.data_len : 1)) return abort_transfer(SdoAbort::kLengthTooLow, now_ns);
+        res_.size = s.size_indicated ? s.data_len : static_cast<std::uint8_t>(f.len - 4);
         std::copy_n(s.data, s.data_len, res_.data.begin());
         return finish(SdoAbort::kNone, false, now_ns);
       }
@@ -174,6 +186,7 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
     case Phase::kUploadSegment: {
       if (s.kind != sdo::SdoFrameKind::kUploadSegmentResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
       if (s.toggle != toggle_) return abort_transfer(SdoAbort::kToggleBit, now_ns);
+      if (f.len < 1 + s.data_len) return abort_transfer(SdoAbort::kLengthTooLow, now_ns);  // announced, not sent
       if (offset_ + s.data_len > kSdoMaxUpload) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
       std::copy_n(s.data, s.data_len, res_.data.begin() + static_cast<std::ptrdiff_t>(offset_));
       offset_ += s.data_len;
@@ -197,7 +210,7 @@ void SdoClient::step(std::int64_t now_ns, FrameSink& out) noexcept {
     cancel_pending_ = false;
     if (phase_ != Phase::kIdle) abort_transfer(SdoAbort::kGeneral, now_ns);
   }
-  if (phase_ != Phase::kIdle && !tx_pending_ && now_ns - last_tx_ns_ > timeout_ns_) {
+  if (phase_ != Phase::kIdle && !tx_pending_ && now_ns - last_tx_ns_ > timeout_of(cur_)) {
     abort_transfer(SdoAbort::kTimeout, now_ns);
   }
   if (phase_ == Phase::kIdle && !tx_pending_ && queue_count_ > 0) {
@@ -215,7 +228,7 @@ void SdoClient::step(std::int64_t now_ns, FrameSink& out) noexcept {
       tx_refused_since_ns_ = -1;
     } else if (tx_refused_since_ns_ < 0) {
       tx_refused_since_ns_ = now_ns;
-    } else if (now_ns - tx_refused_since_ns_ > timeout_ns_ && phase_ != Phase::kIdle) {
+    } else if (now_ns - tx_refused_since_ns_ > timeout_of(cur_) && phase_ != Phase::kIdle) {
       tx_pending_ = false;
       finish(SdoAbort::kTimeout, false, now_ns);  // (the server never got the request: no abort frame)
     } else if (now_ns - tx_refused_since_ns_ > timeout_ns_) {

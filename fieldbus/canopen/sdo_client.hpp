@@ -2,7 +2,8 @@
 /// \file
 /// Non-blocking SDO client (CiA 301 §7.2.4): expedited and segmented upload
 /// and download, toggle bit checked, every abort reported with its code, a
-/// per-node timeout, transfers queued and run one at a time. It is stepped
+/// per-node timeout (a transfer may have its own), short replies taken as
+/// lely takes them, transfers queued and run one at a time. It is stepped
 /// each cycle: on_frame() feeds the server's responses, step() sends what is
 /// due and checks the timeout, poll() hands out finished transfers.
 /// All member functions except the constructor are realtime-safe.
@@ -69,10 +70,11 @@ class SdoClient {
   [[nodiscard]] std::int64_t timeout() const noexcept { return timeout_ns_; }
 
   /// Queue a write of `data` (1..kSdoMaxDownload bytes; <= 4 bytes go
-  /// expedited, longer ones segmented). False if the queue is full or the
-  /// data too long.
-  bool download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
-                std::uint32_t tag = 0) noexcept;
+  /// expedited, longer ones segmented). `timeout_ns` > 0 is this transfer's
+  /// per-response timeout instead of the client's (a store to 0x1010 takes
+  /// seconds). False if the queue is full or the data too long.
+  bool download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data, std::uint32_t tag = 0,
+                std::int64_t timeout_ns = 0) noexcept;
   /// Queue a write of an integer value in its natural size.
   template <typename T>
     requires std::is_integral_v<T>
@@ -83,12 +85,16 @@ class SdoClient {
     for (std::size_t i = 0; i < sizeof(T); ++i) b[i] = static_cast<std::uint8_t>((u >> (8 * i)) & 0xFFu);
     return download(index, sub, b, tag);
   }
-  /// Queue a read. False if the queue is full.
-  bool upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag = 0) noexcept;
+  /// Queue a read (`timeout_ns` as for download()). False if the queue is full.
+  bool upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag = 0, std::int64_t timeout_ns = 0) noexcept;
 
   /// Feed a frame from the server (ID 0x580 + node; other frames are ignored).
   /// An initiate answer naming another object than the running transfer's
   /// (a late answer to one that timed out or was cancelled) is ignored too.
+  /// A reply shorter than 8 bytes is taken with the bytes it lacks as 0 (as
+  /// lely's client does) when it holds the data it announces (else the
+  /// transfer aborts with 0x06070013); an abort without its code counts as
+  /// 0x08000000.
   void on_frame(const can::Frame& f, std::int64_t now_ns) noexcept;
   /// Start the next transfer, send pending segments, check the timeout.
   void step(std::int64_t now_ns, FrameSink& out) noexcept;
@@ -114,6 +120,7 @@ class SdoClient {
   enum class Phase : std::uint8_t { kIdle, kInitDownload, kDownloadSegment, kInitUpload, kUploadSegment };
   struct Request {
     std::uint32_t tag;
+    std::int64_t timeout_ns;  // 0: the client's
     std::uint16_t index;
     std::uint8_t sub;
     bool upload;
@@ -129,6 +136,9 @@ class SdoClient {
     tx_refused_since_ns_ = -1;
   }
   void send_next_download_segment() noexcept;
+  [[nodiscard]] std::int64_t timeout_of(const Request& r) const noexcept {
+    return r.timeout_ns > 0 ? r.timeout_ns : timeout_ns_;
+  }
 
   std::uint8_t node_;
   std::int64_t timeout_ns_;

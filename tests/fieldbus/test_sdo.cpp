@@ -407,3 +407,77 @@ TEST(FieldbusSdo, PollTagLeavesOtherResultsInOrder) {
   while (c.poll(r)) rest.push_back(r.tag);
   EXPECT_EQ(rest, (std::vector<std::uint32_t>{1, 3, 2}));
 }
+
+// Issue 30 part 3: a reply shorter than 8 bytes is taken as lely's client
+// takes it (the bytes it lacks read as 0) when it holds what its command
+// announces; else the transfer aborts, naming why.
+TEST(FieldbusSdo, ShortRepliesAreTakenAsLelyTakesThem) {
+  canopen::SdoClient c(2, 100 * kMs);
+  VecSink out;
+  canopen::SdoResult r;
+  std::int64_t t = 0;
+  auto answer = [&](const char* reply) {
+    c.step(t += kMs, out);
+    c.on_frame(frame(reply), t += kMs);
+    c.step(t += kMs, out);
+    return c.poll(r);
+  };
+  ASSERT_TRUE(c.download_value<std::uint16_t>(0x1017, 0, 100, 1));
+  ASSERT_TRUE(answer("582#60"));  // download confirmed in 1 byte
+  EXPECT_TRUE(r.ok());
+  ASSERT_TRUE(c.upload(0x1001, 0, 2));
+  ASSERT_TRUE(answer("582#4F0110002A"));  // 1 byte, size indicated: 5 bytes carry it
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.size, 1u);
+  EXPECT_EQ(r.u32(), 0x2Au);
+  ASSERT_TRUE(c.upload(0x1000, 0, 3));
+  ASSERT_TRUE(answer("582#420010000102"));  // expedited without a size: the 2 bytes it has
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.size, 2u);
+  EXPECT_EQ(r.u32(), 0x0201u);
+  ASSERT_TRUE(c.upload(0x1000, 0, 4));
+  ASSERT_TRUE(answer("582#4B001000"));  // 2 bytes announced, none sent
+  EXPECT_EQ(r.abort, SdoAbort::kLengthTooLow);
+  EXPECT_FALSE(r.aborted_by_server);
+  EXPECT_EQ(hex(out.frames.back()), "602#8000100013000706");  // our abort, 0x06070013
+  ASSERT_TRUE(c.upload(0x1000, 0, 5));
+  ASSERT_TRUE(answer("582#80001000"));  // an abort without its code
+  EXPECT_EQ(r.abort, SdoAbort::kGeneral);
+  EXPECT_TRUE(r.aborted_by_server);
+  ASSERT_TRUE(c.upload(0x1000, 0, 6));
+  can::Frame empty = frame("582#00");
+  empty.len = 0;
+  c.step(t += kMs, out);
+  c.on_frame(empty, t += kMs);
+  c.step(t += kMs, out);
+  ASSERT_TRUE(c.poll(r));
+  EXPECT_EQ(r.abort, SdoAbort::kCommandSpecifier);  // nothing to read
+}
+
+// Issue 30 part 3: a transfer may have its own timeout (a store to 0x1010
+// takes seconds); the others keep the client's.
+TEST(FieldbusSdo, PerTransferTimeout) {
+  canopen::SdoClient c(2, 100 * kMs);
+  VecSink out;
+  canopen::SdoResult r;
+  const std::uint8_t save[4] = {'s', 'a', 'v', 'e'};
+  ASSERT_TRUE(c.download(0x1010, 1, save, 1, 3000 * kMs));
+  ASSERT_TRUE(c.upload(0x1000, 0, 2));
+  c.step(0, out);
+  EXPECT_EQ(hex(out.frames.back()), "602#2310100173617665");
+  c.step(101 * kMs, out);
+  EXPECT_FALSE(c.poll(r));  // the client's 100 ms do not apply
+  c.step(3000 * kMs, out);
+  EXPECT_FALSE(c.poll(r));
+  c.step(3000 * kMs + 1, out);
+  ASSERT_TRUE(c.poll(r));
+  EXPECT_EQ(r.tag, 1u);
+  EXPECT_EQ(r.abort, SdoAbort::kTimeout);
+  EXPECT_EQ(r.finished_ns - r.started_ns, 3000 * kMs + 1);
+  c.step(3000 * kMs + 2, out);  // the upload starts, with the client's timeout
+  c.step(3100 * kMs + 3, out);
+  ASSERT_TRUE(c.poll(r));
+  EXPECT_EQ(r.tag, 2u);
+  EXPECT_EQ(r.abort, SdoAbort::kTimeout);
+  EXPECT_EQ(r.finished_ns - r.started_ns, 100 * kMs + 1);
+}
