@@ -159,6 +159,11 @@ struct DriveSettings {
   cia402::MdsObjects mds_objects;
   std::array<std::string, cia402::kMdsObjectCount> mds_object_keys;
   std::array<Location, cia402::kMdsObjectCount> mds_object_where;
+  /// Per MDS object: the drive's EDS has another object where this one
+  /// would go (a vendor object of another name or of a non-integer type at
+  /// the default 0x2010..0x2022, or at the placed address): it is not
+  /// written (check_mds_objects_in_eds; a needed one refuses the file).
+  std::array<bool, cia402::kMdsObjectCount> mds_not_in_eds{};
   /// master_heartbeat_timeout_ms is written in the file (not the default):
   /// then 0x1016 is required, else optional (left out for a drive whose EDS
   /// lacks it, accepted missing without an EDS).

@@ -361,6 +361,7 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
     ds.eds_data = it->second.first;
     ds.dictionary = it->second.second;
     drive_units(cfg, a, ai, who, diags);
+    check_mds_objects_in_eds(cfg, a, ai, who, diags);
     const BusSettings* bus = cfg.find_bus(a.bus);
     if (bus == nullptr) continue;  // cross_check reported it
     const eds::CheckResult r = eds::check(*ds.eds_data, drive_requirements(a, *bus, cfg.controller.period_s, ai));

@@ -37,4 +37,15 @@ namespace canmotion::config {
 /// the configuration has no other error.
 void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags);
 
+/// The MDS objects (`direct_control:`) against axis `a`'s EDS, before its
+/// requirements are built: an object whose address holds another object in
+/// the file (another name at the project's default 0x2010..0x2022, or a
+/// non-integer type anywhere) is marked DriveSettings::mds_not_in_eds, so it
+/// is not written. A write the configuration asks for (ramp objects, SLAT
+/// with `slat:`) is then an error naming the direct_control key and the
+/// drive.mds_objects key that places the object; the SLAT-disabled writes
+/// made without `slat:` are left out with a warning. `who` names the axis.
+void check_mds_objects_in_eds(const Config& cfg, AxisSettings& a, std::size_t ai, const std::string& who,
+                              std::vector<Diagnostic>& diags);
+
 }  // namespace canmotion::config

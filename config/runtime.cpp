@@ -86,6 +86,7 @@ std::vector<KeyedWrite> keyed_direct_control_writes(const AxisSettings& a) {
   };
   // An object CiA 402 lacks, where this drive keeps it (drive.mds_objects).
   auto mds = [&](MdsObject o, Value v, const char* key) {
+    if (a.drive.mds_not_in_eds[static_cast<std::size_t>(o)]) return;  // another object there (check_mds_objects_in_eds)
     const cia402::ObjectAddress at = a.drive.mds_objects[o];
     const std::string& placed = a.drive.mds_object_keys[static_cast<std::size_t>(o)];
     std::string k = key;

@@ -10,7 +10,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "config/eds_check.hpp"
 #include "config/runtime.hpp"
@@ -217,6 +221,78 @@ TEST(MdsObjectsConfig, DriveEdsMustHaveTheRelocatedObjects) {
       << e;
   // At the defaults the same file is fine.
   EXPECT_NO_THROW((void)load_string(yaml("  eds: cia402-emu.eds\n"), examples + "/mds-test.yaml"));
+}
+
+/// cia402-emu.eds with each (from, to) replaced once, written beside the
+/// examples' folder copy under a temporary folder; its path.
+std::string eds_variant(const std::string& name, const std::vector<std::pair<std::string, std::string>>& edits) {
+  std::ifstream in(std::string(CANMOTION_EXAMPLES_DIR) + "/cia402-emu.eds");
+  std::string t((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const auto& [from, to] : edits) {
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+  }
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << t;
+  return path;
+}
+
+TEST(MdsObjectsConfig, AVendorObjectAtTheDefaultAddressIsNeverWritten) {
+  // Ingenia's 0x2020 is "Enable alternative frequency PWM", UNSIGNED8 rw: the
+  // same size as SLAT configuration and writable. Without `slat:` the
+  // SLAT-disabled writes are left out with a warning at the mds_objects key.
+  const std::string eds = eds_variant("vendor-2020.eds", {{"ParameterName=SLAT configuration",
+                                                           "ParameterName=Enable alternative frequency PWM"}});
+  const std::string v_only =
+      "controller: {period_ms: 2}\n"
+      "buses:\n"
+      "  - {name: can0, interface: sim}\n"
+      "axes:\n"
+      "  - name: V\n"
+      "    type: AXIS_CIP_DRIVE\n"
+      "    bus: can0\n"
+      "    node: 2\n"
+      "    conversion_constant: 1000\n"
+      "    direct_control: {mode: velocity}\n"
+      "    drive: {pdo: csp_csv_cst, eds: " + eds + "}\n";
+  const Config c = load_string(v_only, "vendor.yaml");
+  EXPECT_TRUE(writes(c.axes[0]).empty());  // nothing to 0x2020..0x2022 (set point and delay alone mean nothing)
+  ASSERT_EQ(c.warnings.size(), 1u);
+  const std::string w = c.warnings[0].message;
+  EXPECT_EQ(c.warnings[0].key, "axes[0].drive.mds_objects.slat_configuration");
+  EXPECT_NE(w.find(":1418: 0x2020:00 is 'Enable alternative frequency PWM' (UNSIGNED8), not slat_configuration"),
+            std::string::npos)
+      << w;
+  EXPECT_NE(w.find("the SLAT-disabled writes are left out"), std::string::npos) << w;
+  // The project's own file: written as before, without a word.
+  const std::string own = std::string(CANMOTION_EXAMPLES_DIR) + "/cia402-emu.eds";
+  std::string y = v_only;
+  y.replace(y.find(eds), eds.size(), own);
+  const Config o = load_string(y, "vendor.yaml");
+  EXPECT_EQ(writes(o.axes[0]).size(), 3u);
+  EXPECT_TRUE(o.warnings.empty()) << o.warnings[0].message;
+  // With `slat:` the write is asked for: refused at the slat key, naming the
+  // mds_objects key that would place it, and not the read-only/size checks.
+  std::string s = v_only;
+  s.replace(s.find("{mode: velocity}"), 16, "{mode: torque, slat: {configuration: 1, set_point: 2}}");
+  const std::string e = test::errors_of(s, "vendor.yaml");
+  EXPECT_NE(e.find("axes[0].direct_control.slat.configuration: axis 'V' (node 2): "), std::string::npos) << e;
+  EXPECT_NE(e.find("set axes[0].drive.mds_objects.slat_configuration to where this drive keeps it, or remove "
+                   "axes[0].direct_control.slat.configuration"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(e.find("slat.set_point"), std::string::npos) << e;  // 0x2021 is the project's own in this file
+}
+
+TEST(MdsObjectsConfig, APlacedObjectOfANonIntegerTypeIsRefused) {
+  // SCHUNK's 0x2021 is REAL32: the master writes an integer there.
+  const std::string eds = eds_variant(
+      "real-2021.eds", {{"ParameterName=SLAT set point\nObjectType=0x7\nDataType=0x0007",
+                         "ParameterName=SLAT set point\nObjectType=0x7\nDataType=0x0008"}});
+  const std::string e = test::errors_of(yaml("  eds: " + eds + "\n"), "real.yaml");
+  EXPECT_NE(e.find("axes[1].direct_control.slat.set_point: axis 'T' (node 3): "), std::string::npos) << e;
+  EXPECT_NE(e.find("0x2021:00 is 'SLAT set point' (REAL32), not slat_set_point"), std::string::npos) << e;
 }
 
 TEST(SyncConfig, SyncWatchAndTheKeysNamedFor1006And1019) {
