@@ -125,6 +125,31 @@ struct SdoWrite {
   Location where;
 };
 
+/// One ParameterValue of a drive's DCF (`drive.dcf`) written at boot.
+struct DcfValue {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  std::uint8_t size = 4;      ///< bytes: 1..4
+  std::uint32_t value = 0;    ///< the bits (REAL32 as IEEE 754), $NODEID resolved
+  int line = 0;               ///< its section's line in the DCF
+};
+
+/// `drive.dcf`: the commissioning engineer's DCF (CiA 306), the drive's
+/// description and the values written at boot (README "DCF download").
+struct DcfSettings {
+  std::string file;      ///< as written
+  std::string key;       ///< "axes[0].drive.dcf" (or "drives.dcf")
+  Location where;
+  bool store = false;    ///< `store: true`: 0x1010:1 = "save" after the values
+  std::uint32_t store_timeout_ms = 5000;
+  /// Filled by check_drive_descriptions: the values written, in file order
+  /// (0x1020 last), and 0x1020:1/2 when the file has both.
+  std::vector<DcfValue> writes;
+  bool dated = false;
+  std::uint32_t date = 0;
+  std::uint32_t time = 0;
+};
+
 /// `drive.identity`: what 0x1000 and 0x1018:1..3 must read at boot (unset: not compared).
 struct DriveIdentitySettings {
   std::optional<std::uint32_t> device_type;
@@ -180,6 +205,9 @@ struct DriveSettings {
   /// naming the same file. Null without `eds:`.
   std::shared_ptr<const eds::Eds> eds_data;
   std::shared_ptr<const canopen::DeviceDictionary> dictionary;
+  /// `dcf:` (empty file: none). Its file is also the drive's description
+  /// (eds_path and the rest above name it).
+  DcfSettings dcf;
   /// `units: {velocity: inc/s | rpm}`: 0x60A9 (SI unit velocity) written at
   /// boot; the EDS must have a writable 0x60A9. `units_key` names it.
   std::optional<std::uint32_t> velocity_unit;

@@ -364,6 +364,7 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags) {
     check_mds_objects_in_eds(cfg, a, ai, who, diags);
     const BusSettings* bus = cfg.find_bus(a.bus);
     if (bus == nullptr) continue;  // cross_check reported it
+    dcf_download(cfg, a, ai, *bus, who, diags);
     const eds::CheckResult r = eds::check(*ds.eds_data, drive_requirements(a, *bus, cfg.controller.period_s, ai));
     for (const eds::Refusal& x : r.refusals) refused.push_back(x.message);
     for (const eds::Refusal& x : r.refusals)

@@ -45,6 +45,14 @@ void check_drive_descriptions(Config& cfg, std::vector<Diagnostic>& diags);
 /// with `slat:`) is then an error naming the direct_control key and the
 /// drive.mds_objects key that places the object; the SLAT-disabled writes
 /// made without `slat:` are left out with a warning. `who` names the axis.
+/// `drive.dcf` (README "DCF download"): fills DriveSettings::dcf.writes from
+/// the DCF's ParameterValues of writable objects, leaving out what the
+/// master configures itself; a value on an object the master writes with
+/// another value is an error naming the DCF line and the master's key.
+/// Called before the requirements are checked (the writes are among them).
+void dcf_download(const Config& cfg, AxisSettings& a, std::size_t ai, const BusSettings& bus, const std::string& who,
+                  std::vector<Diagnostic>& diags);
+
 void check_mds_objects_in_eds(const Config& cfg, AxisSettings& a, std::size_t ai, const std::string& who,
                               std::vector<Diagnostic>& diags);
 

@@ -118,12 +118,44 @@ std::optional<SdoWrite> sdo_write(Reader& r, const YAML::Node& e, const std::str
   return s;
 }
 
+/// `dcf: FILE` or `dcf: {file, store, store_timeout_ms}` of drive map `n`:
+/// the DCF becomes the drive's description too (an `eds:` of `drives:` is
+/// replaced; both in one map are refused).
+void dcf(Reader& r, const YAML::Node& n, const YAML::Node& f, const std::string& path, DriveSettings& d) {
+  const std::string key = path + ".dcf";
+  DcfSettings s;
+  s.key = key;
+  s.where = r.loc(f);
+  if (f.IsMap()) {
+    if (!r.check_map(f, key, {"file", "store", "store_timeout_ms"})) return;
+    if (!f["file"]) {
+      r.error(f, key, "needs file: the DCF (CiA 306) to write at boot");
+      return;
+    }
+    if (!r.string(f, key, "file", s.file)) return;
+    r.scalar(f, key, "store", s.store, false, true);
+    r.scalar(f, key, "store_timeout_ms", s.store_timeout_ms, 1u, 600'000u, "ms");
+  } else if (!r.string(n, path, "dcf", s.file)) {
+    return;
+  }
+  if (n["eds"]) {
+    r.error(f, key, fmt::format("give {} or {}.eds, not both: a DCF is the drive's EDS with its values", key, path));
+    return;
+  }
+  const std::filesystem::path e(s.file);
+  d.eds = s.file;
+  d.eds_path = e.is_absolute() ? e.string() : (std::filesystem::path(r.file()).parent_path() / e).lexically_normal().string();
+  d.eds_key = key;
+  d.eds_where = s.where;
+  d.dcf = std::move(s);
+}
+
 }  // namespace
 
 void drive(Reader& r, const YAML::Node& n, const std::string& path, DriveSettings& d) {
   if (!r.check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
                              "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds", "sync_watch",
-                             "mds_objects", "units"}))
+                             "mds_objects", "units", "dcf"}))
     return;
   if (const YAML::Node u = n["units"]) {
     const std::string up = path + ".units";
@@ -151,6 +183,7 @@ void drive(Reader& r, const YAML::Node& n, const std::string& path, DriveSetting
     d.eds_key = path + ".eds";
     d.eds_where = r.loc(n["eds"]);
   }
+  if (const YAML::Node f = n["dcf"]) dcf(r, n, f, path, d);
   if (n["timeouts"]) timeouts(r, n["timeouts"], path + ".timeouts", d.timeouts);
   r.enumeration(n, path, "pdo", d.pdo,
                 {{"csp", cia402::PdoProfile::kCsp}, {"csp_csv_cst", cia402::PdoProfile::kCspCsvCst}});

@@ -201,6 +201,13 @@ int describe_sync_counter(const Failure& f, std::span<char> out, double) noexcep
 }
 
 // ---- the factor group, read when the configuration cannot tell the units ----------------
+// ---- 0x1020 verify configuration (CiA 302) -------------------------------------
+CheckVerdict verify_configuration_date(const CheckInput& in) noexcept {
+  const std::uint32_t expected = in.sub == 1 ? in.drive.dcf_date : in.drive.dcf_time;
+  if (in.dcf_same != nullptr && in.value == expected) ++*in.dcf_same;
+  return {};
+}
+
 CheckVerdict verify_unit_factor(const CheckInput& in) noexcept {
   if (in.units == nullptr) return {};
   units::FactorGroup& f = in.units->factors;
@@ -259,7 +266,7 @@ int describe_nothing(const Failure& f, std::span<char> out, double) noexcept {
 }
 
 /// Indexed by BootCheck.
-constexpr std::array<BootCheckRule, 12> kRules{{
+constexpr std::array<BootCheckRule, 13> kRules{{
     {verify_nothing, describe_nothing},                               // kNone
     {verify_device_type, describe_device_type},                       // kDeviceType
     {verify_vendor_id, describe_identity},                            // kVendorId
@@ -272,8 +279,9 @@ constexpr std::array<BootCheckRule, 12> kRules{{
     {verify_unit_factor, describe_nothing},                           // kUnitFactor (always passes)
     {verify_velocity_unit, describe_unit},                            // kVelocityUnit
     {verify_acceleration_unit, describe_unit},                        // kAccelerationUnit
+    {verify_configuration_date, describe_nothing},                    // kConfigurationDate (always passes)
 }};
-static_assert(kRules.size() == static_cast<std::size_t>(BootCheck::kAccelerationUnit) + 1, "one rule per BootCheck");
+static_assert(kRules.size() == static_cast<std::size_t>(BootCheck::kConfigurationDate) + 1, "one rule per BootCheck");
 
 }  // namespace
 

@@ -217,6 +217,14 @@ constexpr BootRow kBootPlan[] = {
      .need = Need::kOptional, .on_abort = kAbsentSaid, .applies = read_units, .hint = kCheckHint,
      .notes = {.absent = "its acceleration values are taken in increments/s^2 (CiA 402 without the factor group)",
                .held = "its acceleration unit 0x%08X is not one canmotiond interprets; nothing configured needs it"}},
+    // CiA 302 verify configuration: the DCF's values (among the extra
+    // writes, SdoWrite::dcf) are left out when 0x1020 shows the DCF's date.
+    {.origin = WriteOrigin::kCheck, .index = 0x1020, .sub = 1, .check = BootCheck::kConfigurationDate,
+     .need = Need::kOptional, .on_abort = kAbsentQuiet, .applies = [](const BootInputs& b) { return b.drive.dcf_dated; },
+     .key = &WriteHints::dcf, .hint = kCheckHint},
+    {.origin = WriteOrigin::kCheck, .index = 0x1020, .sub = 2, .check = BootCheck::kConfigurationDate,
+     .need = Need::kOptional, .on_abort = kAbsentQuiet, .applies = [](const BootInputs& b) { return b.drive.dcf_dated; },
+     .key = &WriteHints::dcf, .hint = kCheckHint},
     {.origin = WriteOrigin::kExtra, .need = Need::kConfigured, .on_abort = kAbsentSaid,
      .expand = [](const BootInputs& b, std::vector<SdoWrite>& out) {
        out.insert(out.end(), b.drive.extra_writes.begin(), b.drive.extra_writes.end());

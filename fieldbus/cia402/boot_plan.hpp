@@ -53,6 +53,13 @@ struct SdoWrite {
   enum class Per : std::uint8_t { kNone, kVelocity, kAcceleration };
   Per per = Per::kNone;
   double counts = 0.0;
+  /// This transfer's per-response SDO timeout (0: the client's), e.g. a
+  /// store to 0x1010 that takes the drive seconds.
+  std::int64_t timeout_ns = 0;
+  /// A value of the drive's DCF (`drive.dcf`): left out when 0x1020 read at
+  /// boot shows the configuration the DCF was made for
+  /// (DriveConfig::dcf_date); the DCF's values wait for that answer.
+  bool dcf = false;
 };
 
 /// Configuration keys to name when the drive refuses a boot configuration
@@ -69,6 +76,7 @@ struct WriteHints {
   std::string sync_counter;          ///< 0x1019, e.g. "buses[0].sync_counter_overflow"
   std::string sync_watch;            ///< 0x1006, e.g. "axes[0].drive.sync_watch"
   std::string velocity_unit;         ///< 0x60A9 written (DriveUnits::write_velocity), e.g. "axes[0].drive.units.velocity"
+  std::string dcf;                   ///< 0x1020 read (DriveConfig::dcf_date), e.g. "axes[0].drive.dcf"
 };
 
 /// What a boot transfer is for (a label of its BootRow: Failure::sdo_origin).
@@ -115,6 +123,11 @@ enum class BootCheck : std::uint8_t {
   /// (DriveUnits::velocity_needed_by), else the velocity is not known (NaN).
   kVelocityUnit,
   kAccelerationUnit,  ///< 0x60AA SI unit acceleration, as kVelocityUnit
+  /// 0x1020:1/2 verify configuration (CiA 302: configuration date and
+  /// time) against the DCF's (DriveConfig::dcf_date): when both match, the
+  /// drive holds that configuration and the DCF's values (SdoWrite::dcf) are
+  /// not written again. Always passes (a drive without 0x1020 gets them).
+  kConfigurationDate,
 };
 
 /// What the boot does with one outcome of a transfer.
@@ -297,6 +310,7 @@ struct CheckInput {
   std::uint16_t index = 0;    ///< the object read
   std::uint8_t sub = 0;
   UnitReadings* units = nullptr;  ///< the unit checks keep what they read here
+  std::uint8_t* dcf_same = nullptr;  ///< kConfigurationDate counts the 0x1020 sub-indices that match here
 };
 
 /// A check's verdict.

@@ -51,7 +51,7 @@ DriveProxy::Taken DriveProxy::check_read(std::size_t i, std::uint32_t v, std::in
   const bool fallback = bw.after >= 0;
   const std::uint32_t trigger_abort = fallback ? transfer_[static_cast<std::size_t>(bw.after)].abort : 0;
   const CheckInput in{cfg_,         v,           fallback ? writes_[static_cast<std::size_t>(bw.after)].w.value : 0u,
-                      &fb_.mode_display, bw.w.index, bw.w.sub, &units_};
+                      &fb_.mode_display, bw.w.index, bw.w.sub, &units_, &dcf_same_};
   const CheckVerdict c = boot_check_rule(bw.check).verify(in);
   std::int64_t waited = 0, timeout = 0;
   switch (c.is) {
@@ -97,6 +97,7 @@ void DriveProxy::forget_drive(std::int64_t now_ns) noexcept {
   for (TransferState& t : transfer_) t.fell_back = false;  // (a notice stays said)
   in_fault_ = emcy_in_fault_ = error_code_asked_ = false;
   again_since_ns_ = -1;
+  dcf_same_ = 0;  // 0x1020 is read again
   if (cfg_.units.read_at_boot) {  // read again by this boot (1: a drive without 0x60A9 / 0x60AA)
     units_ = UnitReadings{};
   }
@@ -201,6 +202,16 @@ void DriveProxy::queue_transfers(canopen::SdoClient& sdo) noexcept {
     const SdoWrite& w = bw.w;
     // A value in the drive's unit waits for the answers before it (the unit reads).
     if (w.per != SdoWrite::Per::kNone && done_writes_ < next_write_) break;
+    // The DCF's values wait for 0x1020's answers, and are left out when the
+    // drive holds the configuration they were made for.
+    if (w.dcf) {
+      if (done_writes_ < next_write_ && (next_write_ == 0 || !writes_[next_write_ - 1].w.dcf)) break;
+      if (cfg_.dcf_dated && dcf_same_ == 2) {
+        ++next_write_;
+        ++done_writes_;
+        continue;
+      }
+    }
     const auto tag = static_cast<std::uint32_t>(next_write_);
     if (bw.is_read()) {
       if (!sdo.upload(w.index, w.sub, tag)) break;
@@ -208,7 +219,7 @@ void DriveProxy::queue_transfers(canopen::SdoClient& sdo) noexcept {
       const std::uint32_t value = in_drive_unit(w);
       std::uint8_t b[4];
       for (int i = 0; i < 4; ++i) b[i] = static_cast<std::uint8_t>(value >> (8 * i));
-      if (!sdo.download(w.index, w.sub, std::span<const std::uint8_t>(b, w.size), tag)) break;
+      if (!sdo.download(w.index, w.sub, std::span<const std::uint8_t>(b, w.size), tag, w.timeout_ns)) break;
     }
     ++next_write_;
   }

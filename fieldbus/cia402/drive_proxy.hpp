@@ -161,6 +161,12 @@ struct DriveConfig {
   /// CiA 301 allows a 0x1019 change only while 0x1006 = 0). 0x1019 gets the
   /// master's MasterConfig::sync_counter_overflow (0: no counter).
   bool sync_watch = false;
+  /// `drive.dcf` with 0x1020 values (CiA 302 verify configuration): read
+  /// at boot; when the drive's 0x1020:1 (date) and :2 (time) are these, the
+  /// DCF's values (SdoWrite::dcf) are not written again.
+  bool dcf_dated = false;
+  std::uint32_t dcf_date = 0;
+  std::uint32_t dcf_time = 0;
 };
 
 /// Where the proxy is in bringing its node up.
@@ -568,6 +574,7 @@ class DriveProxy {
   std::int16_t target_torque_ = 0;
   Feedback fb_{};
   UnitReadings units_{};  // velocity_counts(), acceleration_counts(); read at boot with DriveUnits::read_at_boot
+  std::uint8_t dcf_same_ = 0;  // 0x1020 sub-indices that matched DriveConfig::dcf_date/time this boot (2: skip the DCF)
   bool pos_base_ = false;  // fb_.position has a base (false: the next 0x6064 sets it)
   bool got_tpdo_ = false;
   bool expect_tpdo_ = false;

@@ -117,6 +117,13 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
     if ((v >> 24) != 0) return SdoAbort::kInvalidValue;
     if (ms != 0 && (id == 0 || id > 127)) return SdoAbort::kInvalidValue;
   }
+  // 0x1010 store parameters (CiA 301): "save" makes the values the ones a
+  // reset or power-on starts from; any other value is refused.
+  if (index == 0x1010 && sub >= 1) {
+    if (v != 0x65766173u) return SdoAbort::kDataTransfer;
+    for (Entry& x : od_) x.default_value = x.value;
+    return SdoAbort::kNone;  // (it still reads what it can store: 1, on command)
+  }
   set(index, sub, v);
   if (pdo_obj) rebuild_pdos();
   if (index == 0x1017) next_heartbeat_ns_ = now_ns_ + static_cast<std::int64_t>(v) * 1'000'000;
