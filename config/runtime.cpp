@@ -132,6 +132,37 @@ double drive_wait_limit_s(const DriveTimeouts& t) noexcept {
   return (3.0 * t.boot_ms + t.mode_switch_ms + 4.0 * t.transition_ms) / 1e3;
 }
 
+namespace {
+/// `drive.dcf` (README "DCF download"): its values first among the extra
+/// writes (`store` false), left out at boot when 0x1020 shows the drive
+/// holds them; its store last, after every write (`store` true).
+void dcf_writes(const DriveSettings& ds, cia402::DriveConfig& d, bool store) {
+  const DcfSettings& dcf = ds.dcf;
+  if (dcf.file.empty()) return;
+  if (store) {
+    if (!dcf.store) return;
+    cia402::SdoWrite w{0x1010, 1, 4, 0x65766173u};  // 0x1010:1 store parameters: "save" (CiA 301)
+    w.dcf = true;
+    w.timeout_ns = static_cast<std::int64_t>(dcf.store_timeout_ms) * 1'000'000;
+    d.extra_writes.push_back(w);
+    d.hints.extra.push_back(fmt::format("{}.store", dcf.key));
+    return;
+  }
+  for (const DcfValue& v : dcf.writes) {
+    cia402::SdoWrite w{v.index, v.sub, v.size, v.value};
+    w.dcf = true;
+    d.extra_writes.push_back(w);
+    d.hints.extra.push_back(fmt::format("{} ({}:{})", dcf.key, ds.eds, v.line));
+  }
+  if (dcf.dated) {
+    d.dcf_dated = true;
+    d.dcf_date = dcf.date;
+    d.dcf_time = dcf.time;
+    d.hints.dcf = dcf.key;
+  }
+}
+}  // namespace
+
 cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s, std::size_t axis_index) {
   cia402::DriveConfig d;
   const std::string axis = fmt::format("axes[{}]", axis_index);
@@ -218,21 +249,7 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
     need(d.units.velocity_needed_by, fmt::format("{}.homing (speeds, 0x6099)", axis));
     need(d.units.acceleration_needed_by, fmt::format("{}.homing (acceleration, 0x609A)", axis));
   }
-  // The DCF's values first (README "DCF download"), left out at boot when
-  // 0x1020 shows the drive holds them; its store last, after every write.
-  const DcfSettings& dcf = a.drive.dcf;
-  for (const DcfValue& v : dcf.writes) {
-    cia402::SdoWrite w{v.index, v.sub, v.size, v.value};
-    w.dcf = true;
-    d.extra_writes.push_back(w);
-    d.hints.extra.push_back(fmt::format("{} ({}:{})", dcf.key, a.drive.eds, v.line));
-  }
-  if (dcf.dated) {
-    d.dcf_dated = true;
-    d.dcf_date = dcf.date;
-    d.dcf_time = dcf.time;
-    d.hints.dcf = dcf.key;
-  }
+  dcf_writes(a.drive, d, false);
   for (const KeyedWrite& k : keyed_direct_control_writes(a)) {
     d.extra_writes.push_back(k.write);
     d.hints.extra.push_back(fmt::format("{}.{}", axis, k.key));
@@ -242,13 +259,7 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
     d.extra_writes.push_back({w.index, w.sub, w.size, static_cast<std::uint32_t>(static_cast<std::int64_t>(w.value))});
     d.hints.extra.push_back(fmt::format("{}.drive.sdo_writes[{}] (line {})", axis, i, w.where.line));
   }
-  if (dcf.store && !dcf.file.empty()) {  // 0x1010:1 store parameters: "save" (CiA 301)
-    cia402::SdoWrite w{0x1010, 1, 4, 0x65766173u};
-    w.dcf = true;
-    w.timeout_ns = static_cast<std::int64_t>(dcf.store_timeout_ms) * 1'000'000;
-    d.extra_writes.push_back(w);
-    d.hints.extra.push_back(fmt::format("{}.store", dcf.key));
-  }
+  dcf_writes(a.drive, d, true);
   return d;
 }
 
