@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 #include "config/runtime.hpp"
 #include "tests/config/config_errors.hpp"
 #include "tests/config/runtime_rig.hpp"
@@ -70,7 +72,7 @@ std::string drive_file(bool dcf, const std::string& name) {
                  "ParameterValue=-1000\n");
   }
   t += "\n" + store_and_verify(dcf);
-  const std::string path = ::testing::TempDir() + name;
+  const std::string path = ::testing::TempDir() + std::to_string(::getpid()) + "-" + name;
   std::ofstream(path) << t;
   return path;
 }

@@ -16,6 +16,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 #include "config/eds_check.hpp"
 #include "config/runtime.hpp"
 #include "fieldbus/cia402/cia402.hpp"
@@ -233,7 +235,7 @@ std::string eds_variant(const std::string& name, const std::vector<std::pair<std
     EXPECT_NE(at, std::string::npos) << from;
     if (at != std::string::npos) t.replace(at, from.size(), to);
   }
-  const std::string path = ::testing::TempDir() + name;
+  const std::string path = ::testing::TempDir() + std::to_string(::getpid()) + "-" + name;
   std::ofstream(path) << t;
   return path;
 }
