@@ -200,7 +200,6 @@ int describe_sync_counter(const Failure& f, std::span<char> out, double) noexcep
                        key_or(f, "the master's SYNC counter overflow"), f.read_value, f.expected);
 }
 
-// ---- the factor group, read when the configuration cannot tell the units ----------------
 // ---- 0x1020 verify configuration (CiA 302) -------------------------------------
 CheckVerdict verify_configuration_date(const CheckInput& in) noexcept {
   const std::uint32_t expected = in.sub == 1 ? in.drive.dcf_date : in.drive.dcf_time;
@@ -208,6 +207,7 @@ CheckVerdict verify_configuration_date(const CheckInput& in) noexcept {
   return {};
 }
 
+// ---- the factor group, read when the configuration cannot tell the units ----------------
 CheckVerdict verify_unit_factor(const CheckInput& in) noexcept {
   if (in.units == nullptr) return {};
   units::FactorGroup& f = in.units->factors;
