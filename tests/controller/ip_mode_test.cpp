@@ -106,6 +106,8 @@ TEST(IpMode, SameMoveEndsWhereCspEndsIt) {
   const std::int64_t end_csp = csp.move(12.345);
   IpRig ip(cia402::Mode::kInterpolatedPosition);
   const std::int64_t end_ip = ip.move(12.345);
+  RecordProperty("end_csp_counts", std::to_string(end_csp));
+  RecordProperty("end_ip_counts", std::to_string(end_ip));
   EXPECT_NEAR(static_cast<double>(end_csp), 12345.0, 1.0);
   EXPECT_LE(std::llabs(end_ip - end_csp), 1) << "CSP ended at " << end_csp << ", IP at " << end_ip;
   EXPECT_EQ(test::counted_allocations(), 0u) << test::counted_bytes() << " bytes allocated in the cycle";
