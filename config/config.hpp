@@ -163,6 +163,12 @@ struct DriveIdentitySettings {
 struct DriveSettings {
   DriveTimeouts timeouts;
   cia402::PdoProfile pdo = cia402::PdoProfile::kCsp;
+  /// `mode:` the position stream's mode of operation: csp (0x6060 = 8,
+  /// 0x607A, default) or ip (0x6060 = 7 interpolated position, 0x60C0 = 0
+  /// linear when the drive has it, 0x60C1:1 in 0x607A's place, controlword
+  /// bit 4). `mode_where`: its line (line 0: not written).
+  cia402::Mode mode = cia402::Mode::kCsp;
+  Location mode_where;
   std::uint16_t heartbeat_ms = 50;                ///< drive heartbeat producer (0x1017)
   std::uint16_t master_heartbeat_timeout_ms = 300;  ///< drive's consumer of the master's heartbeat (0x1016); 0 = off
   std::uint16_t following_error_window = 0;       ///< written to 0x6065 when non-zero (counts)

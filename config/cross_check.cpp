@@ -188,7 +188,7 @@ canopen::NodeTraffic node_traffic(const Config& cfg, std::size_t ai, CobIds& cob
   const AxisSettings& a = cfg.axes[ai];
   const std::string key = fmt::format("axes[{}].node", ai);
   const std::string who = fmt::format("axis '{}' (node {})", a.name, a.node);
-  const auto pdos = cia402::default_drive_pdos(a.drive.pdo, a.node);
+  const auto pdos = cia402::default_drive_pdos(a.drive.pdo, a.node, a.drive.mode);
   cobs.claim(canopen::cob::heartbeat(a.node), who + " heartbeat", a.where, key);
   cobs.claim(canopen::cob::sdo_tx(a.node), who + " SDO", a.where, key);
   cobs.claim(canopen::cob::emcy(a.node), who + " EMCY", a.where, key);
@@ -217,6 +217,13 @@ void axis_on_bus_checks(Reader& r, const Config& cfg, const BusSettings& bus, st
     r.error_at(a.where, fmt::format("axes[{}].drive.master_heartbeat_timeout_ms", ai),
                fmt::format("{} ms must exceed the master's heartbeat period {} ms (CiA 301: consumer time > producer time)",
                            a.drive.master_heartbeat_timeout_ms, bus.master_heartbeat_ms));
+  // drive.mode: ip streams positions only: MDS (CSV/CST) switches from CSP
+  // and back, which an IP drive's RPDO (0x60C1:1, no 0x607A) cannot carry.
+  if (a.drive.mode == cia402::Mode::kInterpolatedPosition && a.direct.present)
+    r.error_at(a.drive.mode_where.line > 0 ? a.drive.mode_where : a.where, fmt::format("axes[{}].drive.mode", ai),
+               fmt::format("'ip' (interpolated position, 0x6060 = 7) cannot be used with axes[{}].direct_control (MDS "
+                           "runs the drive in CSV/CST and switches back to CSP): use mode csp or remove direct_control",
+                           ai));
   for (std::size_t wi = 0; wi < a.drive.sdo_writes.size(); ++wi) {
     const SdoWrite& w = a.drive.sdo_writes[wi];
     if (w.index != 0x60C2 || !ip) continue;

@@ -140,7 +140,7 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
     else if (w.origin == cia402::WriteOrigin::kUnusedPdo) u.key = d.hints.pdo;
     req.uses.push_back(std::move(u));
   }
-  const cia402::DrivePdoSet pdos = cia402::default_drive_pdos(d.pdo_profile, d.node);
+  const cia402::DrivePdoSet pdos = cia402::default_drive_pdos(d.pdo_profile, d.node, d.mode);
   req.rpdos = pdos.rpdo_count;
   req.tpdos = pdos.tpdo_count;
   auto map = [&](const canopen::PdoMap& m, eds::Usage usage) {
@@ -157,17 +157,22 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
   };
   for (std::uint8_t p = 0; p < pdos.rpdo_count; ++p) map(pdos.rpdo[p], eds::Usage::kMapRpdo);
   for (std::uint8_t p = 0; p < pdos.tpdo_count; ++p) map(pdos.tpdo[p], eds::Usage::kMapTpdo);
-  // 0x6502: CSP always; CSV and CST when the PDO profile carries their targets.
-  std::uint64_t modes = cia402::supported_mode_bit(cia402::Mode::kCsp);
-  if (d.pdo_profile == cia402::PdoProfile::kCspCsvCst)
-    modes |= cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst);
+  // 0x6502: the position stream's mode (drive.mode: CSP, or IP bit 6),
+  // then CSV and CST when the PDO profile carries their targets.
   eds::Use m;
   m.index = cia402::obj::kSupportedDriveModes;
   m.usage = eds::Usage::kRead;
-  m.required_bits = modes;
   m.optional = true;
-  m.key = d.hints.pdo;
+  std::uint64_t modes = cia402::supported_mode_bit(d.mode);
+  m.required_bits = modes;
+  m.key = d.hints.mode.empty() ? d.hints.pdo : d.hints.mode;
   req.uses.push_back(m);
+  if (d.pdo_profile == cia402::PdoProfile::kCspCsvCst) {
+    m.required_bits = cia402::supported_mode_bit(cia402::Mode::kCsv) | cia402::supported_mode_bit(cia402::Mode::kCst);
+    modes |= m.required_bits;
+    m.key = d.hints.pdo;
+    req.uses.push_back(m);
+  }
   // The other modes the proxy checks 0x6502 for at boot (MDS, homing), each
   // with the key that needs it.
   for (const cia402::ModeNeed& need : d.needed_modes) {

@@ -153,7 +153,7 @@ void dcf(Reader& r, const YAML::Node& n, const YAML::Node& f, const std::string&
 }  // namespace
 
 void drive(Reader& r, const YAML::Node& n, const std::string& path, DriveSettings& d) {
-  if (!r.check_map(n, path, {"timeouts", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
+  if (!r.check_map(n, path, {"timeouts", "mode", "pdo", "heartbeat_ms", "master_heartbeat_timeout_ms",
                              "following_error_window", "sdo_writes", "identity", "quick_stop_option", "eds", "sync_watch",
                              "mds_objects", "units", "dcf"}))
     return;
@@ -185,6 +185,8 @@ void drive(Reader& r, const YAML::Node& n, const std::string& path, DriveSetting
   }
   if (const YAML::Node f = n["dcf"]) dcf(r, n, f, path, d);
   if (n["timeouts"]) timeouts(r, n["timeouts"], path + ".timeouts", d.timeouts);
+  if (r.enumeration(n, path, "mode", d.mode, {{"csp", cia402::Mode::kCsp}, {"ip", cia402::Mode::kInterpolatedPosition}}))
+    d.mode_where = r.loc(n["mode"]);
   r.enumeration(n, path, "pdo", d.pdo,
                 {{"csp", cia402::PdoProfile::kCsp}, {"csp_csv_cst", cia402::PdoProfile::kCspCsvCst}});
   r.scalar(n, path, "heartbeat_ms", d.heartbeat_ms, std::uint16_t{0}, std::uint16_t{65535}, "ms");

@@ -196,7 +196,9 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
       a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate)
     d.needed_modes.push_back({cia402::Mode::kHoming, fmt::format("{}.homing.sequence (MAH homes on the drive, mode 6)", axis)});
   d.node = a.node;
-  d.mode = cia402::Mode::kCsp;
+  d.mode = a.drive.mode;  // csp, or ip (drive.mode: ip): the position stream's mode
+  d.hints.mode = fmt::format("{}.drive.mode: {} (or drives.mode)", axis,
+                             d.mode == cia402::Mode::kInterpolatedPosition ? "ip" : "csp");
   d.cycle_ns = period_ns(period_s);
   d.pdo_profile = a.drive.pdo;
   d.producer_heartbeat_ms = a.drive.heartbeat_ms;

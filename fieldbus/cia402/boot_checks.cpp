@@ -82,6 +82,7 @@ CheckVerdict verify_supported_modes(const CheckInput& in) noexcept {
   if ((in.value & supported_mode_bit(in.drive.mode)) == 0) {
     c.is = Is::kFail;
     c.expected = mode_value(in.drive.mode);
+    if (!in.drive.hints.mode.empty()) c.key = &in.drive.hints.mode;
     return c;
   }
   for (const ModeNeed& m : in.drive.needed_modes) {

@@ -16,9 +16,10 @@ namespace canmotion::cia402 {
 namespace {
 
 // ---- the sentences after a refusal (Failure::describe) ------------------------
-constexpr BootHint kModeHint{"; canmotiond runs every drive in a cyclic synchronous mode (0x6060 = 8, 9 or 10): "
-                             "the drive must accept it",
-                             "; canmotiond runs every drive in a cyclic synchronous mode (0x6060 = 8, 9 or 10): "
+constexpr BootHint kModeHint{"; the mode comes from %s (csp: 0x6060 = 8; ip: 0x6060 = 7 and 0x60C0 = 0, linear "
+                             "interpolation): the drive must accept it",
+                             "; canmotiond runs every drive in a cyclic synchronous mode (0x6060 = 8, 9 or 10) "
+                             "or, with drive.mode: ip, in interpolated position mode (0x6060 = 7, 0x60C0 = 0 linear): "
                              "the drive must accept it"};
 constexpr BootHint kPeriodHint{"; 0x60C2 is the cycle period, %s: the drive must accept it in cyclic synchronous modes",
                                "; 0x60C2 is the cycle period: the drive must accept it in cyclic synchronous modes"};
@@ -109,7 +110,15 @@ constexpr BootRow kBootPlan[] = {
      .need = Need::kOptional, .on_abort = kAbsentSaid, .hint = kCheckHint,
      .notes = {.absent = "the modes the configuration needs are not checked"}},
     {.origin = WriteOrigin::kMode, .index = obj::kModesOfOperation, .size = 1,
-     .value = [](const BootInputs& b) -> std::uint32_t { return mode_byte(b.drive.mode); }, .hint = kModeHint},
+     .value = [](const BootInputs& b) -> std::uint32_t { return mode_byte(b.drive.mode); }, .key = &WriteHints::mode,
+     .hint = kModeHint},
+    // IP (mode 7): sub-mode 0 = linear interpolation. 0x60C0 is optional
+    // (CiA 402): a drive without it interpolates linearly by default.
+    {.origin = WriteOrigin::kMode, .index = obj::kInterpolationSubModeSelect, .size = 2, .need = Need::kOptional,
+     .on_abort = kAbsentSaid, .applies = [](const BootInputs& b) { return b.drive.mode == Mode::kInterpolatedPosition; },
+     .key = &WriteHints::mode, .hint = kModeHint,
+     .notes = {.absent = "the drive has no interpolation sub-mode select (0x60C0): its default, linear interpolation, "
+                         "is taken"}},
     {.origin = WriteOrigin::kInterpolationPeriod, .index = obj::kInterpolationTimePeriod, .sub = 1, .size = 1,
      .value = [](const BootInputs& b) -> std::uint32_t { return period(b).value; },
      .key = &WriteHints::interpolation_period, .hint = kPeriodHint},

@@ -77,6 +77,7 @@ struct WriteHints {
   std::string sync_watch;            ///< 0x1006, e.g. "axes[0].drive.sync_watch"
   std::string velocity_unit;         ///< 0x60A9 written (DriveUnits::write_velocity), e.g. "axes[0].drive.units.velocity"
   std::string dcf;                   ///< 0x1020 read (DriveConfig::dcf_date), e.g. "axes[0].drive.dcf"
+  std::string mode;                  ///< 0x6060 / the 0x6502 check of DriveConfig::mode, e.g. "axes[0].drive.mode: ip"
 };
 
 /// What a boot transfer is for (a label of its BootRow: Failure::sdo_origin).

@@ -76,6 +76,13 @@ inline constexpr std::uint16_t kHomingAcceleration = 0x609A;
 inline constexpr std::uint16_t kPositionOffset = 0x60B0;
 inline constexpr std::uint16_t kVelocityOffset = 0x60B1;
 inline constexpr std::uint16_t kTorqueOffset = 0x60B2;
+/// INTEGER16 interpolation sub-mode select (optional): 0 = linear
+/// interpolation (the default), negative = manufacturer-specific.
+inline constexpr std::uint16_t kInterpolationSubModeSelect = 0x60C0;
+/// ARRAY/RECORD interpolation data record: sub1 the position set point of
+/// interpolated position mode (INTEGER32, mapped synchronous like CSP's 0x607A).
+inline constexpr std::uint16_t kInterpolationDataRecord = 0x60C1;
+inline constexpr std::uint8_t kInterpolationDataPositionSub = 1;
 inline constexpr std::uint16_t kInterpolationTimePeriod = 0x60C2;  ///< sub1 value (U8), sub2 index (I8)
 inline constexpr std::uint16_t kFollowingErrorActualValue = 0x60F4;
 inline constexpr std::uint16_t kDigitalInputs = 0x60FD;
@@ -294,6 +301,9 @@ inline constexpr std::uint16_t kFollowsCommand = kOpMode12;
 inline constexpr std::uint16_t kFollowingError = kOpMode13;
 inline constexpr std::uint16_t kHomingAttained = kOpMode12;
 inline constexpr std::uint16_t kHomingError = kOpMode13;
+/// IP (mode 7): "ip mode active", the drive takes the 0x60C1 set points
+/// (controlword bit 4 set in Operation enabled).
+inline constexpr std::uint16_t kIpModeActive = kOpMode12;
 /// Masks for state decoding (§1.1): short for states that ignore bit 5.
 inline constexpr std::uint16_t kStateMaskShort = 0x004F;
 inline constexpr std::uint16_t kStateMaskLong = 0x006F;
@@ -312,6 +322,8 @@ inline constexpr std::uint16_t kHalt = 1u << 8;
 inline constexpr std::uint16_t kOpMode9 = 1u << 9;  ///< PP: change on set-point
 inline constexpr std::uint16_t kHomingStart = kOpMode4;
 inline constexpr std::uint16_t kNewSetPoint = kOpMode4;
+/// IP (mode 7): "enable ip mode"; the drive ignores the set points while it is 0.
+inline constexpr std::uint16_t kEnableIpMode = kOpMode4;
 /// Bits that select the state machine command (0, 1, 2, 3, 7).
 inline constexpr std::uint16_t kCommandMask = 0x008F;
 }  // namespace cw
@@ -670,6 +682,15 @@ enum class Mode : std::int8_t {
   return m == Mode::kCsp || m == Mode::kCsv || m == Mode::kCst;
 }
 
+/// True for the modes the master sends a set point in every cycle: the cyclic
+/// synchronous ones and interpolated position (7, 0x60C1:1 over 0x60C2).
+[[nodiscard]] constexpr bool is_streamed(Mode m) noexcept { return is_cyclic(m) || m == Mode::kInterpolatedPosition; }
+
+/// True for the modes whose set point is a position: CSP (0x607A) and IP (0x60C1:1).
+[[nodiscard]] constexpr bool is_position_stream(Mode m) noexcept {
+  return m == Mode::kCsp || m == Mode::kInterpolatedPosition;
+}
+
 // ============================================================================
 // Homing status (statusword bits 13, 12, 10; mask 0x3400) §3.3
 // ============================================================================
@@ -700,7 +721,9 @@ enum class HomingStatus : std::uint8_t {
 /// What statusword bits 7 (warning), 11 (internal limit active), 12 and 13
 /// (operation mode specific) say in the mode 0x6061 shows. Bits 12 and 13
 /// mean different things per mode: in CSP, CSV and CST bit 12 is "drive
-/// follows the command value" (0: the target is ignored); in CSP bit 13 is
+/// follows the command value" (0: the target is ignored), in IP "ip mode
+/// active" (0: the 0x60C1 set points are ignored), both decoded as
+/// follows_command; in CSP bit 13 is
 /// "following error" (in CSV and CST it is reserved); in homing they are
 /// homing attained / homing error (decode_homing_status()), in profile
 /// position set-point acknowledge / following error. Only what the master
@@ -709,7 +732,7 @@ enum class HomingStatus : std::uint8_t {
 struct StatusBits {
   bool warning = false;          ///< bit 7, every mode
   bool internal_limit = false;   ///< bit 11, every mode
-  bool follows_command = false;  ///< bit 12 in CSP, CSV, CST
+  bool follows_command = false;  ///< bit 12 in CSP, CSV, CST; IP: ip mode active
   bool following_error = false;  ///< bit 13 in CSP and PP
   friend constexpr bool operator==(const StatusBits&, const StatusBits&) = default;
 };
@@ -717,7 +740,7 @@ struct StatusBits {
   StatusBits b;
   b.warning = (statusword & sw::kWarning) != 0;
   b.internal_limit = (statusword & sw::kInternalLimitActive) != 0;
-  b.follows_command = is_cyclic(mode) && (statusword & sw::kFollowsCommand) != 0;
+  b.follows_command = is_streamed(mode) && (statusword & sw::kFollowsCommand) != 0;
   b.following_error = (mode == Mode::kCsp || mode == Mode::kProfilePosition) && (statusword & sw::kFollowingError) != 0;
   return b;
 }

@@ -4,14 +4,15 @@
 
 namespace canmotion::cia402 {
 
-DrivePdoSet default_drive_pdos(PdoProfile profile, std::uint8_t node) noexcept {
+DrivePdoSet default_drive_pdos(PdoProfile profile, std::uint8_t node, Mode mode) noexcept {
   using canopen::PdoDir;
   using canopen::PdoMap;
   namespace cob = canopen::cob;
   DrivePdoSet s;
   PdoMap r1{PdoDir::kRpdo, 1, cob::rpdo(1, node)};
   r1.add(obj::kControlword, 0, 16);
-  r1.add(obj::kTargetPosition, 0, 32);
+  if (mode == Mode::kInterpolatedPosition) r1.add(obj::kInterpolationDataRecord, obj::kInterpolationDataPositionSub, 32);
+  else r1.add(obj::kTargetPosition, 0, 32);
   r1.finalize();
   PdoMap t1{PdoDir::kTpdo, 1, cob::tpdo(1, node)};
   t1.add(obj::kStatusword, 0, 16);

@@ -7,6 +7,7 @@
 
 #include "fieldbus/canopen/bus_budget.hpp"
 #include "fieldbus/canopen/pdo.hpp"
+#include "fieldbus/cia402/cia402.hpp"
 
 namespace canmotion::cia402 {
 
@@ -30,8 +31,10 @@ struct DrivePdoSet {
   std::uint8_t tpdo_count = 0;
 };
 
-/// Build the default maps. Realtime-safe (constexpr data only).
-[[nodiscard]] DrivePdoSet default_drive_pdos(PdoProfile profile, std::uint8_t node) noexcept;
+/// Build the default maps. With `mode` interpolated position (7) RPDO1
+/// carries 0x60C1:1 (interpolation data record) where 0x607A is.
+/// Realtime-safe (constexpr data only).
+[[nodiscard]] DrivePdoSet default_drive_pdos(PdoProfile profile, std::uint8_t node, Mode mode = Mode::kCsp) noexcept;
 
 /// The cyclic bus traffic of one drive with `profile` (for
 /// canopen::bus_budget / canopen::max_axes), with the drive's heartbeat

@@ -19,9 +19,9 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
     throw std::invalid_argument("node-ID " + std::to_string(cfg_.node) +
                                 " is invalid (1..127, not the master's own ID) or already used");
   }
-  if (!is_cyclic(cfg_.mode) && cfg_.mode != Mode::kHoming) {
+  if (!is_streamed(cfg_.mode) && cfg_.mode != Mode::kHoming) {
     throw std::invalid_argument("node " + std::to_string(cfg_.node) + ": mode " + std::string(mode_name(cfg_.mode)) +
-                                " is not supported by the proxy (valid: 8 CSP, 9 CSV, 10 CST, 6 homing)");
+                                " is not supported by the proxy (valid: 8 CSP, 9 CSV, 10 CST, 7 IP, 6 homing)");
   }
   if (!encode_interpolation_period(cfg_.cycle_ns)) {
     throw std::invalid_argument("node " + std::to_string(cfg_.node) + ": cycle period " + std::to_string(cfg_.cycle_ns) +
@@ -30,19 +30,24 @@ DriveProxy::DriveProxy(const DriveConfig& cfg, canopen::Master& master) : cfg_(c
   mode_ = cfg_.mode;
   units_.velocity_counts = cfg_.units.velocity_counts;
   units_.acceleration_counts = cfg_.units.acceleration_counts;
-  pdos_ = default_drive_pdos(cfg_.pdo_profile, cfg_.node);
-  auto find = [this](bool rx, std::uint16_t index) {
+  pdos_ = default_drive_pdos(cfg_.pdo_profile, cfg_.node, cfg_.mode);
+  auto find = [this](bool rx, std::uint16_t index, std::uint8_t sub = 0) {
     Slot s;
     const auto& arr = rx ? pdos_.rpdo : pdos_.tpdo;
     const std::uint8_t n = rx ? pdos_.rpdo_count : pdos_.tpdo_count;
     for (std::uint8_t p = 0; p < n; ++p) {
-      const int e = arr[p].find(index, 0);
+      const int e = arr[p].find(index, sub);
       if (e >= 0) return Slot{static_cast<std::int8_t>(p), static_cast<std::int8_t>(e)};
     }
     return s;
   };
   cw_slot_ = find(true, obj::kControlword);
+  // The position set point: 0x607A (CSP), or in IP 0x60C1:1 in its place.
   tpos_slot_ = find(true, obj::kTargetPosition);
+  if (tpos_slot_.pdo < 0) {
+    tpos_slot_ = find(true, obj::kInterpolationDataRecord, obj::kInterpolationDataPositionSub);
+    if (tpos_slot_.pdo >= 0) position_mode_ = Mode::kInterpolatedPosition;
+  }
   tvel_slot_ = find(true, obj::kTargetVelocity);
   ttrq_slot_ = find(true, obj::kTargetTorque);
   mode_slot_ = find(true, obj::kModesOfOperation);
@@ -306,7 +311,9 @@ void DriveProxy::step_homing(std::int64_t now_ns) noexcept {
 }
 
 bool DriveProxy::set_mode(Mode m) noexcept {
-  if (!is_cyclic(m) && m != Mode::kHoming) return false;
+  if (!is_streamed(m) && m != Mode::kHoming) return false;
+  // A position stream only on the object the RPDO carries (0x607A: CSP; 0x60C1:1: IP).
+  if (is_position_stream(m) && m != position_mode_) return false;
   if (m != Mode::kHoming) cancel_homing();
   if (mode_slot_.pdo < 0) {
     if (!master_.sdo(cfg_.node).download_value<std::int8_t>(obj::kModesOfOperation, 0, static_cast<std::int8_t>(m), kModeWriteTag))
@@ -341,6 +348,10 @@ bool DriveProxy::set_mode(Mode m) noexcept {
         homing_sync_ = homing_fresh_ = false;
       }
       if (homing_step_ == HomingStep::kStarted) cw_ = static_cast<std::uint16_t>(cw_ | cw::kHomingStart);
+      // IP: bit 4 "enable ip mode" only in Operation enabled (every other
+      // controlword goes out with it clear: disable, quick stop, fault).
+      if (mode_ == Mode::kInterpolatedPosition && !mode_switch_pending_)
+        cw_ = static_cast<std::uint16_t>(cw_ | cw::kEnableIpMode);
       break;
     case State::kSwitchedOn: cw_ = cia402::controlword(Command::kSwitchOn); break;
     case State::kReadyToSwitchOn: cw_ = cia402::controlword(Command::kShutdown); break;
@@ -374,7 +385,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
 [[gnu::always_inline]] inline void DriveProxy::step_state_machine(std::int64_t now_ns) noexcept {
   state_ = decode_state(fb_.statusword);
   if (state_ != State::kOperationEnabled) leaving_enabled_ = false;  // it acted (or faulted)
-  // Bit 12 in CSP (awaiting_follow()): latched once seen in this Operation enabled.
+  // Bit 12 in CSP or IP (awaiting_follow()): latched once seen in this Operation enabled.
   if (state_ != State::kOperationEnabled) {
     follow_ok_ = follow_waiting_ = false;
   } else if (!awaiting_follow()) {
@@ -454,7 +465,7 @@ bool DriveProxy::set_mode(Mode m) noexcept {
   ++flight_cycles_;
 }
 
-// Operation enabled in CSP without statusword bit 12 (awaiting_follow()):
+// Operation enabled in CSP or IP without statusword bit 12 (awaiting_follow()):
 // timed like a transition (4, the one that was to make the drive follow),
 // failing once with Failure::follow_missing. From step_state_machine() only.
 void DriveProxy::wait_follow(std::int64_t now_ns) noexcept {

@@ -396,14 +396,15 @@ class DriveProxy {
   }
   /// In CSP, Operation enabled counts as reached only once statusword bit 12
   /// (drive follows the command) shows it: until then the drive may ignore
-  /// 0x607A. True from the TPDO that shows Operation enabled in CSP without
+  /// 0x607A. In IP the same with bit 12 "ip mode active" (the drive takes
+  /// 0x60C1:1 once it saw controlword bit 4 in Operation enabled). True from the TPDO that shows Operation enabled in CSP without
   /// bit 12 until one shows it set (then latched while the drive stays in
   /// Operation enabled; a later bit 12 = 0 is only reported, see
   /// cia402::decode_status_bits()). The wait is timed with
   /// DriveConfig::transition_timeout_ns, then a kTransitionTimeout failure
   /// with Failure::follow_missing. Realtime-safe.
   [[nodiscard]] bool awaiting_follow() const noexcept {
-    return state_ == State::kOperationEnabled && !follow_ok_ && mode_ == Mode::kCsp &&
+    return state_ == State::kOperationEnabled && !follow_ok_ && is_position_stream(mode_) &&
            (fb_.statusword & sw::kFollowsCommand) == 0;
   }
   /// True while no transition is in progress (the state is the wanted one).
@@ -425,6 +426,10 @@ class DriveProxy {
   [[nodiscard]] double acceleration_counts() const noexcept { return units_.acceleration_counts; }
   [[nodiscard]] const UnitReadings& unit_readings() const noexcept { return units_; }
   [[nodiscard]] Mode mode() const noexcept { return mode_; }
+  /// The position-stream mode the RPDOs carry: kCsp (0x607A) or
+  /// kInterpolatedPosition (0x60C1:1, DriveConfig::mode 7). A planner's CSP
+  /// is sent in this mode.
+  [[nodiscard]] Mode position_mode() const noexcept { return position_mode_; }
   [[nodiscard]] std::int64_t target_position() const noexcept { return target_position_; }
   [[nodiscard]] std::int32_t target_velocity() const noexcept { return target_velocity_; }
   [[nodiscard]] std::int16_t target_torque() const noexcept { return target_torque_; }
@@ -563,6 +568,7 @@ class DriveProxy {
   bool reset_after_start_ = false;
 
   Mode mode_ = Mode::kCsp;
+  Mode position_mode_ = Mode::kCsp;  // position_mode()
   Mode sdo_mode_pending_ = Mode::kNoMode;
   bool mode_switch_pending_ = false;      // set_mode() waits for 0x6061 (mode_switch_timeout_ns)
   std::int64_t mode_switch_since_ns_ = 0;

@@ -52,6 +52,7 @@ std::uint16_t Emulator::statusword() const noexcept {
   const auto mode = static_cast<cia402::Mode>(mode_display_);
   if (state_ == State::kOperationEnabled) {
     if (cia402::is_cyclic(mode)) sw |= cia402::sw::kFollowsCommand;
+    if (ip_following()) sw |= cia402::sw::kIpModeActive;  // IP: bit 4 seen, the 0x60C1:1 set points are taken
     if (mode == cia402::Mode::kHoming) {
       if (homing_done_) sw |= cia402::sw::kHomingAttained | cia402::sw::kTargetReached;
       if (homing_error_) sw |= cia402::sw::kHomingError | (vel_ == 0.0 ? cia402::sw::kTargetReached : 0);
@@ -102,7 +103,7 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
     }
     if (r.next == State::kOperationEnabled) {
       // Enabling never jumps: the delay line starts at the present target.
-      const Setpoint sp{static_cast<std::int32_t>(sval(hot_.target_position)),
+      const Setpoint sp{position_setpoint(),
                         static_cast<std::int32_t>(sval(hot_.target_velocity)),
                         static_cast<std::int16_t>(sval(hot_.target_torque))};
       delay_.fill(sp);
@@ -120,6 +121,18 @@ void Emulator::apply_controlword(std::uint16_t cw, canopen::FrameSink& out) noex
     start_homing();
   }
   if ((cw & cia402::cw::kHomingStart) == 0) homing_active_ = false;
+  // IP (mode 7): bit 4 "enable ip mode" in Operation enabled; on its rising
+  // edge the interpolation starts from the present set point (no jump).
+  const bool ip = state_ == State::kOperationEnabled &&
+                  mode_display_ == static_cast<std::int8_t>(cia402::Mode::kInterpolatedPosition) &&
+                  (cw & cia402::cw::kEnableIpMode) != 0;
+  if (ip && !ip_active_) {
+    const auto p = static_cast<std::int32_t>(sval(hot_.ip_data));
+    delay_.fill(Setpoint{p, static_cast<std::int32_t>(sval(hot_.target_velocity)),
+                         static_cast<std::int16_t>(sval(hot_.target_torque))});
+    prev_demand_ = static_cast<double>(cia402::unwrap32(position_counts(), p));
+  }
+  ip_active_ = ip;
   last_cw_ = cw;
 }
 
@@ -128,7 +141,8 @@ void Emulator::advance_motor(double dt) noexcept {
   // ~15-cycle divisions of the CSP path on every SYNC (a deliberate change
   // of the last bit of some results against dividing by dt).
   const double inv_dt = sync_period_.inv_dt;
-  const Setpoint now_sp{static_cast<std::int32_t>(sval(hot_.target_position) + sval(hot_.position_offset)),
+  const bool ip_mode = mode_display_ == static_cast<std::int8_t>(cia402::Mode::kInterpolatedPosition);
+  const Setpoint now_sp{static_cast<std::int32_t>(position_setpoint() + (ip_mode ? 0 : sval(hot_.position_offset))),
                         static_cast<std::int32_t>(sval(hot_.target_velocity) + sval(hot_.velocity_offset)),
                         static_cast<std::int16_t>(sval(hot_.target_torque) + sval(hot_.torque_offset))};
   // Delay line: the setpoint used now is the one received lag_cycles SYNCs ago.
@@ -147,9 +161,9 @@ void Emulator::advance_motor(double dt) noexcept {
   const auto mode = static_cast<cia402::Mode>(mode_display_);
   double torque = 0;
   bool stop_immediately = false;
-  if (state_ == State::kOperationEnabled) {
-    switch (mode) {
-      case cia402::Mode::kCsp: {
+  // CSP, and IP with linear interpolation (sub-mode 0): the demand moves
+  // linearly from the last set point to this one over the period 0x60C2.
+  auto follow = [&] {
         // 0x607A is 32 bits and wraps like 0x6064: the demand is the 64-bit
         // position nearest the last one with these low bits (a step of more
         // than 2^31 counts per SYNC is not a target a drive can take).
@@ -162,8 +176,14 @@ void Emulator::advance_motor(double dt) noexcept {
         v_des = v_ff + cfg_.position_gain * (prev_demand_ - pos_) * inv_dt;
         prev_demand_ = demand;
         put(hot_.position_demand, static_cast<std::uint32_t>(sp.position));
+  };
+  if (state_ == State::kOperationEnabled) {
+    switch (mode) {
+      case cia402::Mode::kCsp: follow(); break;
+      case cia402::Mode::kInterpolatedPosition:
+        if (ip_following()) follow();
+        else v_des = cfg_.position_gain * (prev_demand_ - pos_) * inv_dt;  // bit 4 clear: set points ignored, hold
         break;
-      }
       case cia402::Mode::kCsv: v_des = csv_ramp(sp.velocity * vel_scale_, dt); break;
       case cia402::Mode::kCst: {
         const double tmax = static_cast<double>(val(hot_.max_torque));
@@ -378,12 +398,12 @@ void Emulator::handle_sync(std::int64_t /*now_ns*/, canopen::FrameSink& out) noe
   }
   const std::int64_t period_ns = sync_period_.ns;
   advance_motor(sync_period_.dt);
-  // Following error monitoring (CSP, Operation enabled).
+  // Following error monitoring (CSP, IP following, Operation enabled).
   const auto window = static_cast<std::uint32_t>(val(hot_.fe_window));
-  if (state_ == State::kOperationEnabled && mode_display_ == static_cast<std::int8_t>(cia402::Mode::kCsp) &&
-      window != 0xFFFFFFFFu) {
-    // The error between 0x607A and the position, both modulo 2^32 (as 0x60F4).
-    const auto target = static_cast<std::int32_t>(sval(hot_.target_position));
+  if (state_ == State::kOperationEnabled &&
+      (mode_display_ == static_cast<std::int8_t>(cia402::Mode::kCsp) || ip_following()) && window != 0xFFFFFFFFu) {
+    // The error between the set point (0x607A, IP 0x60C1:1) and the position, both modulo 2^32 (as 0x60F4).
+    const auto target = position_setpoint();
     const double fe = std::abs(static_cast<double>(cia402::unwrap32(position_counts(), target)) - pos_);
     if (fe > window) {
       following_error_ = true;

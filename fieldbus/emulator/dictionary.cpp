@@ -138,6 +138,9 @@ const Emulator::ObjectRow Emulator::kObjectTable[] = {
   {obj::kPositionOffset, 0, 0, Default::kValue, 0, &Hot::position_offset},
   {obj::kVelocityOffset, 0, 0, Default::kValue, 0, &Hot::velocity_offset},
   {obj::kTorqueOffset, 0, 0, Default::kValue, 0, &Hot::torque_offset},
+  {obj::kInterpolationSubModeSelect, 0, 0, Default::kValue, 0},  // 0: linear interpolation (the only one modelled)
+  {obj::kInterpolationDataRecord, 0, 0, Default::kValue, 1},
+  {obj::kInterpolationDataRecord, 1, 1, Default::kValue, 0, &Hot::ip_data},
   {obj::kInterpolationTimePeriod, 0, 0, Default::kValue, 2},
   {obj::kInterpolationTimePeriod, 1, 1, Default::kValue, 1, &Hot::ip_value},
   {obj::kInterpolationTimePeriod, 2, 2, Default::kValue, 0xFD, &Hot::ip_index},  // -3: milliseconds

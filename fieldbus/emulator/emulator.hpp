@@ -153,6 +153,8 @@ struct EmulatorConfig {
   /// 0x6502 supported drive modes (bits per CiA 402) at power-on; 0x6060
   /// values outside the 0x6502 the drive serves are refused (with `served`,
   /// an EDS's 0x6502 default wins; without any 0x6502, this mask).
+  /// IP (mode 7) is modelled (0x60C0/0x60C1, controlword bit 4) but left out
+  /// of the default, as the boots recorded before it (cia402-emu --modes adds it).
   std::uint32_t supported_modes = cia402::supported_mode_bit(cia402::Mode::kHoming) |
                                   cia402::supported_mode_bit(cia402::Mode::kCsp) |
                                   cia402::supported_mode_bit(cia402::Mode::kCsv) |
@@ -386,6 +388,7 @@ class Emulator final : public canopen::SdoServerBackend {
     Entry* position_offset;     // 0x60B0
     Entry* velocity_offset;     // 0x60B1
     Entry* torque_offset;       // 0x60B2
+    Entry* ip_data;             // 0x60C1:1 (IP set point)
     Entry* ip_value;            // 0x60C2:1
     Entry* ip_index;            // 0x60C2:2
     Entry* fe_actual;           // 0x60F4
@@ -463,6 +466,17 @@ class Emulator final : public canopen::SdoServerBackend {
   Entry* find(std::uint16_t index, std::uint8_t sub) noexcept;
   void resolve_hot() noexcept;  // after build_dictionary(): fills hot_
   static std::uint64_t val(const Entry* e) noexcept { return e ? e->value : 0; }
+  /// The position set point of the mode shown: 0x60C1:1 in IP, else 0x607A.
+  [[nodiscard]] std::int32_t position_setpoint() const noexcept {
+    return static_cast<std::int32_t>(
+        sval(mode_display_ == static_cast<std::int8_t>(cia402::Mode::kInterpolatedPosition) ? hot_.ip_data
+                                                                                            : hot_.target_position));
+  }
+  /// IP (mode 7) in Operation enabled with controlword bit 4 seen: statusword bit 12.
+  [[nodiscard]] bool ip_following() const noexcept {
+    return ip_active_ && state_ == cia402::State::kOperationEnabled &&
+           mode_display_ == static_cast<std::int8_t>(cia402::Mode::kInterpolatedPosition);
+  }
   /// canopen::sign_extend(value, 8 * size) for a signed type, with the sign
   /// bit cached (0 otherwise); 0 for an absent object.
   static std::int64_t sval(const Entry* e) noexcept {
@@ -599,6 +613,9 @@ class Emulator final : public canopen::SdoServerBackend {
   std::uint16_t pending_fault_ = 0;
   std::uint16_t active_fault_ = 0;
   bool following_error_ = false;
+  /// IP (mode 7): controlword bit 4 "enable ip mode" seen in Operation
+  /// enabled; the 0x60C1:1 set points are taken (statusword bit 12).
+  bool ip_active_ = false;
   std::uint32_t following_error_cycles_ = 0;
   bool homing_done_ = false;
   bool homing_active_ = false;

@@ -99,6 +99,8 @@ SdoAbort Emulator::sdo_write(std::uint16_t index, std::uint8_t sub, std::span<co
   }
   if (index == 0x1029 && sub == 1 && v > 2) return SdoAbort::kInvalidValue;
   if (index == obj::kInterpolationTimePeriod && sub == 1 && v == 0) return SdoAbort::kInvalidValue;
+  // IP sub-modes: only 0 (linear interpolation) is modelled.
+  if (index == obj::kInterpolationSubModeSelect && v != 0) return SdoAbort::kInvalidValue;
   const std::optional<cia402::MdsObject> mds = cfg_.mds_objects.find(index, sub);
   if (mds == cia402::MdsObject::kRampJerkControl && v > 100) return SdoAbort::kValueTooHigh;
   if (mds == cia402::MdsObject::kSlatConfiguration && v > 2) return SdoAbort::kInvalidValue;

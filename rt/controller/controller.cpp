@@ -361,8 +361,9 @@ void Controller::emit(const Event& e) noexcept { (void)events_.try_push(e); }
   const bool wants_enabled = p.wanted() == cia402::State::kOperationEnabled;
   if (out.enable && !wants_enabled && !p.failed()) p.enable();
   if (!out.enable && wants_enabled) p.disable();
-  const auto mode = static_cast<cia402::Mode>(static_cast<std::int8_t>(out.mode));
-  if (mode != p.mode() && (mode == cia402::Mode::kCsp || mode == cia402::Mode::kCsv || mode == cia402::Mode::kCst))
+  auto mode = static_cast<cia402::Mode>(static_cast<std::int8_t>(out.mode));
+  if (mode == cia402::Mode::kCsp) mode = p.position_mode();  // IP drives (drive.mode: ip) take the position in mode 7
+  if (mode != p.mode() && (cia402::is_position_stream(mode) || mode == cia402::Mode::kCsv || mode == cia402::Mode::kCst))
     (void)p.set_mode(mode);
   // Homing (MAH on a CIP drive): mode 6 and the parameters on the planner's
   // rising edge (retried next cycle when the SDO queue is full), dropped on its falling edge.

@@ -168,5 +168,35 @@ TEST(ControllerHoming, DriveWithoutAHomingObjectEndsMahWithEr) {
   EXPECT_FALSE(r.saw_bit4);
 }
 
+
+// drive.mode ip (issue 30 part 2): MAH on the drive switches from mode 7 to
+// 6 and back to 7 (not to CSP: the RPDO carries 0x60C1:1), where bit 4
+// goes out again and a MAM moves in the homed frame.
+TEST(ControllerHomingIp, MahFromIpReturnsToIpAndMoves) {
+  HomingRig r([](AxisSpec& x, emulator::EmulatorConfig& ec) {
+    active_switch_homing(x, 35);
+    x.drive.mode = cia402::Mode::kInterpolatedPosition;
+    ec.supported_modes |= cia402::supported_mode_bit(cia402::Mode::kInterpolatedPosition);
+    ec.initial_position = 1234;
+  });
+  r.servo_on();
+  EXPECT_EQ(r.status().axes[1].mode_display, 7);
+  r.exec("MAH(X, mah1)");
+  ASSERT_TRUE(r.done_or_error("mah1", 3000));
+  ASSERT_EQ(r.read("mah1.PC"), 1.0) << "MAH ERR " << r.read("mah1.ERR") << " EXERR " << r.read("mah1.EXERR");
+  EXPECT_TRUE(r.saw_mode6);
+  EXPECT_NEAR(r.read("X.ActualPosition"), 5.0, 1e-9);
+  ASSERT_TRUE(r.run_until([](const Status& s) { return s.axes[1].mode_display == 7; }, 1000));
+  ASSERT_TRUE(r.run_until([](const Status& s) { return (s.axes[1].controlword & 0x10) != 0; }, 100))
+      << "bit 4 (enable ip mode) back in mode 7";
+  r.exec("MAM(X, mam1, Absolute, 8, 20, UnitsPerSec, 200, UnitsPerSec2, 200, UnitsPerSec2, Trapezoidal, 100, 100, "
+         "%ofTime, Disabled, Programmed, 0, None, 0, 0)");
+  ASSERT_TRUE(r.done_or_error("mam1", 3000));
+  ASSERT_EQ(r.read("mam1.PC"), 1.0) << "MAM ERR " << r.read("mam1.ERR");
+  r.cycles(50);
+  EXPECT_NEAR(r.read("X.ActualPosition"), 8.0, 0.01);
+  EXPECT_EQ(r.status().axes[1].mode_display, 7);
+}
+
 }  // namespace
 }  // namespace canmotion::rt

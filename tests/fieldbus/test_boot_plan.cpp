@@ -41,7 +41,7 @@ cia402::DriveConfig drive() {
 std::vector<BootWrite> transfers(const cia402::DriveConfig& d, std::uint8_t sync_counter = 0) {
   canopen::MasterConfig m;
   m.sync_counter_overflow = sync_counter;
-  const cia402::DrivePdoSet pdos = cia402::default_drive_pdos(d.pdo_profile, d.node);
+  const cia402::DrivePdoSet pdos = cia402::default_drive_pdos(d.pdo_profile, d.node, d.mode);
   return cia402::build_boot_transfers(cia402::BootInputs{d, pdos, m});
 }
 
@@ -229,7 +229,7 @@ TEST(BootPlan, KeysAndNotesComeFromTheRows) {
   for (const BootWrite& b : w) {
     const std::string* k = cia402::write_hint_key(d.hints, b);
     switch (b.origin) {
-      case WriteOrigin::kMode:
+      case WriteOrigin::kMode: EXPECT_EQ(k, &d.hints.mode) << std::hex << b.w.index; break;  // drive.mode
       case WriteOrigin::kUnusedPdo:
       case WriteOrigin::kCheck: EXPECT_EQ(k, nullptr) << std::hex << b.w.index; break;
       default: ASSERT_NE(k, nullptr) << std::hex << b.w.index; EXPECT_FALSE(k->empty());
@@ -244,5 +244,44 @@ TEST(BootPlan, KeysAndNotesComeFromTheRows) {
   EXPECT_EQ(zero.on_abort.of(SdoAbort::kReadOnly), Then::kNotice);
 }
 
+}  // namespace
+}  // namespace canmotion
+
+namespace canmotion {
+namespace {
+// drive.mode: ip (issue 30 part 2): 0x6060 = 7, then 0x60C0 = 0 (INTEGER16,
+// optional: a drive without it interpolates linearly), 0x60C1:1 in RPDO1
+// where 0x607A is; the same rows in CSP write 8 and no 0x60C0.
+TEST(BootPlan, IpModeWritesModeSevenSubModeZeroAndMapsTheDataRecord) {
+  cia402::DriveConfig d = drive();
+  d.mode = cia402::Mode::kInterpolatedPosition;
+  d.hints.mode = "axes[0].drive.mode: ip";
+  const std::vector<BootWrite> w = transfers(d);
+  std::size_t mode_at = w.size(), sub_at = w.size();
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    if (w[i].w.index == obj::kModesOfOperation && !w[i].is_read()) mode_at = i;
+    if (w[i].w.index == obj::kInterpolationSubModeSelect) sub_at = i;
+  }
+  ASSERT_LT(mode_at, w.size());
+  ASSERT_LT(sub_at, w.size());
+  EXPECT_EQ(sub_at, mode_at + 1);
+  EXPECT_EQ(w[mode_at].w.value, 7u);
+  EXPECT_EQ(w[mode_at].w.size, 1u);
+  EXPECT_EQ(w[sub_at].w.value, 0u);
+  EXPECT_EQ(w[sub_at].w.size, 2u);
+  EXPECT_TRUE(w[sub_at].optional);
+  EXPECT_EQ(*cia402::write_hint_key(d.hints, w[sub_at]), "axes[0].drive.mode: ip");
+  EXPECT_NE(std::string(cia402::boot_note(w[sub_at], cia402::Fallback::kAbsent)).find("linear interpolation"),
+            std::string::npos);
+  ASSERT_EQ(of(w, 0x1600, 2).size(), 1u);
+  EXPECT_EQ(of(w, 0x1600, 2)[0].w.value, 0x60C10120u);  // 0x60C1:01, 32 bits
+  // CSP: 8, no 0x60C0, 0x607A mapped.
+  const std::vector<BootWrite> c = transfers(drive());
+  EXPECT_TRUE(of(c, obj::kInterpolationSubModeSelect, 0).empty());
+  EXPECT_EQ(of(c, 0x1600, 2)[0].w.value, 0x607A0020u);
+  // An EDS without 0x60C0: left out (the drive's default, linear, is taken).
+  d.dictionary = dict({{0x60C2, 1, canopen::DataType::kUnsigned8, canopen::Access::kRw, ""}});
+  EXPECT_TRUE(of(transfers(d), obj::kInterpolationSubModeSelect, 0).empty());
+}
 }  // namespace
 }  // namespace canmotion

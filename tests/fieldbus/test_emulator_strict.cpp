@@ -679,3 +679,39 @@ TEST(EmulatorStrict, MdsObjectsServedWhereConfigured) {
   for (const int i : {0x3000, 0x3001, 0x3011, 0x3012, 0x2010})
     EXPECT_EQ(a.read(static_cast<std::uint16_t>(i), 0, v), kNoObject) << std::hex << i;
 }
+
+// Interpolated position mode (issue 30 part 2): 0x60C0 takes 0 (linear) only;
+// in mode 7 the 0x60C1:1 set points are followed only while controlword bit
+// 4 "enable ip mode" is set in Operation enabled (statusword bit 12 then).
+TEST(EmulatorStrict, InterpolatedPositionFollowsTheDataRecordOnlyWithBit4) {
+  EmulatorConfig c;
+  c.supported_modes |= cia402::supported_mode_bit(cia402::Mode::kInterpolatedPosition);
+  Drive s(c);
+  s.boot();
+  EXPECT_EQ(s.write(0x60C0, 0, 1, 2), kInvalidValue) << "only sub-mode 0 is modelled";
+  ASSERT_EQ(s.write(0x60C0, 0, 0, 2), 0u);
+  ASSERT_EQ(s.write(0x6060, 0, 7, 1), 0u);
+  EXPECT_EQ(s.emu.mode_display(), 7);
+  s.start();
+  ASSERT_TRUE(s.enable());
+  EXPECT_EQ(s.emu.statusword() & cia402::sw::kIpModeActive, 0u) << "bit 4 not set yet";
+  ASSERT_EQ(s.write(0x60C1, 1, 5000, 4), 0u);
+  for (int i = 0; i < 10; ++i) s.sync();
+  EXPECT_EQ(s.emu.position(), 0) << "set points ignored without bit 4";
+  ASSERT_EQ(s.write(0x60C1, 1, 0, 4), 0u);
+  ASSERT_EQ(s.write(0x6040, 0, 0x001F, 2), 0u);
+  s.sync();
+  EXPECT_NE(s.emu.statusword() & cia402::sw::kIpModeActive, 0u);
+  for (std::uint32_t k = 1; k <= 10; ++k) {  // a ramp of 100 counts per period
+    ASSERT_EQ(s.write(0x60C1, 1, 100 * k, 4), 0u);
+    s.sync();
+  }
+  for (int i = 0; i < 60; ++i) s.sync();
+  EXPECT_EQ(s.emu.position(), 1000);
+  ASSERT_EQ(s.write(0x6040, 0, 0x000F, 2), 0u);  // bit 4 cleared: held, bit 12 clear
+  ASSERT_EQ(s.write(0x60C1, 1, 9000, 4), 0u);
+  for (int i = 0; i < 20; ++i) s.sync();
+  EXPECT_EQ(s.emu.position(), 1000);
+  EXPECT_EQ(s.emu.statusword() & cia402::sw::kIpModeActive, 0u);
+  EXPECT_EQ(s.emu.state(), State::kOperationEnabled);
+}

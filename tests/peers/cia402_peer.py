@@ -139,6 +139,14 @@ MODE_NONE, MODE_CSP = 0, 8
 MODE_HOMING, MODE_CSV = 6, 9
 SW_TARGET_REACHED = 1 << 10
 CW_HOMING_START = 1 << 4        # homing mode: bit 4 starts the homing
+# Interpolated position mode (CiA 402 / DSP 402 v2 clause 11): mode 7; the
+# set point is 0x60C1:1, taken only while controlword bit 4 "enable ip mode"
+# is 1 in Operation enabled; statusword bit 12 "ip mode active" says so.
+MODE_IP = 7
+CW_ENABLE_IP = 1 << 4
+SW_IP_ACTIVE = 1 << 12
+# 0x6502 supported drive modes bits: 5 homing, 6 ip, 7 csp, 8 csv.
+MODE_BITS = {MODE_HOMING: 1 << 5, MODE_IP: 1 << 6, MODE_CSP: 1 << 7, MODE_CSV: 1 << 8}
 QUICK_STOP_OPTION_DEFAULT = 2  # 0x605A: quick-stop ramp, then Switch on disabled
 
 
@@ -344,7 +352,7 @@ class Drive:
 
     def __init__(self, node: int, rpdos: int = 2, tpdos: int = 2, position: int = 0, heartbeat_ms: int = 0,
                  consumer_heartbeat: int = 0, fault_code: int = 0xFF00, sdo_timeout: float = 1.0, log=None,
-                 velocity_unit: str = None, encoder_increments: int = 0):
+                 velocity_unit: str = None, encoder_increments: int = 0, modes: str = 'csp'):
         if not 1 <= node <= 127:
             raise ValueError(f'node-ID {node} is not 1..127')
         if not 1 <= rpdos <= 8 or not 1 <= tpdos <= 8:
@@ -361,6 +369,12 @@ class Drive:
         # 0x608F:1 increments per 0x608F:2 = 1 motor revolution).
         self.velocity_unit = velocity_unit
         self.encoder_increments = encoder_increments
+        # The position modes it has: 'csp', 'ip' or 'csp,ip' (--modes).
+        self.position_modes = set()
+        for m in modes.split(','):
+            if m.strip() not in ('csp', 'ip'):
+                raise ValueError(f"mode '{m}' is not csp or ip")
+            self.position_modes.add(MODE_CSP if m.strip() == 'csp' else MODE_IP)
         self.node = node
         self.default_heartbeat_ms = heartbeat_ms
         self.consumer_entries = consumer_heartbeat
@@ -399,6 +413,8 @@ class Drive:
         self.velocity = 0
         self.target_velocity = 0          # 0x60FF, in the velocity unit
         self.target_torque = 0            # 0x6071
+        self.ip_target = self.actual      # 0x60C1:1, the IP set point
+        self.ip_sub_mode = 0              # 0x60C0: 0 = linear interpolation (the only one)
         self.homing_method = 0
         self.homing_speeds = [0, 0]       # 0x6099:1/2, in the velocity unit
         self.homing_accel = 0             # 0x609A
@@ -470,7 +486,7 @@ class Drive:
                               set=lambda v: setattr(d, 'quick_stop_option', v),
                               check=lambda v: 0 if 0 <= v <= 8 else ABORT_VALUE))
         od.add(0x6060, 0, Var('Modes of operation', 'i8', 'rw', pdo='R', get=lambda: d.mode, set=self._set_mode,
-                              check=lambda v: 0 if v in (MODE_NONE, MODE_CSP) or (
+                              check=lambda v: 0 if v == MODE_NONE or v in self.position_modes or (
                                   self.velocity_unit and v in (MODE_CSV, MODE_HOMING)) else ABORT_VALUE))
         od.add(0x6061, 0, Var('Modes of operation display', 'i8', 'ro', pdo='T', get=lambda: d.mode))
         od.add(0x6062, 0, Var('Position demand value', 'i32', 'ro', pdo='T', get=lambda: d.demand))
@@ -478,14 +494,23 @@ class Drive:
         od.add(0x606C, 0, Var('Velocity actual value', 'i32', 'ro', pdo='T', get=lambda: d.velocity))
         od.add(0x607A, 0, Var('Target position', 'i32', 'rw', pdo='R', get=lambda: d.target,
                               set=lambda v: setattr(d, 'target', v)))
+        if MODE_IP in self.position_modes:
+            od.add(0x60C0, 0, Var('Interpolation sub mode select', 'i16', 'rw', get=lambda: d.ip_sub_mode,
+                                  set=lambda v: setattr(d, 'ip_sub_mode', v),
+                                  check=lambda v: 0 if v == 0 else ABORT_VALUE))   # linear only
+            od.add(0x60C1, 0, Var('Interpolation data record', 'u8', 'ro', 1))
+            od.add(0x60C1, 1, Var('Interpolation data record 1', 'i32', 'rw', pdo='R', get=lambda: d.ip_target,
+                                  set=lambda v: setattr(d, 'ip_target', v)))
         od.add(0x60C2, 0, Var('Interpolation time period', 'u8', 'ro', 2))
         od.add(0x60C2, 1, Var('Interpolation time period value', 'u8', 'rw', get=lambda: d.ip_value,
                               set=lambda v: setattr(d, 'ip_value', v)))
         od.add(0x60C2, 2, Var('Interpolation time index', 'i8', 'rw', get=lambda: d.ip_index,
                               set=lambda v: setattr(d, 'ip_index', v),
                               check=lambda v: 0 if -128 <= v <= 63 else ABORT_VALUE))
-        od.add(0x6502, 0, Var('Supported drive modes', 'u32', 'ro',
-                              (1 << 7) | ((1 << 8) | (1 << 5) if self.velocity_unit else 0)))   # CSP (CSV, homing)
+        supported = sum(MODE_BITS[m] for m in self.position_modes)   # CSP and/or IP
+        if self.velocity_unit:
+            supported |= MODE_BITS[MODE_CSV] | MODE_BITS[MODE_HOMING]
+        od.add(0x6502, 0, Var('Supported drive modes', 'u32', 'ro', supported))
         if self.velocity_unit:
             self._add_unit_objects()
         # --- manufacturer-specific area: a writable string (segmented downloads)
@@ -688,9 +713,15 @@ class Drive:
             sw |= SW_VOLTAGE_ENABLED
         if self.state == OPERATION_ENABLED and self.mode in (MODE_CSP, MODE_CSV):
             sw |= SW_CSP_FOLLOWING        # bit 12: drive follows the command value
+        if self.ip_active():
+            sw |= SW_IP_ACTIVE            # bit 12 in IP: ip mode active
         if self.mode == MODE_HOMING and self.homing == 'attained':
             sw |= SW_CSP_FOLLOWING | SW_TARGET_REACHED   # bit 12 homing attained, bit 10 target reached
         return sw
+
+    def ip_active(self) -> bool:
+        """IP: Operation enabled, mode 7 and controlword bit 4 (enable ip mode)."""
+        return self.state == OPERATION_ENABLED and self.mode == MODE_IP and bool(self.controlword & CW_ENABLE_IP)
 
     def counts_per_unit(self) -> float:
         """Increments per second of one unit of 0x60FF/0x6099/0x606C."""
@@ -889,9 +920,11 @@ class Drive:
         was = self.demand
         if not enabled or (self.mode != MODE_HOMING and self.homing == 'active'):
             self.homing = None            # a homing ends with the enable or its mode
-        self.following = self.state == OPERATION_ENABLED and self.mode == MODE_CSP
+        # IP (sub-mode 0, linear): the same, with 0x60C1:1 while bit 4 is set.
+        ip = self.ip_active()
+        self.following = (self.state == OPERATION_ENABLED and self.mode == MODE_CSP) or ip
         if self.following:
-            self.demand = self.target
+            self.demand = self.ip_target if ip else self.target
             if getattr(self, 'pending_enable_log', False):
                 self.pending_enable_log = False
                 self.enable_log.append((self.actual, self.demand))
@@ -1382,6 +1415,9 @@ Exit status: 0 after quit, SIGINT/SIGTERM or --duration; 1 on errors (bus, argum
                          '0x6099 and 0x606C in that unit (default: CSP only, no 0x60A9)')
     ap.add_argument('--encoder-increments', type=int, default=0, metavar='N',
                     help='0x608F:1, increments per motor revolution (needed by rpm)')
+    ap.add_argument('--modes', default='csp', metavar='LIST',
+                    help="position modes: csp (default), ip (interpolated position, mode 7: 0x60C0, 0x60C1:1, "
+                         "controlword bit 4; an IP-only drive) or csp,ip")
     ap.add_argument('--control', metavar='PATH', help="control channel: a FIFO path, or '-' for stdin")
     ap.add_argument('--powered-off', action='store_true',
                     help='start without power: silent (no boot-up, nothing answered) until the control command '
@@ -1416,8 +1452,12 @@ def main(argv=None) -> int:
     except Exception as e:   # python-can raises several types for a missing interface
         print(f'cia402_peer: cannot open {a.bus_type} bus {a.interface}: {e}', file=sys.stderr)
         return 1
-    drive = Drive(a.node, a.rpdos, a.tpdos, a.position, a.heartbeat_ms, a.consumer_heartbeat, a.fault_code,
-                  a.sdo_timeout_ms / 1000.0, log, a.velocity_unit, a.encoder_increments)
+    try:
+        drive = Drive(a.node, a.rpdos, a.tpdos, a.position, a.heartbeat_ms, a.consumer_heartbeat, a.fault_code,
+                      a.sdo_timeout_ms / 1000.0, log, a.velocity_unit, a.encoder_increments, a.modes)
+    except ValueError as e:
+        print(f'cia402_peer: {e}', file=sys.stderr)
+        return 2
     runner = Runner(drive, bus, powered=not a.powered_off)
 
     def on_stop(signum, frame):

@@ -514,6 +514,61 @@ class Csp(PeerCase):
         self.assertEqual(self.drive.actual, 500)
 
 
+class InterpolatedPosition(PeerCase):
+    """Mode 7 (--modes ip): 0x60C1:1 in RPDO1, controlword bit 4 "enable ip
+    mode", statusword bit 12 "ip mode active", 0x60C0 = 0 linear only."""
+
+    def ip(self, position=0, modes='ip'):
+        self.make(position=position, modes=modes)
+        c = spec_checks.Ctx(self.link, NODE, PERIOD)
+        c.remap(True, 1, [0x60400010, 0x60C10120])
+        c.remap(False, 1, [0x60410010, 0x60640020])
+        self.sdo.write(0x6060, 0, 7, '<b')
+        self.sdo.write(0x60C0, 0, 0, '<h')
+        self.nmt(0x01)
+        self.link.clear()
+
+    def test_ip_only_drive_objects_and_modes(self):
+        self.make(modes='ip')
+        self.assertEqual(self.sdo.read(0x6502), (1 << 6))              # IP only: no CSP bit
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x6060, 0, 8, '<b'), peer.ABORT_VALUE)
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x60C0, 0, -1, '<h'), peer.ABORT_VALUE)
+        self.assertEqual(self.sdo.read(0x60C1, 0, '<B'), 1)
+        self.make(modes='csp')
+        self.assertEqual(self.sdo.read(0x6502), (1 << 7))
+        self.assertEqual(self.sdo.abort_code(self.sdo.write, 0x6060, 0, 7, '<b'), peer.ABORT_VALUE)
+        self.assertEqual(self.sdo.abort_code(self.sdo.read, 0x60C1, 1), 0x06020000)
+        self.make(modes='csp,ip')
+        self.assertEqual(self.sdo.read(0x6502), (1 << 6) | (1 << 7))
+        with self.assertRaises(ValueError):
+            peer.Drive(NODE, modes='pp')
+
+    def test_set_points_taken_only_with_bit_4(self):
+        self.ip(position=1000)
+        self.enable(1000)                                    # 0x000F: Operation enabled, bit 4 clear
+        sw = [struct.unpack('<Hi', d)[0] for _, _, d in self.sync(2)]
+        self.assertEqual(sw[-1] & peer.SW_IP_ACTIVE, 0)
+        self.rpdo(0x000F, 5000)                              # ignored without bit 4
+        self.sync(2)
+        self.assertEqual(self.drive.actual, 1000)
+        self.rpdo(0x001F, 1000)                              # enable ip mode at the present position
+        self.sync(1)
+        last = None
+        for target in range(1100, 2100, 100):                # a ramp of 100 counts per period
+            self.rpdo(0x001F, target)
+            got = self.sync(1)
+            if got:
+                last = struct.unpack('<Hi', got[-1][2])
+        self.sync(2)
+        self.assertEqual(self.drive.actual, 2000)
+        self.assertNotEqual(last[0] & peer.SW_IP_ACTIVE, 0)
+        self.assertEqual(self.drive.max_step, 100)           # linear: no jump at the start
+        self.rpdo(0x000F, 9999)                              # bit 4 cleared: held where it is
+        self.sync(3)
+        self.assertEqual(self.drive.actual, 2000)
+        self.assertEqual(self.drive.statusword() & peer.SW_IP_ACTIVE, 0)
+
+
 class ControlAndCli(PeerCase):
     def test_silence_and_resume(self):
         self.make(heartbeat_ms=10)

@@ -46,7 +46,8 @@ config=vcan.yaml
 [[ $scenario == never_heard ]] && config=vcan-two.yaml
 [[ $scenario == units_rpm ]] && config=vcan-units.yaml
 [[ $scenario == units_rpm_boot ]] && config=vcan-units-boot.yaml
-rm -f "$art/vcan.yaml" "$art/vcan-two.yaml" "$art/vcan-units.yaml" "$art/vcan-units-boot.yaml"
+[[ $scenario == ip_move ]] && config=vcan-ip.yaml
+rm -f "$art/vcan.yaml" "$art/vcan-two.yaml" "$art/vcan-units.yaml" "$art/vcan-units-boot.yaml" "$art/vcan-ip.yaml"
 cp "$here/$config" "$art/$config"
 # units_rpm: the drive's units come from its EDS (next to the configuration).
 [[ $scenario == units_rpm ]] && cp "$here/../units/rpm-drive.eds" "$art/rpm-drive.eds"

@@ -153,12 +153,19 @@ class Check:
         t_boot = max((t for t, _, _ in boot if t < starts[0]), default=0.0)
         cfg = [x for x in xs if t_boot < x[0] < starts[0] and x[4] == 0]   # the configuration of the last boot
         written = {(i, s): v for _, i, s, v, c in cfg}
-        self.item(written.get((0x6060, 0)) == 8, '0x6060 = 8 (CSP)', f'written {written.get((0x6060, 0))}')
+        ip = self.a.scenario == 'ip_move'   # drive.mode: ip (the peer with --modes ip)
+        if ip:
+            self.item(written.get((0x6060, 0)) == 7, '0x6060 = 7 (IP)', f'written {written.get((0x6060, 0))}')
+            self.item(written.get((0x60C0, 0)) == 0, '0x60C0 = 0 (linear interpolation)',
+                      f'written {written.get((0x60C0, 0))}')
+        else:
+            self.item(written.get((0x6060, 0)) == 8, '0x6060 = 8 (CSP)', f'written {written.get((0x6060, 0))}')
         v, idx = written.get((0x60C2, 1)), written.get((0x60C2, 2))
         idx = None if idx is None else (idx - 256 if idx > 127 else idx)
         ok = v is not None and idx is not None and abs(v * 10.0 ** idx - self.period) < 1e-12
         self.item(ok, '0x60C2 = the period', f'value {v}, index {idx} (period {self.a.period_ms} ms)')
-        for name, comm, mapi, cob, entries in (('RPDO1', 0x1400, 0x1600, self.RPDO, [0x60400010, 0x607A0020]),
+        target = 0x60C10120 if ip else 0x607A0020   # IP: 0x60C1:1 where 0x607A is
+        for name, comm, mapi, cob, entries in (('RPDO1', 0x1400, 0x1600, self.RPDO, [0x60400010, target]),
                                                ('TPDO1', 0x1800, 0x1A00, self.TPDO, [0x60410010, 0x60640020])):
             seq = [(i, s, v) for _, i, s, v, c in cfg if i in (comm, mapi)]
             steps = [(comm, 1, cob | 1 << 31), (mapi, 0, 0)] + [(mapi, k + 1, e) for k, e in enumerate(entries)] + \
@@ -208,6 +215,20 @@ class Check:
         got = self.printed('X.ActualPosition')
         want = f'{end / 1000:g}'
         self.item(bool(got) and got[-1] == want, 'X.ActualPosition after the MAM', f'{got[-1:]} (want {want})')
+
+    def ip_bits(self, t_oe):
+        """IP: controlword bit 4 (enable ip mode) only with Operation
+        enabled, and statusword bit 12 (ip mode active) after it."""
+        rp, tp = self.rpdos(), self.tpdos()
+        with4 = [t for t, cw, _ in rp if cw & 0x10]
+        early = [t for t in with4 if t < t_oe]
+        self.item(bool(with4) and not early, 'IP: controlword bit 4 in Operation enabled',
+                  f'{len(with4)} RPDO1 with bit 4, {len(early)} before Operation enabled' +
+                  (f' (first 0x{next(cw for t, cw, _ in rp if cw & 0x10):04X})' if with4 else ''))
+        active = [t for t, sw, _ in tp if sw & 0x1000 and state_of(sw) == 'operation enabled']
+        self.item(bool(active) and bool(with4) and active[0] >= with4[0], 'IP: statusword bit 12 (ip mode active)',
+                  f'{len(active)} TPDO1 with bit 12' + (f', first {1e3 * (active[0] - with4[0]):.0f} ms after the '
+                                                        'first bit 4' if active and with4 else ''))
 
     def sync_period(self, t_start):
         syncs = [t for t, _, _ in self.t.of(self.SYNC)]
@@ -658,7 +679,7 @@ def main():
                                         '(run-vcan-test); PEER_SYNC_MEAN_MAX (1.5), PEER_VANISH_SLACK_MS (100).')
     ap.add_argument('scenario', choices=('boot_enable_move', 'fault_recovery', 'vanish', 'nmt_preop', 'boot_late',
                                          'power_cycle', 'link_down', 'never_heard', 'units_rpm',
-                                         'units_rpm_boot'))
+                                         'units_rpm_boot', 'ip_move'))
     ap.add_argument('--period-ms', type=float, default=10.0)
     ap.add_argument('--node', type=int, default=5)
     ap.add_argument('--start', type=int, default=123456, help='the peer\'s --position')
@@ -670,13 +691,16 @@ def main():
         c.live_boot()
     t_start = c.boot()
     if t_start is not None:
-        oe = c.enable(t_start, 0.4 if a.scenario in ('boot_enable_move', 'boot_late', 'never_heard') else 0.0)
-        if a.scenario in ('boot_enable_move', 'boot_late', 'never_heard'):
+        moves = ('boot_enable_move', 'boot_late', 'never_heard', 'ip_move')
+        oe = c.enable(t_start, 0.4 if a.scenario in moves else 0.0)
+        if a.scenario in moves:
             got, want = c.printed('X.ActualPosition'), f'{a.start / 1000:g}'
             c.item(got[:1] == [want], 'X.ActualPosition after MSO', f'{got[:1]} (want {want})')
             c.sync_period(t_start)
             if oe is not None:
-                c.move(a.start, 20000)
+                c.move(a.start, 20000)   # ip_move: where CSP (boot_enable_move) ends it, 143456 counts
+                if a.scenario == 'ip_move':
+                    c.ip_bits(oe)
             if a.scenario == 'never_heard':
                 c.never_heard()
         elif a.scenario == 'fault_recovery':

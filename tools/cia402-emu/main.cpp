@@ -238,7 +238,7 @@ void add_profile_options(CLI::App& app, Options& o) {
   app.add_option("--mode-switch-syncs", o.mode_switch_syncs, "SYNCs until 0x6061 shows a new 0x6060 (strict 2)");
   app.add_flag("--no-remote", o.no_remote, "statusword bit 9 = 0: local control, the bus's controlword is ignored");
   app.add_option("--supported-modes", o.supported_modes,
-                 "0x6502 (e.g. 0x3A0 = HM, CSP, CSV, CST; the default); 0x6060 outside it is refused");
+                 "0x6502 (e.g. 0x3A0 = HM, CSP, CSV, CST: the default; 0x3E0 adds IP; 0x60 = HM and IP only, an IP-only drive); 0x6060 outside it is refused");
   app.add_option("--duration", o.duration, "exit after this many seconds (0 = run until SIGINT/SIGTERM)");
   app.add_flag("-v,--verbose", o.verbose, "print NMT and CiA 402 state changes");
   app.add_flag("--check-args", o.check_args,
