@@ -161,6 +161,43 @@ void dcf_writes(const DriveSettings& ds, cia402::DriveConfig& d, bool store) {
     d.hints.dcf = dcf.key;
   }
 }
+/// Drive units (README "Drive units"): as the file tells them, or read at
+/// boot; what needs them, named in a boot failure.
+void drive_units_config(const AxisSettings& a, const std::string& axis, cia402::DriveConfig& d) {
+  // `units.velocity` is written before that read and any value in it.
+  d.units.read_at_boot = a.drive.units_at_boot;
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  d.units.velocity_counts = a.drive.units_at_boot ? 1.0 : a.drive.velocity_counts.value_or(unknown);
+  d.units.acceleration_counts = a.drive.units_at_boot ? 1.0 : a.drive.acceleration_counts.value_or(unknown);
+  if (a.drive.velocity_unit) {
+    d.units.has_write_velocity = true;
+    d.units.write_velocity = *a.drive.velocity_unit;
+    d.hints.velocity_unit = fmt::format("{} (line {}; needs a writable 0x60A9)", a.drive.units_key, a.drive.units_where.line);
+  }
+  auto need = [](std::string& to, const std::string& what) { to += (to.empty() ? "" : " and ") + what; };
+  if (a.direct.present) {
+    const bool torque = a.axis.direct_mode == motion::AxisConfig::DirectMode::Torque;
+    need(d.units.velocity_needed_by, fmt::format("{}.direct_control (MDS in {})", axis, torque ? "CST" : "CSV"));
+    if (a.direct.ramp_acceleration || a.direct.ramp_deceleration)
+      need(d.units.acceleration_needed_by, fmt::format("{}.direct_control.ramp (0x6083/0x6084)", axis));
+  }
+  if (a.axis.homing.mode == motion::HomingConfig::Mode::Active &&
+      a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate) {
+    need(d.units.velocity_needed_by, fmt::format("{}.homing (speeds, 0x6099)", axis));
+    need(d.units.acceleration_needed_by, fmt::format("{}.homing (acceleration, 0x609A)", axis));
+  }
+}
+
+void identity_config(const DriveIdentitySettings& id, cia402::DriveIdentity& out) {
+  out.has_device_type = id.device_type.has_value();
+  out.device_type = id.device_type.value_or(0);
+  out.has_vendor_id = id.vendor_id.has_value();
+  out.vendor_id = id.vendor_id.value_or(0);
+  out.has_product_code = id.product_code.has_value();
+  out.product_code = id.product_code.value_or(0);
+  out.has_revision = id.revision.has_value();
+  out.revision = id.revision.value_or(0);
+}
 }  // namespace
 
 cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s, std::size_t axis_index) {
@@ -177,15 +214,7 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   d.hints.sync_watch = drive_key("sync_watch");
   d.hints.sync_counter = fmt::format("buses[].sync_counter_overflow of bus '{}' (line {})", bus.name, bus.where.line);
   d.sync_watch = a.drive.sync_watch;
-  const DriveIdentitySettings& id = a.drive.identity;
-  d.identity.has_device_type = id.device_type.has_value();
-  d.identity.device_type = id.device_type.value_or(0);
-  d.identity.has_vendor_id = id.vendor_id.has_value();
-  d.identity.vendor_id = id.vendor_id.value_or(0);
-  d.identity.has_product_code = id.product_code.has_value();
-  d.identity.product_code = id.product_code.value_or(0);
-  d.identity.has_revision = id.revision.has_value();
-  d.identity.revision = id.revision.value_or(0);
+  identity_config(a.drive.identity, d.identity);
   // Modes the axis may switch to besides CSP: checked against 0x6502 at boot.
   if (a.direct.present) {
     const bool torque = a.axis.direct_mode == motion::AxisConfig::DirectMode::Torque;
@@ -228,29 +257,7 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   }
   d.mode_switch_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.mode_switch_ms) * 1'000'000;
   d.homing_timeout_ns = static_cast<std::int64_t>(a.drive.timeouts.homing_ms) * 1'000'000;
-  // Drive units (README "Drive units"): as the file tells them, or read at
-  // boot; `units.velocity` is written before that read and any value in it.
-  d.units.read_at_boot = a.drive.units_at_boot;
-  const double unknown = std::numeric_limits<double>::quiet_NaN();
-  d.units.velocity_counts = a.drive.units_at_boot ? 1.0 : a.drive.velocity_counts.value_or(unknown);
-  d.units.acceleration_counts = a.drive.units_at_boot ? 1.0 : a.drive.acceleration_counts.value_or(unknown);
-  if (a.drive.velocity_unit) {
-    d.units.has_write_velocity = true;
-    d.units.write_velocity = *a.drive.velocity_unit;
-    d.hints.velocity_unit = fmt::format("{} (line {}; needs a writable 0x60A9)", a.drive.units_key, a.drive.units_where.line);
-  }
-  auto need = [](std::string& to, const std::string& what) { to += (to.empty() ? "" : " and ") + what; };
-  if (a.direct.present) {
-    const bool torque = a.axis.direct_mode == motion::AxisConfig::DirectMode::Torque;
-    need(d.units.velocity_needed_by, fmt::format("{}.direct_control (MDS in {})", axis, torque ? "CST" : "CSV"));
-    if (a.direct.ramp_acceleration || a.direct.ramp_deceleration)
-      need(d.units.acceleration_needed_by, fmt::format("{}.direct_control.ramp (0x6083/0x6084)", axis));
-  }
-  if (a.axis.homing.mode == motion::HomingConfig::Mode::Active &&
-      a.axis.homing.sequence != motion::HomingConfig::Sequence::Immediate) {
-    need(d.units.velocity_needed_by, fmt::format("{}.homing (speeds, 0x6099)", axis));
-    need(d.units.acceleration_needed_by, fmt::format("{}.homing (acceleration, 0x609A)", axis));
-  }
+  drive_units_config(a, axis, d);
   dcf_writes(a.drive, d, false);
   for (const KeyedWrite& k : keyed_direct_control_writes(a)) {
     d.extra_writes.push_back(k.write);

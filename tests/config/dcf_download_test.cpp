@@ -4,6 +4,7 @@
 // with another value is refused naming both, 0x1020 (CiA 302 verify
 // configuration) goes last and a drive that holds it is not written again,
 // and the optional store (0x1010:1 = "save") has its own timeout.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -50,12 +51,22 @@ std::string store_and_verify(bool values) {
          var("1020sub2", "Configuration time", "0x0007", "rw", "0", "36000000");
 }
 
+/// 0x1010 and 0x1020 added at the end of [OptionalObjects].
+void list_store_and_verify(std::string& t) {
+  const std::size_t at = t.find("SupportedObjects=");
+  ASSERT_NE(at, std::string::npos);
+  const int n = std::stoi(t.substr(at + 17));
+  replace_once(t, fmt::format("SupportedObjects={}\n", n), fmt::format("SupportedObjects={}\n", n + 2));
+  const std::size_t last = t.find(fmt::format("\n{}=0x", n));
+  ASSERT_NE(last, std::string::npos);
+  t.insert(t.find('\n', last + 1) + 1, fmt::format("{}=0x1010\n{}=0x1020\n", n + 1, n + 2));
+}
+
 /// cia402-emu.eds with 0x1010 and 0x1020; `dcf`: with ParameterValues (the
 /// commissioning engineer's), written to a temporary file; its path.
 std::string drive_file(bool dcf, const std::string& name) {
   std::string t = read_text(std::string(CANMOTION_EXAMPLES_DIR) + "/cia402-emu.eds");
-  replace_once(t, "SupportedObjects=72\n", "SupportedObjects=74\n");
-  replace_once(t, "72=0x6502\n", "72=0x6502\n73=0x1010\n74=0x1020\n");
+  list_store_and_verify(t);
   if (dcf) {
     // Written: 0x6065 and 0x605A.
     replace_once(t, "AccessType=rww\nDefaultValue=0x000186A0\n", "AccessType=rww\nDefaultValue=0x000186A0\nParameterValue=4321\n");
