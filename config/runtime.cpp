@@ -224,6 +224,14 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   for (std::size_t i = 0; i < a.drive.sdo_writes.size(); ++i) {
     const SdoWrite& w = a.drive.sdo_writes[i];
     d.extra_writes.push_back({w.index, w.sub, w.size, static_cast<std::uint32_t>(static_cast<std::int64_t>(w.value))});
+    if (!w.bytes.empty()) {
+      cia402::SdoWrite& x = d.extra_writes.back();
+      d.value_storage.push_back(std::make_shared<const std::vector<std::uint8_t>>(w.bytes));
+      x.data = d.value_storage.back()->data();
+      x.data_len = static_cast<std::uint32_t>(w.bytes.size());
+      x.value = 0;
+      for (std::size_t b = 0; b < w.bytes.size() && b < 4; ++b) x.value |= static_cast<std::uint32_t>(w.bytes[b]) << (8 * b);
+    }
     d.hints.extra.push_back(fmt::format("{}.drive.sdo_writes[{}] (line {})", axis, i, w.where.line));
   }
   return d;
