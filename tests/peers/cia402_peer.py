@@ -413,6 +413,7 @@ class Drive:
         self.error_code = 0
         self.ip_value, self.ip_index = 1, -3   # 0x60C2: 1 ms until the master writes it
         self.note = b''
+        self.block = b''
         self.reaction_deadline = None
         self.fault_held = False
         for code in list(self.fault_codes):
@@ -496,6 +497,9 @@ class Drive:
         # --- manufacturer-specific area: a writable string (segmented downloads)
         od.add(0x2000, 0, Var('Application note', 'str', 'rw', get=lambda: d.note,
                               set=lambda v: setattr(d, 'note', v), max_len=64))
+        # a DOMAIN of up to 1 KiB (parameter blocks: SDO block transfer)
+        od.add(0x2F00, 0, Var('Parameter block', 'domain', 'rw', get=lambda: d.block,
+                              set=lambda v: setattr(d, 'block', v), max_len=1024))
 
     def _add_unit_objects(self):
         od, d = self.od, self
@@ -1057,6 +1061,8 @@ class Drive:
             if abort:
                 return self._abort(t['index'], t['sub'], abort)
             self.block_log.append(('download', t['index'], t['sub'], buf, crc))
+            self.log(f"SDO block download 0x{t['index']:04X}:{t['sub']:02X}: {len(buf)} bytes, "
+                     f"CRC 0x{crc:04X} {'checked' if t['crc'] else '(not used)'}")
             return self._reply(bytes([0xA1]))
         cs = cmd & 0x03                                                      # ccs 5: block upload
         if cs == 0:
