@@ -79,6 +79,41 @@ std::optional<std::vector<std::uint8_t>> utf16le(const std::string& s) {
   }
   return out;
 }
+/// `file:` relative to the YAML file's folder, read whole; a missing,
+/// unreadable or empty file is an error naming `key`.
+void read_value_file(Reader& r, const YAML::Node& f, const std::string& key, std::vector<std::uint8_t>& out) {
+  const std::filesystem::path fp(f.Scalar());
+  const auto full = fp.is_absolute() ? fp : (std::filesystem::path(r.file()).parent_path() / fp).lexically_normal();
+  std::ifstream in(full, std::ios::binary);
+  if (!in) return r.error(f, key, fmt::format("cannot read '{}'", full.string()));
+  out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (in.bad()) r.error(f, key, fmt::format("cannot read '{}'", full.string()));
+  else if (out.empty()) r.error(f, key, fmt::format("'{}' is empty", full.string()));
+}
+/// INTEGERn / UNSIGNEDn (n = 8..64) `v` into `out`, little endian; a value
+/// out of the type's range is an error naming the key and the type.
+void encode_integer(Reader& r, const YAML::Node& v, const std::string& p, DataType type, std::vector<std::uint8_t>& out) {
+  const std::string text = v.Scalar();
+  const std::string tn(canopen::data_type_name(type));
+  const auto bad = [&](const std::string& why) { r.error(v, p + ".value", fmt::format("{} for {}", why, tn)); };
+  const std::size_t size = canopen::data_type_size(type);
+  const int bits = static_cast<int>(8 * size);
+  if (canopen::data_type_signed(type)) {
+    long long x = 0;
+    if (!YAML::convert<long long>::decode(v, x)) return bad(fmt::format("'{}' is not an integer", text));
+    const long long lo = bits == 64 ? std::numeric_limits<long long>::min() : -(1LL << (bits - 1));
+    const long long hi = bits == 64 ? std::numeric_limits<long long>::max() : (1LL << (bits - 1)) - 1;
+    if (x < lo || x > hi) return bad(fmt::format("{} is out of range ({} .. {})", text, lo, hi));
+    le(out, static_cast<std::uint64_t>(x), size);
+  } else {
+    unsigned long long x = 0;
+    if (!text.empty() && text[0] == '-') return bad(fmt::format("{} is out of range (0 .. {})", text, bits == 64 ? std::numeric_limits<unsigned long long>::max() : (1ULL << bits) - 1));
+    if (!YAML::convert<unsigned long long>::decode(v, x)) return bad(fmt::format("'{}' is not an unsigned integer", text));
+    const unsigned long long hi = bits == 64 ? std::numeric_limits<unsigned long long>::max() : (1ULL << bits) - 1;
+    if (x > hi) return bad(fmt::format("{} is out of range (0 .. {})", text, hi));
+    le(out, x, size);
+  }
+}
 }  // namespace
 
 bool typed_sdo_write(Reader& r, const YAML::Node& e, const std::string& p, const canopen::ObjectInfo* known,
@@ -108,24 +143,12 @@ bool typed_sdo_write(Reader& r, const YAML::Node& e, const std::string& p, const
   const YAML::Node v = e["value"];
   const YAML::Node f = e["file"];
   if (f) {
-    if (*type != DataType::kDomain && *type != DataType::kOctetString) {
+    if (*type != DataType::kDomain && *type != DataType::kOctetString)
       r.error(f, p + ".file", fmt::format("a file is for DOMAIN or OCTET_STRING, not {}", tn));
-      return true;
-    }
-    if (v) {
+    else if (v)
       r.error(f, p + ".file", "give value or file, not both");
-      return true;
-    }
-    const std::filesystem::path fp(f.Scalar());
-    const auto full = fp.is_absolute() ? fp : (std::filesystem::path(r.file()).parent_path() / fp).lexically_normal();
-    std::ifstream in(full, std::ios::binary);
-    if (!in) {
-      r.error(f, p + ".file", fmt::format("cannot read '{}'", full.string()));
-      return true;
-    }
-    out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) r.error(f, p + ".file", fmt::format("cannot read '{}'", full.string()));
-    else if (out.empty()) r.error(f, p + ".file", fmt::format("'{}' is empty", full.string()));
+    else
+      read_value_file(r, f, p + ".file", out);
     return true;
   }
   if (!v || !v.IsScalar()) {
@@ -134,7 +157,6 @@ bool typed_sdo_write(Reader& r, const YAML::Node& e, const std::string& p, const
   }
   const std::string text = v.Scalar();
   const auto bad = [&](const std::string& why) { r.error(v, p + ".value", fmt::format("{} for {}", why, tn)); };
-  const std::size_t size = canopen::data_type_size(*type);
   switch (*type) {
     case DataType::kBoolean: {
       bool b = false;
@@ -180,23 +202,7 @@ bool typed_sdo_write(Reader& r, const YAML::Node& e, const std::string& p, const
     }
     default: break;
   }
-  // INTEGERn / UNSIGNEDn, n = 8..64.
-  const int bits = static_cast<int>(8 * size);
-  if (canopen::data_type_signed(*type)) {
-    long long x = 0;
-    if (!YAML::convert<long long>::decode(v, x)) return bad(fmt::format("'{}' is not an integer", text)), true;
-    const long long lo = bits == 64 ? std::numeric_limits<long long>::min() : -(1LL << (bits - 1));
-    const long long hi = bits == 64 ? std::numeric_limits<long long>::max() : (1LL << (bits - 1)) - 1;
-    if (x < lo || x > hi) return bad(fmt::format("{} is out of range ({} .. {})", text, lo, hi)), true;
-    le(out, static_cast<std::uint64_t>(x), size);
-  } else {
-    unsigned long long x = 0;
-    if (!text.empty() && text[0] == '-') return bad(fmt::format("{} is out of range (0 .. {})", text, bits == 64 ? std::numeric_limits<unsigned long long>::max() : (1ULL << bits) - 1)), true;
-    if (!YAML::convert<unsigned long long>::decode(v, x)) return bad(fmt::format("'{}' is not an unsigned integer", text)), true;
-    const unsigned long long hi = bits == 64 ? std::numeric_limits<unsigned long long>::max() : (1ULL << bits) - 1;
-    if (x > hi) return bad(fmt::format("{} is out of range (0 .. {})", text, hi)), true;
-    le(out, x, size);
-  }
+  encode_integer(r, v, p, *type, out);
   return true;
 }
 

@@ -137,6 +137,7 @@ void SdoClient::finish(SdoAbort abort, bool by_server, std::int64_t now_ns) noex
   res_.abort = abort;
   res_.aborted_by_server = by_server;
   res_.finished_ns = now_ns;
+  if (abort == SdoAbort::kNone && !cur_.upload) res_.bytes = static_cast<std::uint32_t>(src_len());  // a download sent it all
   if (abort == SdoAbort::kNone) {
     ++completed_;
   } else {
@@ -205,10 +206,7 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
   switch (phase_) {
     case Phase::kInitDownload:
       if (s.kind != sdo::SdoFrameKind::kInitiateDownloadResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
-      if (src_len() <= 4) {
-        res_.bytes = static_cast<std::uint32_t>(src_len());
-        return finish(SdoAbort::kNone, false, now_ns);
-      }
+      if (src_len() <= 4) return finish(SdoAbort::kNone, false, now_ns);
       phase_ = Phase::kDownloadSegment;
       toggle_ = false;
       send_next_download_segment();
@@ -216,10 +214,7 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
     case Phase::kDownloadSegment:
       if (s.kind != sdo::SdoFrameKind::kDownloadSegmentResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
       if (s.toggle != toggle_) return abort_transfer(SdoAbort::kToggleBit, now_ns);
-      if (offset_ >= src_len()) {
-        res_.bytes = static_cast<std::uint32_t>(offset_);
-        return finish(SdoAbort::kNone, false, now_ns);
-      }
+      if (offset_ >= src_len()) return finish(SdoAbort::kNone, false, now_ns);
       toggle_ = !toggle_;
       send_next_download_segment();
       return;

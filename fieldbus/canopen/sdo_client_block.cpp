@@ -153,7 +153,6 @@ bool SdoClient::on_block_frame(const can::Frame& fin, std::int64_t now_ns) noexc
     }
     case Phase::kBlockDownEnd:
       if (!is(f, 0xE3, 0xA1)) return false;  // scs 5, ss 1: end response
-      res_.bytes = static_cast<std::uint32_t>(src_len());
       finish(SdoAbort::kNone, false, now_ns);
       return true;
     case Phase::kBlockUpInit:
