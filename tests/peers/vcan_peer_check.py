@@ -95,9 +95,13 @@ class Check:
 
     def sdo_transfers(self):
         """Expedited downloads by the master: (t, index, sub, value, abort or 0 or None)."""
-        out = []
+        out, block = [], False
         for t, d, rsp in self.sdo_pairs():
-            if d[0] >> 5 != 1:
+            if d[0] & 0xE1 == 0xC0:       # a block download initiate: its sub-block segments
+                block = True              # (any first byte, 0x21.. included) are not initiates
+            elif block and d[0] & 0xE3 == 0xC1:
+                block = False
+            if block or d[0] >> 5 != 1:
                 continue
             index, sub = struct.unpack_from('<HB', d, 1)
             n = (d[0] >> 2) & 3 if d[0] & 1 else 0
