@@ -120,9 +120,11 @@ struct DriveTimeouts {
 struct SdoWrite {
   std::uint16_t index = 0;
   std::uint8_t sub = 0;
-  std::uint8_t size = 4;  ///< bytes: 1, 2 or 4
+  std::uint8_t size = 4;  ///< bytes: 1, 2 or 4 (integer path, `bytes` empty)
   std::int64_t value = 0;
   Location where;
+  std::string type;                 ///< CiA 301 type name when given or taken from the object table ("" = integer path)
+  std::vector<std::uint8_t> bytes;  ///< typed entries: the value's bytes, prepared at load (little endian)
 };
 
 /// One ParameterValue of a drive's DCF (`drive.dcf`) written at boot.

@@ -76,9 +76,9 @@ void identity(Reader& r, const YAML::Node& id, const std::string& p, DriveIdenti
 std::optional<SdoWrite> sdo_write(Reader& r, const YAML::Node& e, const std::string& p) {
   SdoWrite s;
   s.where = r.loc(e);
-  if (!r.check_map(e, p, {"index", "sub", "size", "value"})) return std::nullopt;
-  if (!e["index"] || !e["value"]) {
-    r.error(e, p, "needs at least index and value");
+  if (!r.check_map(e, p, {"index", "sub", "size", "value", "type", "file"})) return std::nullopt;
+  if (!e["index"] || (!e["value"] && !e["file"])) {
+    r.error(e, p, "needs at least index and value (or file)");
     return std::nullopt;
   }
   r.scalar(e, p, "index", s.index, std::uint16_t{0x1000}, std::uint16_t{0xFFFF});
@@ -89,6 +89,16 @@ std::optional<SdoWrite> sdo_write(Reader& r, const YAML::Node& e, const std::str
   const std::size_t known_size = known != nullptr ? canopen::data_type_size(known->type) : 0;
   if (known != nullptr && (known->access == canopen::Access::kRo || known->access == canopen::Access::kConst))
     r.error(e["index"], p + ".index", fmt::format("0x{:04X}:{:02X} ({}) is read-only", s.index, s.sub, known->name));
+  // A CiA 301 type (given, or a table type the integer path cannot carry):
+  // the bytes are prepared here.
+  const bool table_typed = known != nullptr && known_size != 1 && known_size != 2 && known_size != 4;
+  if (e["type"] || e["file"] || table_typed) {
+    if (e["size"]) r.error(e["size"], p + ".size", "is for the integer form; a typed entry takes its size from its type");
+    if (typed_sdo_write(r, e, p, known, s)) {
+      s.size = static_cast<std::uint8_t>(std::min<std::size_t>(s.bytes.size(), 255));
+      return s;
+    }
+  }
   if (known_size == 1 || known_size == 2 || known_size == 4) s.size = static_cast<std::uint8_t>(known_size);
   if (const YAML::Node sz = e["size"]) {
     std::uint8_t given = 0;

@@ -10,6 +10,8 @@
 #include "config/config.hpp"
 #include "config/yaml_reader.hpp"
 
+#include "fieldbus/canopen/object_names.hpp"
+
 namespace canmotion::config::load {
 
 // load_controller.cpp
@@ -22,6 +24,12 @@ namespace canmotion::config::load {
 /// A `drive:` block (of `drives:` at `path` "drives", or of an axis) over `d`:
 /// the keys present override the defaults already in `d`.
 void drive(Reader& r, const YAML::Node& n, const std::string& path, DriveSettings& d);
+/// An `sdo_writes` entry with `type:` (or `file:`, or an object whose table
+/// type is a string, domain, 64-bit or real type): fills s.type and s.bytes
+/// (prepared at load) and returns true, errors reported naming the key and
+/// the type; false when the entry takes the integer path (size/value).
+bool typed_sdo_write(Reader& r, const YAML::Node& e, const std::string& p, const canopen::ObjectInfo* known,
+                     SdoWrite& s);
 
 // load_axis.cpp
 /// One `axes:` entry at `path`, its drive settings starting from `defaults` (`drives:`).

@@ -200,6 +200,16 @@ void identity_config(const DriveIdentitySettings& id, cia402::DriveIdentity& out
 }
 }  // namespace
 
+/// A typed sdo_writes value: its bytes kept by the DriveConfig (shared by
+/// its copies), the write referencing them (no copy at boot).
+static void reference_typed_bytes(const std::vector<std::uint8_t>& bytes, cia402::SdoWrite& x, cia402::DriveConfig& d) {
+  d.value_storage.push_back(std::make_shared<const std::vector<std::uint8_t>>(bytes));
+  x.data = d.value_storage.back()->data();
+  x.data_len = static_cast<std::uint32_t>(bytes.size());
+  x.value = 0;
+  for (std::size_t b = 0; b < bytes.size() && b < 4; ++b) x.value |= static_cast<std::uint32_t>(bytes[b]) << (8 * b);
+}
+
 cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s, std::size_t axis_index) {
   cia402::DriveConfig d;
   const std::string axis = fmt::format("axes[{}]", axis_index);
@@ -266,6 +276,7 @@ cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, 
   for (std::size_t i = 0; i < a.drive.sdo_writes.size(); ++i) {
     const SdoWrite& w = a.drive.sdo_writes[i];
     d.extra_writes.push_back({w.index, w.sub, w.size, static_cast<std::uint32_t>(static_cast<std::int64_t>(w.value))});
+    if (!w.bytes.empty()) reference_typed_bytes(w.bytes, d.extra_writes.back(), d);
     d.hints.extra.push_back(fmt::format("{}.drive.sdo_writes[{}] (line {})", axis, i, w.where.line));
   }
   dcf_writes(a.drive, d, true);

@@ -26,6 +26,9 @@ bool SdoClient::download(std::uint16_t index, std::uint8_t sub, std::span<const 
   r.index = index;
   r.sub = sub;
   r.upload = false;
+  r.block = false;
+  r.ref = nullptr;
+  r.dest = nullptr;
   r.len = static_cast<std::uint8_t>(data.size());
   std::copy(data.begin(), data.end(), r.data.begin());
   ++queue_count_;
@@ -40,7 +43,46 @@ bool SdoClient::upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag,
   r.index = index;
   r.sub = sub;
   r.upload = true;
+  r.block = false;
+  r.ref = nullptr;
+  r.dest = nullptr;
   r.len = 0;
+  ++queue_count_;
+  return true;
+}
+
+bool SdoClient::download_ref(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                             std::uint32_t tag, std::int64_t timeout_ns, Transfer mode) noexcept {
+  if (queue_count_ == kQueueCapacity || data.empty() || data.size() > 0xFFFFFFFFu) return false;
+  Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
+  r.tag = tag;
+  r.timeout_ns = timeout_ns;
+  r.index = index;
+  r.sub = sub;
+  r.upload = false;
+  r.block = mode == Transfer::kBlock || (mode == Transfer::kAuto && data.size() > kSdoMaxDownload);
+  r.len = 0;
+  r.ref = data.data();
+  r.dest = nullptr;
+  r.ref_len = static_cast<std::uint32_t>(data.size());
+  ++queue_count_;
+  return true;
+}
+
+bool SdoClient::upload_into(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> dest, std::uint32_t tag,
+                            std::int64_t timeout_ns, Transfer mode) noexcept {
+  if (queue_count_ == kQueueCapacity || dest.empty() || dest.size() > 0xFFFFFFFFu) return false;
+  Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
+  r.tag = tag;
+  r.timeout_ns = timeout_ns;
+  r.index = index;
+  r.sub = sub;
+  r.upload = true;
+  r.block = mode != Transfer::kSegmented;
+  r.len = 0;
+  r.ref = nullptr;
+  r.dest = dest.data();
+  r.ref_len = static_cast<std::uint32_t>(dest.size());
   ++queue_count_;
   return true;
 }
@@ -52,6 +94,10 @@ void SdoClient::cancel_all() noexcept {
 
 void SdoClient::start(const Request& r, std::int64_t now_ns) noexcept {
   cur_ = r;
+  res_.block = false;
+  res_.fell_back = false;
+  res_.retried = false;
+  res_.bytes = 0;
   res_.tag = r.tag;
   res_.node = node_;
   res_.index = r.index;
@@ -68,20 +114,22 @@ void SdoClient::start(const Request& r, std::int64_t now_ns) noexcept {
   offset_ = 0;
   expected_ = 0;
   size_known_ = false;
-  if (r.upload) {
+  if (r.block && !block_refused_) {
+    start_block(now_ns);
+  } else if (r.upload) {
     phase_ = Phase::kInitUpload;
     queue_tx(sdo_frame(node_, 0x40, r.index, r.sub));
-  } else if (r.len <= 4) {
+  } else if (src_len() <= 4) {
     phase_ = Phase::kInitDownload;
-    const auto n = static_cast<std::uint8_t>(4 - r.len);
+    const auto n = static_cast<std::uint8_t>(4 - src_len());
     can::Frame f = sdo_frame(node_, static_cast<std::uint8_t>(0x20 | (n << 2) | sdo::kExpedited | sdo::kSizeIndicated),
                              r.index, r.sub);
-    std::copy_n(r.data.begin(), r.len, f.data.begin() + 4);
+    std::copy_n(src(), src_len(), f.data.begin() + 4);
     queue_tx(f);
   } else {
     phase_ = Phase::kInitDownload;
     res_.segmented = true;
-    queue_tx(sdo_frame(node_, 0x21, r.index, r.sub, r.len));  // size indicated
+    queue_tx(sdo_frame(node_, 0x21, r.index, r.sub, static_cast<std::uint32_t>(src_len())));  // size indicated
   }
 }
 
@@ -89,6 +137,7 @@ void SdoClient::finish(SdoAbort abort, bool by_server, std::int64_t now_ns) noex
   res_.abort = abort;
   res_.aborted_by_server = by_server;
   res_.finished_ns = now_ns;
+  if (abort == SdoAbort::kNone && !cur_.upload) res_.bytes = static_cast<std::uint32_t>(src_len());  // a download sent it all
   if (abort == SdoAbort::kNone) {
     ++completed_;
   } else {
@@ -109,20 +158,21 @@ void SdoClient::abort_transfer(SdoAbort abort, std::int64_t now_ns) noexcept {
 }
 
 void SdoClient::send_next_download_segment() noexcept {
-  const std::size_t remaining = cur_.len - offset_;
+  const std::size_t remaining = src_len() - offset_;
   const std::size_t n = std::min<std::size_t>(7, remaining);
   const bool last = n == remaining;
-  queue_tx(sdo::segment_frame(cob::sdo_rx(node_), toggle_, std::span<const std::uint8_t>(cur_.data.data() + offset_, n), last));
+  queue_tx(sdo::segment_frame(cob::sdo_rx(node_), toggle_, std::span<const std::uint8_t>(src() + offset_, n), last));
   offset_ += n;
 }
 
 void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
   if (f.id != cob::sdo_tx(node_) || f.extended() || f.remote()) return;
-  if (phase_ == Phase::kIdle) return;  // late or unsolicited response
+  if (phase_ == Phase::kIdle || phase_ == Phase::kRetry) return;  // late or unsolicited response
   if (f.len == 0 || f.len > 8) {
     abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
     return;
   }
+  if (on_block_frame(f, now_ns)) return;
   // A reply shorter than 8 bytes is taken as lely takes it: the bytes it
   // lacks read as 0, as long as it carries what its command needs (checked
   // below: the data an expedited or segment reply announces; an abort
@@ -133,6 +183,9 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
   const sdo::SdoFrame s = sdo::decode(padded, true);
   if (s.kind == sdo::SdoFrameKind::kAbort) {
     const SdoAbort code = f.len >= 8 ? static_cast<SdoAbort>(s.abort_code) : SdoAbort::kGeneral;
+    if ((phase_ == Phase::kBlockDownInit || phase_ == Phase::kBlockUpInit) && code == SdoAbort::kCommandSpecifier) {
+      return fall_back_to_segmented(now_ns);  // the server lacks block transfer
+    }
     // One transfer at a time per server: an abort now is for it, whatever
     // index/sub it names (some servers name another or none). Its code is
     // the answer, not a timeout later; what it named is kept.
@@ -153,7 +206,7 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
   switch (phase_) {
     case Phase::kInitDownload:
       if (s.kind != sdo::SdoFrameKind::kInitiateDownloadResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
-      if (cur_.len <= 4) return finish(SdoAbort::kNone, false, now_ns);
+      if (src_len() <= 4) return finish(SdoAbort::kNone, false, now_ns);
       phase_ = Phase::kDownloadSegment;
       toggle_ = false;
       send_next_download_segment();
@@ -161,7 +214,7 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
     case Phase::kDownloadSegment:
       if (s.kind != sdo::SdoFrameKind::kDownloadSegmentResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
       if (s.toggle != toggle_) return abort_transfer(SdoAbort::kToggleBit, now_ns);
-      if (offset_ >= cur_.len) return finish(SdoAbort::kNone, false, now_ns);
+      if (offset_ >= src_len()) return finish(SdoAbort::kNone, false, now_ns);
       toggle_ = !toggle_;
       send_next_download_segment();
       return;
@@ -170,14 +223,17 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
       if (s.expedited) {
         // The bytes it announces must be there (without a size: up to 4, as many as it has).
         if (f.len < 4 + (s.size_indicated ? s.data_len : 1)) return abort_transfer(SdoAbort::kLengthTooLow, now_ns);
-        res_.size = s.size_indicated ? s.data_len : static_cast<std::uint8_t>(f.len - 4);
-        std::copy_n(s.data, s.data_len, res_.data.begin());
+        const std::uint8_t n = s.size_indicated ? s.data_len : static_cast<std::uint8_t>(f.len - 4);
+        if (n > dst_cap()) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
+        std::copy_n(s.data, n, dst());
+        res_.bytes = n;
+        if (cur_.dest == nullptr) res_.size = n;
         return finish(SdoAbort::kNone, false, now_ns);
       }
       res_.segmented = true;
       size_known_ = s.size_indicated;
       expected_ = s.size;
-      if (size_known_ && expected_ > kSdoMaxUpload) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
+      if (size_known_ && expected_ > dst_cap()) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
       phase_ = Phase::kUploadSegment;
       toggle_ = false;
       queue_tx(sdo_frame(node_, 0x60, 0, 0));
@@ -187,10 +243,11 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
       if (s.kind != sdo::SdoFrameKind::kUploadSegmentResponse) return abort_transfer(SdoAbort::kCommandSpecifier, now_ns);
       if (s.toggle != toggle_) return abort_transfer(SdoAbort::kToggleBit, now_ns);
       if (f.len < 1 + s.data_len) return abort_transfer(SdoAbort::kLengthTooLow, now_ns);  // announced, not sent
-      if (offset_ + s.data_len > kSdoMaxUpload) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
-      std::copy_n(s.data, s.data_len, res_.data.begin() + static_cast<std::ptrdiff_t>(offset_));
+      if (offset_ + s.data_len > dst_cap()) return abort_transfer(SdoAbort::kOutOfMemory, now_ns);
+      std::copy_n(s.data, s.data_len, dst() + offset_);
       offset_ += s.data_len;
-      res_.size = static_cast<std::uint16_t>(offset_);
+      res_.bytes = static_cast<std::uint32_t>(offset_);
+      if (cur_.dest == nullptr) res_.size = static_cast<std::uint16_t>(offset_);
       if (s.last) {
         if (size_known_ && offset_ != expected_) {
           return abort_transfer(offset_ > expected_ ? SdoAbort::kLengthTooHigh : SdoAbort::kLengthTooLow, now_ns);
@@ -201,7 +258,7 @@ void SdoClient::on_frame(const can::Frame& f, std::int64_t now_ns) noexcept {
       queue_tx(sdo_frame(node_, static_cast<std::uint8_t>(0x60 | (toggle_ ? sdo::kToggle : 0)), 0, 0));
       return;
     }
-    case Phase::kIdle: return;
+    default: return;  // idle, retry; block phases are handled by on_block_frame()
   }
 }
 
@@ -210,8 +267,21 @@ void SdoClient::step(std::int64_t now_ns, FrameSink& out) noexcept {
     cancel_pending_ = false;
     if (phase_ != Phase::kIdle) abort_transfer(SdoAbort::kGeneral, now_ns);
   }
-  if (phase_ != Phase::kIdle && !tx_pending_ && now_ns - last_tx_ns_ > timeout_of(cur_)) {
-    abort_transfer(SdoAbort::kTimeout, now_ns);
+  if (phase_ != Phase::kIdle && phase_ != Phase::kRetry && !tx_pending_ && now_ns - last_tx_ns_ > timeout_of(cur_)) {
+    if (res_.retried) {
+      abort_transfer(SdoAbort::kTimeout, now_ns);
+    } else {
+      // One retry: abort the first try (0x05040000, so the server drops
+      // it), then start the same transfer from its initiate next step.
+      queue_tx(sdo::abort_frame(cob::sdo_rx(node_), cur_.index, cur_.sub, static_cast<std::uint32_t>(SdoAbort::kTimeout)));
+      phase_ = Phase::kRetry;
+    }
+  } else if (phase_ == Phase::kRetry && !tx_pending_) {
+    const SdoResult first = res_;
+    start(cur_, now_ns);
+    res_.started_ns = first.started_ns;
+    res_.fell_back = first.fell_back;
+    res_.retried = true;
   }
   if (phase_ == Phase::kIdle && !tx_pending_ && queue_count_ > 0) {
     const Request r = queue_[queue_head_];
@@ -226,6 +296,7 @@ void SdoClient::step(std::int64_t now_ns, FrameSink& out) noexcept {
       tx_pending_ = false;
       last_tx_ns_ = now_ns;
       tx_refused_since_ns_ = -1;
+      if (phase_ == Phase::kBlockDownSub) send_block_segments(now_ns, out);
     } else if (tx_refused_since_ns_ < 0) {
       tx_refused_since_ns_ = now_ns;
     } else if (now_ns - tx_refused_since_ns_ > timeout_of(cur_) && phase_ != Phase::kIdle) {
@@ -234,6 +305,8 @@ void SdoClient::step(std::int64_t now_ns, FrameSink& out) noexcept {
     } else if (now_ns - tx_refused_since_ns_ > timeout_ns_) {
       tx_pending_ = false;  // an abort frame of ours that cannot go out: dropped
     }
+  } else if (phase_ == Phase::kBlockDownSub) {
+    send_block_segments(now_ns, out);
   }
 }
 

@@ -27,6 +27,27 @@ namespace canmotion::canopen {
 inline constexpr std::size_t kSdoMaxDownload = 64;
 /// Largest value an upload may return (0x1008 device names, short strings).
 inline constexpr std::size_t kSdoMaxUpload = 256;
+/// Segments per sub-block the client asks for in a block upload (CiA 301
+/// allows 1..127; 127 is what python-canopen and CANopenNode ask for).
+inline constexpr std::uint8_t kSdoBlockSize = 127;
+
+/// How a transfer goes on the wire. kAuto: block for data longer than
+/// kSdoMaxDownload bytes (block upload for upload_into()), else expedited or
+/// segmented. A server that refuses a block initiate with 0x05040001 gets the
+/// same transfer segmented (a drive may lack block transfer).
+enum class Transfer : std::uint8_t { kAuto, kSegmented, kBlock };
+
+/// CRC-16 of CiA 301 §7.2.4.3.16 (CCITT polynomial 0x1021, initial value 0,
+/// no reflection: CRC-16/XMODEM; check value of "123456789" is 0x31C3),
+/// continuing from `crc`. Realtime-safe.
+[[nodiscard]] constexpr std::uint16_t sdo_crc16(std::span<const std::uint8_t> data, std::uint16_t crc = 0) noexcept {
+  for (const std::uint8_t b : data) {
+    crc = static_cast<std::uint16_t>(crc ^ (static_cast<std::uint16_t>(b) << 8));
+    for (int i = 0; i < 8; ++i)
+      crc = static_cast<std::uint16_t>((crc & 0x8000u) != 0 ? (crc << 1) ^ 0x1021u : crc << 1);
+  }
+  return crc;
+}
 
 /// A finished transfer.
 struct SdoResult {
@@ -40,6 +61,10 @@ struct SdoResult {
   std::uint16_t abort_index = 0;     ///< aborted_by_server: the index/sub the abort frame named (may differ from index/sub)
   std::uint8_t abort_sub = 0;
   bool segmented = false;
+  bool block = false;        ///< the transfer went as a block transfer
+  bool fell_back = false;    ///< a block initiate was refused (0x05040001) and the transfer went segmented
+  bool retried = false;      ///< the first try timed out and the transfer was started once more
+  std::uint32_t bytes = 0;   ///< bytes transferred (download_ref(): sent; upload_into(): written to the destination)
   std::int64_t started_ns = 0;
   std::int64_t finished_ns = 0;
   std::uint16_t size = 0;  ///< bytes in `data` (uploads)
@@ -88,6 +113,19 @@ class SdoClient {
   /// Queue a read (`timeout_ns` as for download()). False if the queue is full.
   bool upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag = 0, std::int64_t timeout_ns = 0) noexcept;
 
+  /// Queue a write of `data` of any length (firmware, parameter blocks,
+  /// DOMAIN values) that the caller keeps alive and unchanged until the
+  /// transfer's result is polled: nothing is copied, nothing allocated.
+  /// `mode` as Transfer says. False if the queue is full or `data` is empty.
+  bool download_ref(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data, std::uint32_t tag = 0,
+                    std::int64_t timeout_ns = 0, Transfer mode = Transfer::kAuto) noexcept;
+  /// Queue a read into `dest` (kept alive by the caller until the result is
+  /// polled; SdoResult::bytes says how much was written, SdoResult::data is
+  /// not used). A value longer than `dest` aborts with 0x05040005. kAuto goes
+  /// as a block upload. False if the queue is full or `dest` is empty.
+  bool upload_into(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> dest, std::uint32_t tag = 0,
+                   std::int64_t timeout_ns = 0, Transfer mode = Transfer::kAuto) noexcept;
+
   /// Feed a frame from the server (ID 0x580 + node; other frames are ignored).
   /// An initiate answer naming another object than the running transfer's
   /// (a late answer to one that timed out or was cancelled) is ignored too.
@@ -117,17 +155,35 @@ class SdoClient {
   [[nodiscard]] std::uint64_t failed() const noexcept { return failed_; }
 
  private:
-  enum class Phase : std::uint8_t { kIdle, kInitDownload, kDownloadSegment, kInitUpload, kUploadSegment };
+  enum class Phase : std::uint8_t {
+    kIdle, kInitDownload, kDownloadSegment, kInitUpload, kUploadSegment,
+    kBlockDownInit, kBlockDownSub, kBlockDownAck, kBlockDownEnd,  // block download (CiA 301 §7.2.4.3.9-.12)
+    kBlockUpInit, kBlockUpSub, kBlockUpEnd,                       // block upload (§7.2.4.3.13-.16)
+    kRetry,  // timed out once: the abort goes out, then the transfer starts again
+  };
   struct Request {
     std::uint32_t tag;
     std::int64_t timeout_ns;  // 0: the client's
     std::uint16_t index;
     std::uint8_t sub;
     bool upload;
+    bool block;  // go as a block transfer
     std::uint8_t len;
     std::array<std::uint8_t, kSdoMaxDownload> data;
+    const std::uint8_t* ref = nullptr;  // download_ref(): caller's data; upload_into(): caller's destination
+    std::uint8_t* dest = nullptr;
+    std::uint32_t ref_len = 0;  // bytes at ref / room at dest
   };
+  [[nodiscard]] const std::uint8_t* src() const noexcept { return cur_.ref != nullptr ? cur_.ref : cur_.data.data(); }
+  [[nodiscard]] std::size_t src_len() const noexcept { return cur_.ref != nullptr ? cur_.ref_len : cur_.len; }
+  [[nodiscard]] std::uint8_t* dst() noexcept { return cur_.dest != nullptr ? cur_.dest : res_.data.data(); }
+  [[nodiscard]] std::size_t dst_cap() const noexcept { return cur_.dest != nullptr ? cur_.ref_len : kSdoMaxUpload; }
   void start(const Request& r, std::int64_t now_ns) noexcept;
+  void start_block(std::int64_t now_ns) noexcept;
+  bool on_block_frame(const can::Frame& f, std::int64_t now_ns) noexcept;
+  void on_block_upload_segment(const can::Frame& f, std::int64_t now_ns) noexcept;
+  void send_block_segments(std::int64_t now_ns, FrameSink& out) noexcept;
+  void fall_back_to_segmented(std::int64_t now_ns) noexcept;
   void finish(SdoAbort abort, bool by_server, std::int64_t now_ns) noexcept;
   void abort_transfer(SdoAbort abort, std::int64_t now_ns) noexcept;
   void queue_tx(const can::Frame& f) noexcept {
@@ -161,6 +217,15 @@ class SdoClient {
   std::int64_t tx_refused_since_ns_ = -1;  // the pending frame's first refused send (-1: none)
   bool cancel_pending_ = false;
   can::Frame tx_{};
+  // Block transfer state.
+  bool block_refused_ = false;    // the server refused a block initiate once: later transfers go segmented
+  bool server_crc_ = false;       // the server supports the CRC (both sides must for it to be used)
+  std::uint8_t blksize_ = 0;      // segments in the current sub-block
+  std::uint8_t seqno_ = 0;        // download: last segment sent; upload: last in-order segment received
+  std::size_t sub_start_ = 0;     // download: data offset of the current sub-block's first segment
+  bool last_sent_ = false;        // download: the segment with the c bit is in this sub-block
+  bool got_last_ = false;         // upload: the segment with the c bit arrived in order
+  std::array<std::uint8_t, 7> last_seg_{};  // upload: that segment's bytes until the end frame says how many count
   std::uint64_t completed_ = 0;
   std::uint64_t failed_ = 0;
 };

@@ -29,6 +29,7 @@ void SdoServer::on_frame(const can::Frame& f, std::int64_t now_ns, FrameSink& ou
     send_abort(static_cast<std::uint16_t>(f.data[1] | (f.data[2] << 8)), f.data[3], SdoAbort::kCommandSpecifier, out);
     return;
   }
+  if (phase_ == Phase::kBlockDown && f.data[0] != 0x80) return on_block_download_segment(f, out);
   const sdo::SdoFrame s = sdo::decode(f, false);
   switch (s.kind) {
     case sdo::SdoFrameKind::kAbort:
@@ -57,7 +58,7 @@ void SdoServer::on_frame(const can::Frame& f, std::int64_t now_ns, FrameSink& ou
       if (phase_ != Phase::kDownload) return send_abort(index_, sub_, SdoAbort::kCommandSpecifier, out);
       if (s.toggle != toggle_) return send_abort(index_, sub_, SdoAbort::kToggleBit, out);
       if (offset_ + s.data_len > kSdoServerBuffer) return send_abort(index_, sub_, SdoAbort::kOutOfMemory, out);
-      std::copy_n(s.data, s.data_len, buf_.begin() + static_cast<std::ptrdiff_t>(offset_));
+      std::copy_n(s.data, s.data_len, buf_.begin() + offset_);
       offset_ += s.data_len;
       if (s.last) {
         if (size_indicated_ && offset_ != size_) {
@@ -107,8 +108,11 @@ void SdoServer::on_frame(const can::Frame& f, std::int64_t now_ns, FrameSink& ou
       out.send(r);
       return;
     }
-    default:
-      // Block transfers and unknown command specifiers.
+    case sdo::SdoFrameKind::kBlock:
+      if (block_) return on_block_frame(f, out);
+      // A drive without block transfer; the abort names the initiate's object.
+      return send_abort(static_cast<std::uint16_t>(f.data[1] | (f.data[2] << 8)), f.data[3], SdoAbort::kCommandSpecifier, out);
+    default:  // unknown command specifiers
       return send_abort(s.index, s.sub, SdoAbort::kCommandSpecifier, out);
   }
 }

@@ -60,6 +60,13 @@ struct SdoWrite {
   /// boot shows the configuration the DCF was made for
   /// (DriveConfig::dcf_date); the DCF's values wait for that answer.
   bool dcf = false;
+  /// A typed value of any length (sdo_writes with `type:`/`file:`: strings,
+  /// 64-bit, REAL, DOMAIN), prepared at set-up and only referenced by the
+  /// boot (SdoClient::download_ref, block transfer when longer than 64
+  /// bytes): `size`/`value` are then not written. Null: the integer form.
+  /// The bytes are owned by DriveConfig::value_storage.
+  const std::uint8_t* data = nullptr;
+  std::uint32_t data_len = 0;
 };
 
 /// Configuration keys to name when the drive refuses a boot configuration

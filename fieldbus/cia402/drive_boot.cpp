@@ -215,6 +215,9 @@ void DriveProxy::queue_transfers(canopen::SdoClient& sdo) noexcept {
     const auto tag = static_cast<std::uint32_t>(next_write_);
     if (bw.is_read()) {
       if (!sdo.upload(w.index, w.sub, tag)) break;
+    } else if (w.data != nullptr && w.data_len > 0) {
+      // Prepared at set-up and kept by the DriveConfig: referenced, not copied.
+      if (!sdo.download_ref(w.index, w.sub, std::span<const std::uint8_t>(w.data, w.data_len), tag, w.timeout_ns)) break;
     } else {
       const std::uint32_t value = in_drive_unit(w);
       std::uint8_t b[4];

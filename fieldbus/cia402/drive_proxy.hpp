@@ -125,6 +125,9 @@ struct DriveConfig {
   std::uint16_t consumer_heartbeat_ms = 300;  ///< drive's 0x1016:1, watching the master (0 = not written: 0x1016 is optional)
   std::int64_t heartbeat_timeout_ns = 0;      ///< master-side consumer; 0 = 3 x producer period
   std::vector<SdoWrite> extra_writes;         ///< written after the standard configuration
+  /// The bytes of typed extra_writes (SdoWrite::data points into them),
+  /// shared by copies of this DriveConfig so that the pointers stay valid.
+  std::vector<std::shared_ptr<const std::vector<std::uint8_t>>> value_storage;
   DriveUnits units;                           ///< the velocity and acceleration units (read at boot if unknown)
   std::int64_t boot_timeout_ns = 2'000'000'000;     ///< wait for boot-up/heartbeat before resetting the node
   std::int64_t sdo_timeout_ns = 200'000'000;        ///< per SDO response

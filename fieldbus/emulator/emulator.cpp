@@ -43,6 +43,7 @@ Emulator::Emulator(const EmulatorConfig& cfg)
       sw_version_("canmotion 0.1"),
       sdo_(cfg.node, *this) {
   cfg_.lag_cycles = std::min<std::uint32_t>(cfg_.lag_cycles, kMaxLag);
+  sdo_.set_block_transfer(!cfg_.behaviour.sdo_block_refused);
   build_dictionary();
   resolve_hot();
   pos_ = static_cast<double>(cfg_.initial_position);

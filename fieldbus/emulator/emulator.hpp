@@ -100,6 +100,9 @@ struct EmulatorBehaviour {
   /// (error register bit 4) and takes 0x1029:1's reaction (error_behaviour:
   /// 0 leaves Operational); the next SYNC clears it (EMCY 0000h).
   bool sync_timeout = true;
+  /// The SDO server refuses block transfer with 0x05040001, as a drive
+  /// without it (the master then goes segmented). Off in both profiles.
+  bool sdo_block_refused = false;
   /// 0x1029:1 (error behaviour, communication error) exists and acts on a
   /// communication error (lost master heartbeat, SYNC watch): 0 = Pre-operational
   /// (default), 1 = no change, 2 = Stopped.

@@ -134,7 +134,7 @@ case $scn in
     say "message: $why"
     if [[ $scn == sdo_timeout ]]; then
       parts=("node 2: configuration read of 0x1000:0" "aborted with 0x05040000" "the drive did not answer")
-      lo=500 hi=1500
+      lo=1000 hi=1500  # sdo_ms 500, tried twice (one retry): 2 x 500 ms + up to 3 cycles
     else
       parts=("node 2: configuration write to 0x1016:1" "aborted with 0x06020000 (object does not exist in the object dictionary)"
              "the drive refused it" "set axes[0].drive.master_heartbeat_timeout_ms (or drives.master_heartbeat_timeout_ms): 0")

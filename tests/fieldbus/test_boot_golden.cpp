@@ -266,7 +266,8 @@ const std::vector<Scenario>& scenarios() {
        c.emulator.behaviour = emulator::EmulatorBehaviour::permissive();
      }},
     {"reboot", 0x04F96B8C2B80BDEFull, [](SimRigConfig&) {}, reboot},
-    {"sdo-timeout", 0x729266779EBC4725ull, [](SimRigConfig& c) { c.emulator.behaviour.sdo_reply_delay_ns = 300'000'000; }},
+    // 500 ms: later than both tries of the 200 ms SDO timeout (one retry, issue 30).
+    {"sdo-timeout", 0x7F1E266554EB5903ull, [](SimRigConfig& c) { c.emulator.behaviour.sdo_reply_delay_ns = 500'000'000; }},
     {"reset-first-fewer-pdos", 0x005BD85B5979650Eull, [](SimRigConfig& c) {
        c.drive.reset_node_first = true;
        c.emulator.absent_objects = {0x1402, 0x1602, 0x1803, 0x1A03};

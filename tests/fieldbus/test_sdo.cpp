@@ -285,15 +285,23 @@ TEST(FieldbusSdo, TimeoutOnVirtualClockThenNextTransferRuns) {
   canopen::SdoResult r;
   EXPECT_FALSE(c.poll(r));
   EXPECT_EQ(out.frames.size(), 1u);
-  c.step(100 * kMs + 1, out);
+  c.step(100 * kMs + 1, out);  // the first try is aborted ...
+  EXPECT_FALSE(c.poll(r));
+  EXPECT_EQ(hex(out.frames.back()), "602#8000100000000405");
+  c.step(100 * kMs + 2, out);  // ... and started once more (issue 30: one retry)
+  EXPECT_EQ(hex(out.frames.back()), "602#4000100000000000");
+  c.step(200 * kMs + 2, out);
+  EXPECT_FALSE(c.poll(r));
+  c.step(200 * kMs + 3, out);
   ASSERT_TRUE(c.poll(r));
   EXPECT_EQ(r.tag, 1u);
   EXPECT_EQ(r.abort, SdoAbort::kTimeout);
-  EXPECT_EQ(r.finished_ns - r.started_ns, 100 * kMs + 1);
+  EXPECT_TRUE(r.retried);
+  EXPECT_EQ(r.finished_ns - r.started_ns, 200 * kMs + 3);  // timeout x 2 + the step between abort and initiate
   EXPECT_EQ(hex(out.frames.back()), "602#8000100000000405");
-  c.step(100 * kMs + 2, out);  // the queued upload starts
+  c.step(200 * kMs + 4, out);  // the queued upload starts
   EXPECT_EQ(hex(out.frames.back()), "602#4001100000000000");
-  c.on_frame(frame("582#4F01100000000000"), 100 * kMs + 3);
+  c.on_frame(frame("582#4F01100000000000"), 200 * kMs + 5);
   ASSERT_TRUE(c.poll(r));
   EXPECT_EQ(r.tag, 2u);
   EXPECT_TRUE(r.ok());
@@ -366,7 +374,10 @@ TEST(FieldbusSdo, EmulatorAbortPaths) {
       {"TPDO sub-index 4 does not exist", {}, "602#2F00180404000000", 0x06090011},
       {"transmission type 245", {}, "602#2F001402F5000000", 0x06090030},
       {"unknown command specifier", {}, "602#E000100000000000", 0x05040001},
-      {"block transfer", {}, "602#C000100000000000", 0x05040001},
+      {"block upload with block size 0", {}, "602#A400100000000000", 0x05040002},
+      {"block upload of a missing object", {}, "602#A40044447F000000", 0x06020000},
+      {"block download end without transfer", {}, "602#C100000000000000", 0x05040001},
+      {"block download larger than the server's buffer", {}, "602#C600200000100000", 0x05040005},
       {"segment without transfer", {}, "602#0000000000000000", 0x05040001},
   };
   for (const auto& c : cases) {
@@ -469,15 +480,23 @@ TEST(FieldbusSdo, PerTransferTimeout) {
   EXPECT_FALSE(c.poll(r));  // the client's 100 ms do not apply
   c.step(3000 * kMs, out);
   EXPECT_FALSE(c.poll(r));
-  c.step(3000 * kMs + 1, out);
+  c.step(3000 * kMs + 1, out);  // first try aborted
+  c.step(3000 * kMs + 2, out);  // retried
+  EXPECT_EQ(hex(out.frames.back()), "602#2310100173617665");
+  c.step(6000 * kMs + 2, out);
+  EXPECT_FALSE(c.poll(r));
+  c.step(6000 * kMs + 3, out);
   ASSERT_TRUE(c.poll(r));
   EXPECT_EQ(r.tag, 1u);
   EXPECT_EQ(r.abort, SdoAbort::kTimeout);
-  EXPECT_EQ(r.finished_ns - r.started_ns, 3000 * kMs + 1);
-  c.step(3000 * kMs + 2, out);  // the upload starts, with the client's timeout
-  c.step(3100 * kMs + 3, out);
+  EXPECT_EQ(r.finished_ns - r.started_ns, 6000 * kMs + 3);
+  c.step(6000 * kMs + 4, out);  // the upload starts, with the client's timeout
+  c.step(6100 * kMs + 5, out);  // first try aborted
+  EXPECT_FALSE(c.poll(r));
+  c.step(6100 * kMs + 6, out);  // retried
+  c.step(6200 * kMs + 7, out);
   ASSERT_TRUE(c.poll(r));
   EXPECT_EQ(r.tag, 2u);
   EXPECT_EQ(r.abort, SdoAbort::kTimeout);
-  EXPECT_EQ(r.finished_ns - r.started_ns, 100 * kMs + 1);
+  EXPECT_EQ(r.finished_ns - r.started_ns, 200 * kMs + 3);
 }

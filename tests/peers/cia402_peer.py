@@ -56,6 +56,8 @@ NMT_NAMES = {BOOTUP: 'boot-up', STOPPED: 'stopped', OPERATIONAL: 'operational', 
 ABORT_TOGGLE = 0x05030000
 ABORT_TIMEOUT = 0x05040000
 ABORT_COMMAND = 0x05040001
+ABORT_BLOCK_SIZE = 0x05040002
+ABORT_CRC = 0x05040004
 ABORT_WRITE_ONLY = 0x06010001
 ABORT_READ_ONLY = 0x06010002
 ABORT_NO_OBJECT = 0x06020000
@@ -427,6 +429,7 @@ class Drive:
         self.error_code = 0
         self.ip_value, self.ip_index = 1, -3   # 0x60C2: 1 ms until the master writes it
         self.note = b''
+        self.block = b''
         self.reaction_deadline = None
         self.fault_held = False
         for code in list(self.fault_codes):
@@ -445,6 +448,9 @@ class Drive:
             p.reset()
         self.sdo = None
         self.last_sync = None
+        if not hasattr(self, 'block_transfer'):
+            self.block_transfer = True    # serve SDO block transfer (False: abort 0504 0001h, as a drive without it)
+            self.block_log = []           # finished block transfers: (direction, index, sub, bytes, CRC)
         self._build_od()
 
     def _build_od(self):
@@ -516,6 +522,9 @@ class Drive:
         # --- manufacturer-specific area: a writable string (segmented downloads)
         od.add(0x2000, 0, Var('Application note', 'str', 'rw', get=lambda: d.note,
                               set=lambda v: setattr(d, 'note', v), max_len=64))
+        # a DOMAIN of up to 1 KiB (parameter blocks: SDO block transfer)
+        od.add(0x2F00, 0, Var('Parameter block', 'domain', 'rw', get=lambda: d.block,
+                              set=lambda v: setattr(d, 'block', v), max_len=1024))
 
     def _add_unit_objects(self):
         od, d = self.od, self
@@ -1014,11 +1023,124 @@ class Drive:
         t['deadline'] = now + self.sdo_timeout
         return t, None
 
+    # ---- SDO block transfer (CiA 301 7.2.4.3.9 .. 7.2.4.3.16) ------------------------
+    BLOCK_SIZE = 127                      # segments per sub-block this server asks for
+
+    @staticmethod
+    def crc16(data: bytes) -> int:
+        """CiA 301 7.2.4.3.16: CRC-CCITT, polynomial x^16 + x^12 + x^5 + 1, initial 0."""
+        crc = 0
+        for b in data:
+            crc ^= b << 8
+            for _ in range(8):
+                crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
+        return crc
+
+    def _sub_block(self, t) -> list:
+        """The next sub-block of a block upload: up to blksize segments of 7 bytes."""
+        out, t['start'] = [], t['pos']
+        pos = t['pos']
+        for seq in range(1, t['blksize'] + 1):
+            if pos >= len(t['buf']):
+                break
+            chunk = t['buf'][pos:pos + 7]
+            pos += len(chunk)
+            last = pos >= len(t['buf'])
+            out += self._reply(bytes([0x80 * last | seq]) + chunk)
+        return out
+
+    def _on_block(self, data: bytes, now: float) -> list:
+        cmd = data[0]
+        index, sub = struct.unpack_from('<HB', data, 1)
+        t = self.sdo
+        if t and t['dir'] == 'bdown' and not t['end'] and cmd != 0x80:      # a sub-block segment
+            seq, c = cmd & 0x7F, cmd & 0x80
+            if seq == t['seq'] + 1 and not t['last']:                       # in order: kept
+                t['buf'] += data[1:8]
+                t['seq'], t['last'] = seq, bool(c)
+            t['deadline'] = now + self.sdo_timeout
+            if not c and seq < self.BLOCK_SIZE:
+                return []
+            ack = bytes([0xA2, t['seq'], self.BLOCK_SIZE])                  # last in-order segment
+            t['seq'] = 0
+            t['end'] = t['last']
+            return self._reply(ack)
+        if cmd >> 5 == 6 and cmd & 0x01 == 0:                               # block download initiate
+            self.sdo = None
+            if not self.block_transfer:
+                return self._abort(index, sub, ABORT_COMMAND)
+            var, abort = self.od.find(index, sub)
+            if abort:
+                return self._abort(index, sub, abort)
+            if var.access in ('ro', 'const'):
+                return self._abort(index, sub, ABORT_READ_ONLY)
+            size = struct.unpack_from('<I', data, 4)[0] if cmd & 0x02 else None
+            if size is not None and var.dtype not in NUMERIC and size > var.max_len:
+                return self._abort(index, sub, ABORT_LENGTH_HIGH)
+            self.sdo = {'dir': 'bdown', 'index': index, 'sub': sub, 'buf': b'', 'size': size, 'seq': 0,
+                        'last': False, 'end': False, 'crc': bool(cmd & 0x04), 'deadline': now + self.sdo_timeout}
+            return self._reply(struct.pack('<BHBB', 0xA4, index, sub, self.BLOCK_SIZE))
+        if cmd >> 5 == 6:                                                    # block download end
+            if not t or t['dir'] != 'bdown' or not t['end']:
+                return self._abort(t['index'] if t else 0, t['sub'] if t else 0, ABORT_COMMAND)
+            self.sdo = None
+            buf = t['buf'][:len(t['buf']) - ((cmd >> 2) & 0x07)]
+            if t['size'] is not None and len(buf) != t['size']:
+                return self._abort(t['index'], t['sub'], ABORT_LENGTH)
+            crc = struct.unpack_from('<H', data, 1)[0]
+            if t['crc'] and crc != self.crc16(buf):
+                return self._abort(t['index'], t['sub'], ABORT_CRC)
+            abort = self.od.download(t['index'], t['sub'], buf)
+            if abort:
+                return self._abort(t['index'], t['sub'], abort)
+            self.block_log.append(('download', t['index'], t['sub'], buf, crc))
+            self.log(f"SDO block download 0x{t['index']:04X}:{t['sub']:02X}: {len(buf)} bytes, "
+                     f"CRC 0x{crc:04X} {'checked' if t['crc'] else '(not used)'}")
+            return self._reply(bytes([0xA1]))
+        cs = cmd & 0x03                                                      # ccs 5: block upload
+        if cs == 0:
+            self.sdo = None
+            if not self.block_transfer:
+                return self._abort(index, sub, ABORT_COMMAND)
+            if not 1 <= data[4] <= 127:
+                return self._abort(index, sub, ABORT_BLOCK_SIZE)
+            value, abort = self.od.upload(index, sub)
+            if abort:
+                return self._abort(index, sub, abort)
+            self.sdo = {'dir': 'bup', 'index': index, 'sub': sub, 'buf': value, 'pos': 0, 'start': 0,
+                        'blksize': data[4], 'crc': bool(cmd & 0x04), 'started': False,
+                        'deadline': now + self.sdo_timeout}
+            return self._reply(struct.pack('<BHBI', 0xC6, index, sub, len(value)))
+        if not t or t['dir'] != 'bup':
+            return self._abort(index, sub, ABORT_COMMAND)
+        t['deadline'] = now + self.sdo_timeout
+        if cs == 3 and not t['started']:                                     # start
+            t['started'] = True
+            return self._sub_block(t)
+        if cs == 2 and t['started']:                                         # ack of a sub-block
+            ackseq, t['blksize'] = data[1], data[2]
+            if not 1 <= t['blksize'] <= 127:
+                return self._abort(t['index'], t['sub'], ABORT_BLOCK_SIZE)
+            t['pos'] = min(len(t['buf']), t['start'] + 7 * ackseq)
+            if t['pos'] < len(t['buf']):
+                return self._sub_block(t)
+            n = 7 - (len(t['buf']) - 7 * ((len(t['buf']) - 1) // 7)) if t['buf'] else 7
+            crc = self.crc16(t['buf']) if t['crc'] else 0
+            t['ended'] = True
+            return self._reply(struct.pack('<BH', 0xC1 | n << 2, crc))
+        if cs == 1 and t.get('ended'):                                       # the client's end response
+            self.sdo = None
+            self.block_log.append(('upload', t['index'], t['sub'], t['buf'], self.crc16(t['buf'])))
+            return []
+        return self._abort(t['index'], t['sub'], ABORT_COMMAND)
+
     def _on_sdo(self, data: bytes, now: float) -> list:
         if len(data) != 8:
             return []                     # not an SDO request (CiA 301: DLC 8)
         cmd = data[0]
         ccs = cmd >> 5
+        if (self.sdo and self.sdo['dir'] in ('bdown', 'bup') and cmd != 0x80) or ccs in (5, 6):  # (0x81..0xFF: segments)
+            return self._on_block(data, now)
         index, sub = struct.unpack_from('<HB', data, 1)
         if ccs == 4:                      # abort from the client
             self.sdo = None
@@ -1086,8 +1208,7 @@ class Drive:
             if last:
                 self.sdo = None
             return self._reply(bytes([toggle << 4 | (7 - len(chunk)) << 1 | int(last)]) + chunk)
-        # block upload/download (5, 6) and 7: not supported by this server
-        return self._abort(index, sub, ABORT_COMMAND)
+        return self._abort(index, sub, ABORT_COMMAND)     # 7: no such command
 
     # ---- time ------------------------------------------------------------------------
     def tick(self, now: float) -> list:

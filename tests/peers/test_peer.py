@@ -160,8 +160,76 @@ class Sdo(PeerCase):
 
     def test_block_transfer_refused(self):
         self.make()
-        r = self.sdo.request(struct.pack('<BHB', 0xA4, 0x1008, 0))      # block upload initiate
+        self.drive.block_transfer = False                                # a drive without block transfer
+        r = self.sdo.request(struct.pack('<BHBB', 0xA4, 0x1008, 0, 127))  # block upload initiate
         self.assertEqual(struct.unpack_from('<BHBI', r), (0x80, 0x1008, 0, peer.ABORT_COMMAND))
+
+    def test_crc16_check_value(self):
+        # CRC-16/XMODEM (CiA 301: CCITT 0x1021, initial 0): "123456789" -> 0x31C3
+        self.assertEqual(peer.Drive.crc16(b'123456789'), 0x31C3)
+
+    def block_download(self, data: bytes, lose=None, crc=None):
+        """Block download of `data` to 0x2000 with segment number `lose` of
+        the first sub-block left out (then resent); the server's answers."""
+        r = self.sdo.request(struct.pack('<BHBI', 0xC6, 0x2000, 0, len(data)))
+        self.assertEqual(r[:4], struct.pack('<BHB', 0xA4, 0x2000, 0))
+        blksize = r[4]
+        self.assertEqual(blksize, 127)
+        segs = [data[i:i + 7] for i in range(0, len(data), 7)]
+        first = 0
+        while True:
+            for seq, chunk in enumerate(segs[first:first + blksize], 1):
+                last = first + seq == len(segs)
+                if seq == lose:
+                    lose = None
+                    continue
+                self.link.send(0x600 + NODE, (bytes([0x80 * last | seq]) + chunk).ljust(8, b'\x00'))
+            (_, _, ack), = self.frames(0x580 + NODE)
+            self.assertEqual(ack[0], 0xA2)
+            first += ack[1]
+            if first == len(segs):
+                break
+        n = 7 - (len(data) - 7 * (len(segs) - 1))
+        crc = peer.Drive.crc16(data) if crc is None else crc
+        return self.sdo.request(struct.pack('<BH', 0xC1 | n << 2, crc))
+
+    def test_block_download_with_crc_and_a_lost_segment(self):
+        self.make()
+        data = bytes(range(0x41, 0x41 + 40))
+        r = self.block_download(data, lose=3)
+        self.assertEqual(r[0], 0xA1)
+        self.assertEqual(self.sdo.upload(0x2000, 0), data)
+        self.assertEqual(self.drive.block_log[-1][3], data)
+
+    def test_block_download_with_a_wrong_crc(self):
+        self.make()
+        data = bytes(range(0x41, 0x41 + 20))
+        r = self.block_download(data, crc=peer.Drive.crc16(data) ^ 1)
+        self.assertEqual(struct.unpack_from('<BHBI', r), (0x80, 0x2000, 0, peer.ABORT_CRC))
+
+    def test_block_upload_with_crc_and_a_resend(self):
+        self.make()
+        name = self.sdo.upload(0x1008, 0)
+        r = self.sdo.request(struct.pack('<BHBBB', 0xA4, 0x1008, 0, 127, 0))
+        self.assertEqual(struct.unpack_from('<BHBI', r), (0xC6, 0x1008, 0, len(name)))
+        self.link.send(0x600 + NODE, bytes([0xA3]).ljust(8, b'\x00'))
+        segs = [f[2] for f in self.frames(0x580 + NODE)]
+        self.assertEqual(len(segs), (len(name) + 6) // 7)
+        self.assertEqual([s[0] & 0x7F for s in segs], list(range(1, len(segs) + 1)))
+        self.assertEqual(segs[-1][0] & 0x80, 0x80)
+        # Segment 2 "lost": ack 1, the server resends from the 2nd segment, numbered from 1.
+        self.link.send(0x600 + NODE, bytes([0xA2, 1, 127]).ljust(8, b'\x00'))
+        again = [f[2] for f in self.frames(0x580 + NODE)]
+        self.assertEqual(again[0], bytes([1]) + name[7:14])
+        got = segs[0][1:] + b''.join(s[1:] for s in again)
+        self.link.send(0x600 + NODE, bytes([0xA2, len(again), 127]).ljust(8, b'\x00'))
+        (_, _, end), = self.frames(0x580 + NODE)
+        n = (end[0] >> 2) & 7
+        self.assertEqual(end[0] & 0xE3, 0xC1)
+        self.assertEqual(got[:len(got) - n], name)
+        self.assertEqual(struct.unpack_from('<H', end, 1)[0], peer.Drive.crc16(name))
+        self.link.send(0x600 + NODE, bytes([0xA1]).ljust(8, b'\x00'))
+        self.assertEqual(self.drive.block_log[-1][:4], ('upload', 0x1008, 0, name))
 
     def test_value_range(self):
         self.make()

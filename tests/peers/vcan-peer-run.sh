@@ -47,7 +47,10 @@ config=vcan.yaml
 [[ $scenario == units_rpm ]] && config=vcan-units.yaml
 [[ $scenario == units_rpm_boot ]] && config=vcan-units-boot.yaml
 [[ $scenario == ip_move ]] && config=vcan-ip.yaml
-rm -f "$art/vcan.yaml" "$art/vcan-two.yaml" "$art/vcan-units.yaml" "$art/vcan-units-boot.yaml" "$art/vcan-ip.yaml"
+[[ $scenario == sdo_block ]] && config=vcan-sdo-block.yaml
+rm -f "$art/vcan.yaml" "$art/vcan-two.yaml" "$art/vcan-units.yaml" "$art/vcan-units-boot.yaml" "$art/vcan-sdo-block.yaml" "$art/vcan-ip.yaml"
+# sdo_block: the DOMAIN file next to the configuration (a path relative to it).
+[[ $scenario == sdo_block ]] && cp "$here/sdo-block.bin" "$art/sdo-block.bin"
 cp "$here/$config" "$art/$config"
 # units_rpm: the drive's units come from its EDS (next to the configuration).
 [[ $scenario == units_rpm ]] && cp "$here/../units/rpm-drive.eds" "$art/rpm-drive.eds"
