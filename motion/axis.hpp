@@ -73,10 +73,12 @@ struct AxisConfig {
   /// sets it from the drive's timeouts (drive.timeouts.wait_ms). > 0.
   double drive_wait_limit = 5.0;
   /// Exception action per ExceptionKind. Defaults: position error and drive
-  /// fault stop the drive, lost node and bus-off shut down, soft overtravel stops the planner.
+  /// fault stop the drive, lost node and bus-off shut down, soft overtravel
+  /// stops the planner, hardware overtravel (a limit switch) stops the drive.
   std::array<ExceptionAction, static_cast<std::size_t>(ExceptionKind::Count)> exception_actions{
-      ExceptionAction::StopDrive, ExceptionAction::StopDrive, ExceptionAction::Shutdown,
-      ExceptionAction::StopPlanner, ExceptionAction::StopPlanner, ExceptionAction::Shutdown};
+      ExceptionAction::StopDrive,   ExceptionAction::StopDrive,   ExceptionAction::Shutdown,
+      ExceptionAction::StopPlanner, ExceptionAction::StopPlanner, ExceptionAction::Shutdown,
+      ExceptionAction::StopDrive,   ExceptionAction::StopDrive};
 
   /// Action configured for one exception.
   constexpr ExceptionAction action(ExceptionKind k) const noexcept {

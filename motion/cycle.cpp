@@ -48,6 +48,8 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
     if (drive_fault && !resetting) active |= bit(ExceptionKind::DriveFault);
     if (a.fb.node_lost && !resetting) active |= bit(ExceptionKind::NodeLost);
     if (a.fb.bus_off) active |= bit(ExceptionKind::BusOff);
+    if (a.fb.limit_positive) active |= bit(ExceptionKind::HardOvertravelPos);
+    if (a.fb.limit_negative) active |= bit(ExceptionKind::HardOvertravelNeg);
     if (a.servo.on && a.cfg.position_error_tolerance > 0 &&
         std::fabs(compared_command(a) - a.fb_pos) > a.cfg.position_error_tolerance)
       active |= bit(ExceptionKind::PositionError);
@@ -122,6 +124,7 @@ void Core::handle_feedback(AxisRt& a, const AxisFeedback* fb) noexcept {
   if (f & (bit(ExceptionKind::DriveFault) | bit(ExceptionKind::PositionError))) af |= 1u << axis_fault::PhysicalAxisFault;
   if (f & (bit(ExceptionKind::NodeLost) | bit(ExceptionKind::BusOff))) af |= 1u << axis_fault::ModuleFault;
   if (f & (bit(ExceptionKind::SoftOvertravelPos) | bit(ExceptionKind::SoftOvertravelNeg))) af |= 1u << axis_fault::MotionFault;
+  if (f & (bit(ExceptionKind::HardOvertravelPos) | bit(ExceptionKind::HardOvertravelNeg))) af |= 1u << axis_fault::PhysicalAxisFault;
   a.tag.axis_fault = af | link_fault;
 }
 

@@ -69,6 +69,8 @@ struct AxisFeedback {
   std::uint16_t emcy_code = 0;
   bool node_lost = false;     ///< heartbeat / cyclic data lost
   bool bus_off = false;       ///< the CAN interface is bus-off
+  bool limit_positive = false;  ///< positive limit switch active (0x60FD bit 1, CiA 402 digital inputs)
+  bool limit_negative = false;  ///< negative limit switch active (0x60FD bit 0)
   bool homing_attained = false;  ///< statusword bit 12 in homing mode
   bool homing_error = false;     ///< statusword bit 13 in homing mode, a homing timeout or a refused homing parameter
   /// EXERR of the MAH's ERR 12 when homing_error: 16 (device in wrong state:

@@ -81,6 +81,8 @@ std::string_view exception_key(ExceptionKind k) noexcept {
     case ExceptionKind::SoftOvertravelPos: return "soft_overtravel_positive";
     case ExceptionKind::SoftOvertravelNeg: return "soft_overtravel_negative";
     case ExceptionKind::BusOff: return "bus_off";
+    case ExceptionKind::HardOvertravelPos: return "hard_overtravel_positive";
+    case ExceptionKind::HardOvertravelNeg: return "hard_overtravel_negative";
     case ExceptionKind::Count: break;
   }
   return "?";

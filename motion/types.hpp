@@ -250,7 +250,12 @@ enum class ExceptionKind : std::uint8_t {
   SoftOvertravelPos = 3, ///< command/actual beyond the positive soft limit
   SoftOvertravelNeg = 4, ///< command/actual beyond the negative soft limit
   BusOff = 5,            ///< CAN controller bus-off
-  Count = 6,
+  /// Hardware overtravel: the drive's positive limit switch (0x60FD bit 1,
+  /// CiA 402 digital inputs) is active (Logix PositiveOvertravelFault)
+  HardOvertravelPos = 6,
+  /// the negative limit switch (0x60FD bit 0) is active (NegativeOvertravelFault)
+  HardOvertravelNeg = 7,
+  Count = 8,
 };
 
 /// The key of an exception under an axis's `exception_actions:` in the

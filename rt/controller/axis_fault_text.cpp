@@ -67,6 +67,8 @@ std::string describe_axis_fault(const Event& e, const AxisSpec& axis, std::size_
     case K::DriveFault: what = "drive fault (its cause is logged for the drive)"; break;
     case K::NodeLost: what = "node lost (heartbeat lost, or the node left NMT operational)"; break;
     case K::BusOff: what = "its bus is off (bus-off, or its interface down)"; break;
+    case K::HardOvertravelPos: what = "PositiveOvertravelFault: the positive limit switch is active (0x60FD bit 1)"; break;
+    case K::HardOvertravelNeg: what = "NegativeOvertravelFault: the negative limit switch is active (0x60FD bit 0)"; break;
     case K::Count: break;
   }
   const motion::ExceptionAction act = c.action(kind);

@@ -35,7 +35,7 @@ axes:
     conversion_constant: 10000
     rotary: true
     unwind: 360
-    exception_actions: {position_error: Fault Status Only, node_lost: 5}
+    exception_actions: {position_error: Fault Status Only, node_lost: 5, hard_overtravel_positive: Stop Planner}
     drive:
       pdo: csp_csv_cst
       timeouts: {transition_ms: 250}
@@ -59,6 +59,8 @@ TEST(Config, LoadsAGoodFile) {
   EXPECT_TRUE(x.axis.rotary);
   EXPECT_EQ(x.axis.action(motion::ExceptionKind::PositionError), motion::ExceptionAction::FaultStatusOnly);
   EXPECT_EQ(x.axis.action(motion::ExceptionKind::NodeLost), motion::ExceptionAction::Shutdown);
+  EXPECT_EQ(x.axis.action(motion::ExceptionKind::HardOvertravelPos), motion::ExceptionAction::StopPlanner);
+  EXPECT_EQ(x.axis.action(motion::ExceptionKind::HardOvertravelNeg), motion::ExceptionAction::StopDrive);
   EXPECT_EQ(x.drive.pdo, cia402::PdoProfile::kCspCsvCst);
   // Defaults from `drives:` with the axis's own override on top.
   EXPECT_EQ(x.drive.timeouts.sdo_ms, 150u);

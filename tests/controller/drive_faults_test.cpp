@@ -1014,6 +1014,16 @@ TEST(DriveFaults, AxisFaultTexts) {
             "stopped, servo off (drive disabled); MAFR clears it, then MSO");
   e.value = static_cast<std::uint64_t>(motion::ExceptionKind::BusOff);
   EXPECT_EQ(describe_axis_fault(e, a, 2).rfind("its bus is off (bus-off, or its interface down): Shutdown (axes[2].exception_actions.bus_off)", 0), 0u);
+  e.value = static_cast<std::uint64_t>(motion::ExceptionKind::HardOvertravelPos);
+  EXPECT_EQ(describe_axis_fault(e, a, 4),
+            "PositiveOvertravelFault: the positive limit switch is active (0x60FD bit 1): Stop Drive "
+            "(axes[4].exception_actions.hard_overtravel_positive): motion stopped, servo off (drive disabled); MAFR "
+            "clears it, then MSO");
+  e.value = static_cast<std::uint64_t>(motion::ExceptionKind::HardOvertravelNeg);
+  EXPECT_EQ(describe_axis_fault(e, a, 4).rfind("NegativeOvertravelFault: the negative limit switch is active (0x60FD bit 0): "
+                                               "Stop Drive (axes[4].exception_actions.hard_overtravel_negative)",
+                                               0),
+            0u);
 }
 
 }  // namespace
