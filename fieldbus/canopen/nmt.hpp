@@ -103,4 +103,58 @@ struct NmtFrame {
   return NmtFrame{f.data[0], f.data[1]};
 }
 
+/// Node-guarding request (CiA 301 §7.2.8.3.2.1): a remote frame (RTR) on
+/// ID 0x700 + node with DLC 1 and no data, sent by the master every guard time.
+[[nodiscard]] constexpr can::Frame make_guard_request(std::uint8_t node) noexcept {
+  can::Frame f;
+  f.id = cob::heartbeat(node);
+  f.len = 1;
+  f.flags = can::kRemote;
+  return f;
+}
+
+/// Node-guarding response: ID 0x700 + node, DLC 1, bit 7 the toggle bit, bits
+/// 6..0 the NMT state. The toggle starts at 0 after boot-up / reset communication
+/// and alternates with each response.
+[[nodiscard]] constexpr can::Frame make_guard_response(std::uint8_t node, NmtState s, bool toggle) noexcept {
+  can::Frame f = make_heartbeat_frame(node, s);
+  if (toggle) f.data[0] = static_cast<std::uint8_t>(f.data[0] | 0x80U);
+  return f;
+}
+
+/// What a node-guarding response says against the toggle the master expects.
+enum class GuardAnswer : std::uint8_t {
+  kOk,           ///< toggle as expected, a valid NMT state
+  kToggleError,  ///< the toggle did not alternate (a lost or repeated answer)
+  kBadState,     ///< bits 6..0 are not an NMT state (or boot-up: the node reset)
+  kNotAnswer,    ///< not a guarding response (wrong ID, RTR, DLC != 1)
+};
+
+/// The master's side of one guarded node: expected toggle, last state.
+/// Realtime-safe: plain value type, no allocation.
+class GuardChecker {
+ public:
+  /// After boot-up / reset communication the node's next toggle is 0.
+  constexpr void reset() noexcept { expect_toggle_ = false; state_ = NmtState::kUnknown; }
+
+  /// Check one frame received on 0x700 + node as the answer to a guarding request.
+  [[nodiscard]] constexpr GuardAnswer check(const can::Frame& f, std::uint8_t node) noexcept {
+    if (f.id != cob::heartbeat(node) || f.extended() || f.remote() || f.len != 1) return GuardAnswer::kNotAnswer;
+    const bool toggle = (f.data[0] & 0x80U) != 0;
+    const NmtState s = nmt_state_from_byte(f.data[0]);
+    if (s == NmtState::kUnknown || s == NmtState::kBootUp) return GuardAnswer::kBadState;
+    if (toggle != expect_toggle_) return GuardAnswer::kToggleError;
+    expect_toggle_ = !expect_toggle_;
+    state_ = s;
+    return GuardAnswer::kOk;
+  }
+
+  [[nodiscard]] constexpr NmtState state() const noexcept { return state_; }
+  [[nodiscard]] constexpr bool expected_toggle() const noexcept { return expect_toggle_; }
+
+ private:
+  bool expect_toggle_ = false;
+  NmtState state_ = NmtState::kUnknown;
+};
+
 }  // namespace canmotion::canopen
