@@ -17,73 +17,57 @@ can::Frame sdo_frame(std::uint8_t node, std::uint8_t b0, std::uint16_t index, st
 SdoClient::SdoClient(std::uint8_t node, std::int64_t timeout_ns)
     : node_(node), timeout_ns_(timeout_ns), queue_(kQueueCapacity), results_(kResultCapacity) {}
 
-bool SdoClient::download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data, std::uint32_t tag,
-                         std::int64_t timeout_ns) noexcept {
-  if (queue_count_ == kQueueCapacity || data.empty() || data.size() > kSdoMaxDownload) return false;
+SdoClient::Request* SdoClient::enqueue(std::uint16_t index, std::uint8_t sub, bool upload, std::uint32_t tag,
+                                      std::int64_t timeout_ns) noexcept {
+  if (queue_count_ == kQueueCapacity) return nullptr;
   Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
   r.tag = tag;
   r.timeout_ns = timeout_ns;
   r.index = index;
   r.sub = sub;
-  r.upload = false;
+  r.upload = upload;
   r.block = false;
+  r.len = 0;
   r.ref = nullptr;
   r.dest = nullptr;
-  r.len = static_cast<std::uint8_t>(data.size());
-  std::copy(data.begin(), data.end(), r.data.begin());
+  r.ref_len = 0;
   ++queue_count_;
+  return &r;
+}
+
+bool SdoClient::download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data, std::uint32_t tag,
+                         std::int64_t timeout_ns) noexcept {
+  if (data.empty() || data.size() > kSdoMaxDownload) return false;
+  Request* r = enqueue(index, sub, false, tag, timeout_ns);
+  if (r == nullptr) return false;
+  r->len = static_cast<std::uint8_t>(data.size());
+  std::copy(data.begin(), data.end(), r->data.begin());
   return true;
 }
 
 bool SdoClient::upload(std::uint16_t index, std::uint8_t sub, std::uint32_t tag, std::int64_t timeout_ns) noexcept {
-  if (queue_count_ == kQueueCapacity) return false;
-  Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
-  r.tag = tag;
-  r.timeout_ns = timeout_ns;
-  r.index = index;
-  r.sub = sub;
-  r.upload = true;
-  r.block = false;
-  r.ref = nullptr;
-  r.dest = nullptr;
-  r.len = 0;
-  ++queue_count_;
-  return true;
+  return enqueue(index, sub, true, tag, timeout_ns) != nullptr;
 }
 
 bool SdoClient::download_ref(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
                              std::uint32_t tag, std::int64_t timeout_ns, Transfer mode) noexcept {
-  if (queue_count_ == kQueueCapacity || data.empty() || data.size() > 0xFFFFFFFFu) return false;
-  Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
-  r.tag = tag;
-  r.timeout_ns = timeout_ns;
-  r.index = index;
-  r.sub = sub;
-  r.upload = false;
-  r.block = mode == Transfer::kBlock || (mode == Transfer::kAuto && data.size() > kSdoMaxDownload);
-  r.len = 0;
-  r.ref = data.data();
-  r.dest = nullptr;
-  r.ref_len = static_cast<std::uint32_t>(data.size());
-  ++queue_count_;
+  if (data.empty() || data.size() > 0xFFFFFFFFu) return false;
+  Request* r = enqueue(index, sub, false, tag, timeout_ns);
+  if (r == nullptr) return false;
+  r->block = mode == Transfer::kBlock || (mode == Transfer::kAuto && data.size() > kSdoMaxDownload);
+  r->ref = data.data();
+  r->ref_len = static_cast<std::uint32_t>(data.size());
   return true;
 }
 
 bool SdoClient::upload_into(std::uint16_t index, std::uint8_t sub, std::span<std::uint8_t> dest, std::uint32_t tag,
                             std::int64_t timeout_ns, Transfer mode) noexcept {
-  if (queue_count_ == kQueueCapacity || dest.empty() || dest.size() > 0xFFFFFFFFu) return false;
-  Request& r = queue_[(queue_head_ + queue_count_) % kQueueCapacity];
-  r.tag = tag;
-  r.timeout_ns = timeout_ns;
-  r.index = index;
-  r.sub = sub;
-  r.upload = true;
-  r.block = mode != Transfer::kSegmented;
-  r.len = 0;
-  r.ref = nullptr;
-  r.dest = dest.data();
-  r.ref_len = static_cast<std::uint32_t>(dest.size());
-  ++queue_count_;
+  if (dest.empty() || dest.size() > 0xFFFFFFFFu) return false;
+  Request* r = enqueue(index, sub, true, tag, timeout_ns);
+  if (r == nullptr) return false;
+  r->block = mode != Transfer::kSegmented;
+  r->dest = dest.data();
+  r->ref_len = static_cast<std::uint32_t>(dest.size());
   return true;
 }
 

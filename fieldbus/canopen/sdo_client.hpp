@@ -178,6 +178,9 @@ class SdoClient {
   [[nodiscard]] std::size_t src_len() const noexcept { return cur_.ref != nullptr ? cur_.ref_len : cur_.len; }
   [[nodiscard]] std::uint8_t* dst() noexcept { return cur_.dest != nullptr ? cur_.dest : res_.data.data(); }
   [[nodiscard]] std::size_t dst_cap() const noexcept { return cur_.dest != nullptr ? cur_.ref_len : kSdoMaxUpload; }
+  /// The next free queue slot with the fields every request has set (the
+  /// rest cleared), counted as queued; nullptr when the queue is full.
+  Request* enqueue(std::uint16_t index, std::uint8_t sub, bool upload, std::uint32_t tag, std::int64_t timeout_ns) noexcept;
   void start(const Request& r, std::int64_t now_ns) noexcept;
   void start_block(std::int64_t now_ns) noexcept;
   bool on_block_frame(const can::Frame& f, std::int64_t now_ns) noexcept;
