@@ -133,6 +133,9 @@ struct DcfValue {
   std::uint8_t sub = 0;
   std::uint8_t size = 4;      ///< bytes: 1..4
   std::uint32_t value = 0;    ///< the bits (REAL32 as IEEE 754), $NODEID resolved
+  /// Longer values, strings and domains: the bytes as sent (UNICODE_STRING
+  /// as UTF-16LE); empty for the 1..4-byte values above.
+  std::vector<std::uint8_t> bytes;
   int line = 0;               ///< its section's line in the DCF
 };
 

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "config/eds_check.hpp"
+#include "config/load_sections.hpp"
 #include "config/runtime.hpp"
 
 namespace canmotion::config {
@@ -35,11 +36,36 @@ bool command_object(std::uint16_t index) {
   return index == 0x1010 || index == 0x1011 || (index >= 0x1F50 && index <= 0x1F5F);
 }
 
-/// Types whose value the boot writes from a DCF: 1 to 4 bytes, expedited.
+/// Types whose value the boot writes from a DCF as 1 to 4 bytes (expedited).
 bool expedited_type(canopen::DataType t) {
   const std::size_t n = canopen::data_type_size(t);
   return n >= 1 && n <= 4 && t != canopen::DataType::kVisibleString && t != canopen::DataType::kOctetString &&
          t != canopen::DataType::kUnicodeString && t != canopen::DataType::kDomain;
+}
+
+/// The bytes of a value the boot writes as a typed write: 40- to 64-bit
+/// integers and REAL64 (little endian), VISIBLE_STRING, OCTET_STRING and
+/// DOMAIN as the file gives them, UNICODE_STRING as UTF-16LE. Empty: a type
+/// it does not write (TIME_OF_DAY, TIME_DIFFERENCE), an empty value, or
+/// invalid UTF-8.
+std::vector<std::uint8_t> typed_bytes(const eds::SubObject& s, std::uint8_t node) {
+  using canopen::DataType;
+  const eds::Value& v = *s.parameter_value;
+  switch (s.type) {
+    case DataType::kVisibleString:
+    case DataType::kOctetString:
+    case DataType::kDomain: return {v.data.begin(), v.data.end()};
+    case DataType::kUnicodeString: return load::utf16le(v.data).value_or(std::vector<std::uint8_t>{});
+    case DataType::kTimeOfDay:
+    case DataType::kTimeDifference: return {};
+    default: break;
+  }
+  const std::size_t n = canopen::data_type_size(s.type);
+  if (n < 5 || n > 8) return {};
+  const std::uint64_t bits = v.resolve(node, n);
+  std::vector<std::uint8_t> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<std::uint8_t>(bits >> (8 * i));
+  return out;
 }
 
 /// The first `n` lines as "file:L1, :L2 ... (k more)".
@@ -48,6 +74,17 @@ std::string lines_of(const std::string& file, const std::vector<int>& lines) {
   for (std::size_t i = 0; i < lines.size() && i < 6; ++i) s += i == 0 ? fmt::format("{}:{}", file, lines[i]) : fmt::format(", :{}", lines[i]);
   if (lines.size() > 6) s += fmt::format(" ({} more)", lines.size() - 6);
   return s;
+}
+
+/// The master's write `mine` writes what DCF value `v` holds. A typed write
+/// is compared byte for byte from `keyed` (whose storage holds its bytes).
+bool same_value(const cia402::DriveConfig& keyed, const cia402::BootWrite& mine, const DcfValue& v) {
+  for (const cia402::SdoWrite& w : keyed.extra_writes) {
+    if (w.index != v.index || w.sub != v.sub || w.dcf) continue;
+    if (w.data == nullptr) return v.bytes.empty() && w.value == v.value;
+    return w.data_len == v.bytes.size() && std::equal(v.bytes.begin(), v.bytes.end(), w.data);
+  }
+  return v.bytes.empty() && mine.w.value == v.value;
 }
 
 }  // namespace
@@ -74,12 +111,17 @@ void dcf_download(const Config& cfg, AxisSettings& a, std::size_t ai, const BusS
         defect_lines.push_back(s.line);
         continue;
       }
-      if (!expedited_type(s.type)) {
-        type_lines.push_back(s.line);
-        continue;
+      DcfValue v{o.index, s.sub, static_cast<std::uint8_t>(s.size()), 0, {}, s.line};
+      if (expedited_type(s.type)) {
+        v.value = static_cast<std::uint32_t>(s.parameter_value->resolve(a.node, s.size()));
+      } else {
+        v.bytes = typed_bytes(s, a.node);
+        if (v.bytes.empty()) {
+          type_lines.push_back(s.line);
+          continue;
+        }
+        for (std::size_t b = 0; b < v.bytes.size() && b < 4; ++b) v.value |= static_cast<std::uint32_t>(v.bytes[b]) << (8 * b);
       }
-      DcfValue v{o.index, s.sub, static_cast<std::uint8_t>(s.size()),
-                 static_cast<std::uint32_t>(s.parameter_value->resolve(a.node, s.size())), s.line};
       const auto mine = std::find_if(own.begin(), own.end(), [&](const cia402::BootWrite& w) {
         return !w.is_read() && w.w.index == v.index && w.w.sub == v.sub;
       });
@@ -88,7 +130,7 @@ void dcf_download(const Config& cfg, AxisSettings& a, std::size_t ai, const BusS
         continue;
       }
       if (mine != own.end()) {
-        if (mine->w.value == v.value) continue;  // the master writes it, to the same value
+        if (same_value(keyed, *mine, v)) continue;  // the master writes it, to the same value
         if (mine->origin != cia402::WriteOrigin::kExtra) {  // the master's own setting wins
           master_own.push_back(fmt::format("0x{:04X}:{:02X} at :{}", v.index, v.sub, s.line));
           continue;
@@ -129,8 +171,8 @@ void dcf_download(const Config& cfg, AxisSettings& a, std::size_t ai, const BusS
   }
   if (!type_lines.empty())
     diags.push_back({Severity::kWarning, cfg.path, dcf.where, dcf.key,
-                     fmt::format("{}: {} value{} of more than 4 bytes, strings or domains left out (the boot writes "
-                                 "a DCF's values of 1 to 4 bytes): {}",
+                     fmt::format("{}: {} value{} left out: empty strings or domains, invalid UTF-8, or "
+                                 "TIME_OF_DAY/TIME_DIFFERENCE values: {}",
                                  who, type_lines.size(), type_lines.size() == 1 ? "" : "s", lines_of(e.file, type_lines))});
   if (!defect_lines.empty())
     diags.push_back({Severity::kWarning, cfg.path, dcf.where, dcf.key,

@@ -123,7 +123,10 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
       continue;
     }
     u.usage = eds::Usage::kWrite;
-    u.size = w.w.size;
+    // A typed value (sdo_writes `type:`, a DCF's string or 64-bit value): its
+    // length, checked against a fixed-size type; no range check on its bytes.
+    const bool typed = w.w.data != nullptr;
+    u.size = typed ? static_cast<std::uint8_t>(w.w.data_len <= 8 ? w.w.data_len : 0) : w.w.size;
     // The value as the object's type reads it (INTEGERn sign-extended).
     const eds::SubObject* s = e != nullptr ? e->find(w.w.index, w.w.sub) : nullptr;
     // A read-only 0x1006 or 0x1019 is what the boot falls back on: 0x1006 = 0
@@ -135,7 +138,7 @@ eds::Requirements drive_requirements(const AxisSettings& a, const BusSettings& b
           s->value()->resolve(a.node, 1) == w.w.value)))
       continue;
     const bool is_signed = s != nullptr && canopen::data_type_signed(s->type);
-    u.value = is_signed ? canopen::sign_extend(w.w.value, 8u * w.w.size) : static_cast<std::int64_t>(w.w.value);
+    if (!typed) u.value = is_signed ? canopen::sign_extend(w.w.value, 8u * w.w.size) : static_cast<std::int64_t>(w.w.value);
     if (const std::string* k = cia402::write_hint_key(d.hints, w); k != nullptr) u.key = *k;
     else if (w.origin == cia402::WriteOrigin::kUnusedPdo) u.key = d.hints.pdo;
     req.uses.push_back(std::move(u));

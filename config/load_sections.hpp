@@ -30,6 +30,8 @@ void drive(Reader& r, const YAML::Node& n, const std::string& path, DriveSetting
 /// the type; false when the entry takes the integer path (size/value).
 bool typed_sdo_write(Reader& r, const YAML::Node& e, const std::string& p, const canopen::ObjectInfo* known,
                      SdoWrite& s);
+/// UTF-8 -> UTF-16LE code units (UNICODE_STRING on the wire); nullopt on invalid UTF-8.
+[[nodiscard]] std::optional<std::vector<std::uint8_t>> utf16le(const std::string& s);
 
 // load_axis.cpp
 /// One `axes:` entry at `path`, its drive settings starting from `defaults` (`drives:`).

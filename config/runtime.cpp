@@ -132,6 +132,16 @@ double drive_wait_limit_s(const DriveTimeouts& t) noexcept {
   return (3.0 * t.boot_ms + t.mode_switch_ms + 4.0 * t.transition_ms) / 1e3;
 }
 
+/// A typed sdo_writes value: its bytes kept by the DriveConfig (shared by
+/// its copies), the write referencing them (no copy at boot).
+static void reference_typed_bytes(const std::vector<std::uint8_t>& bytes, cia402::SdoWrite& x, cia402::DriveConfig& d) {
+  d.value_storage.push_back(std::make_shared<const std::vector<std::uint8_t>>(bytes));
+  x.data = d.value_storage.back()->data();
+  x.data_len = static_cast<std::uint32_t>(bytes.size());
+  x.value = 0;
+  for (std::size_t b = 0; b < bytes.size() && b < 4; ++b) x.value |= static_cast<std::uint32_t>(bytes[b]) << (8 * b);
+}
+
 namespace {
 /// `drive.dcf` (README "DCF download"): its values first among the extra
 /// writes (`store` false), left out at boot when 0x1020 shows the drive
@@ -151,6 +161,7 @@ void dcf_writes(const DriveSettings& ds, cia402::DriveConfig& d, bool store) {
   for (const DcfValue& v : dcf.writes) {
     cia402::SdoWrite w{v.index, v.sub, v.size, v.value};
     w.dcf = true;
+    if (!v.bytes.empty()) reference_typed_bytes(v.bytes, w, d);
     d.extra_writes.push_back(w);
     d.hints.extra.push_back(fmt::format("{} ({}:{})", dcf.key, ds.eds, v.line));
   }
@@ -199,16 +210,6 @@ void identity_config(const DriveIdentitySettings& id, cia402::DriveIdentity& out
   out.revision = id.revision.value_or(0);
 }
 }  // namespace
-
-/// A typed sdo_writes value: its bytes kept by the DriveConfig (shared by
-/// its copies), the write referencing them (no copy at boot).
-static void reference_typed_bytes(const std::vector<std::uint8_t>& bytes, cia402::SdoWrite& x, cia402::DriveConfig& d) {
-  d.value_storage.push_back(std::make_shared<const std::vector<std::uint8_t>>(bytes));
-  x.data = d.value_storage.back()->data();
-  x.data_len = static_cast<std::uint32_t>(bytes.size());
-  x.value = 0;
-  for (std::size_t b = 0; b < bytes.size() && b < 4; ++b) x.value |= static_cast<std::uint32_t>(bytes[b]) << (8 * b);
-}
 
 cia402::DriveConfig drive_config(const AxisSettings& a, const BusSettings& bus, double period_s, std::size_t axis_index) {
   cia402::DriveConfig d;

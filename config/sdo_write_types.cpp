@@ -49,8 +49,8 @@ std::optional<std::vector<std::uint8_t>> hex_bytes(const std::string& s) {
   if (hi >= 0) return std::nullopt;
   return out;
 }
+}  // namespace
 
-/// UTF-8 -> UTF-16LE code units; nullopt on invalid UTF-8.
 std::optional<std::vector<std::uint8_t>> utf16le(const std::string& s) {
   std::vector<std::uint8_t> out;
   for (std::size_t i = 0; i < s.size();) {
@@ -79,6 +79,8 @@ std::optional<std::vector<std::uint8_t>> utf16le(const std::string& s) {
   }
   return out;
 }
+
+namespace {
 /// `file:` relative to the YAML file's folder, read whole; a missing,
 /// unreadable or empty file is an error naming `key`.
 void read_value_file(Reader& r, const YAML::Node& f, const std::string& key, std::vector<std::uint8_t>& out) {

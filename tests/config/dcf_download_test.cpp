@@ -35,14 +35,16 @@ void replace_once(std::string& s, const std::string& from, const std::string& to
 
 /// 0x1010 store parameters and 0x1020 verify configuration, which
 /// cia402-emu.eds lacks; `values`: with the DCF's ParameterValues.
-std::string store_and_verify(bool values) {
+std::string store_and_verify(bool values, bool string_value = true) {
   auto var = [&](const char* section, const char* name, const char* type, const char* access, const char* def,
                  const char* value) {
     return std::string("[") + section + "]\nParameterName=" + name + "\nObjectType=0x7\nDataType=" + type +
            "\nAccessType=" + access + "\nDefaultValue=" + def + "\nPDOMapping=0\n" +
            (values && value != nullptr ? std::string("ParameterValue=") + value + "\n" : std::string()) + "\n";
   };
-  return "[1010]\nParameterName=Store parameters\nObjectType=0x8\nSubNumber=2\n\n" +
+  return var("2100", "Axis label", "0x0009", "rw", "none", string_value ? "Spindle 2" : nullptr) +
+         var("2101", "Encoder serial", "0x001B", "rw", "0", "0x1122334455667788") +
+         "[1010]\nParameterName=Store parameters\nObjectType=0x8\nSubNumber=2\n\n" +
          var("1010sub0", "Highest sub-index supported", "0x0005", "const", "1", nullptr) +
          var("1010sub1", "Save all parameters", "0x0007", "rw", "1", "0x65766173") +
          "[1020]\nParameterName=Verify configuration\nObjectType=0x9\nSubNumber=3\n\n" +
@@ -60,11 +62,19 @@ void list_store_and_verify(std::string& t) {
   const std::size_t last = t.find(fmt::format("\n{}=0x", n));
   ASSERT_NE(last, std::string::npos);
   t.insert(t.find('\n', last + 1) + 1, fmt::format("{}=0x1010\n{}=0x1020\n", n + 1, n + 2));
+  // 0x2100 and 0x2101 at the end of [ManufacturerObjects].
+  const std::size_t m = t.find("[ManufacturerObjects]\nSupportedObjects=");
+  ASSERT_NE(m, std::string::npos);
+  const int k = std::stoi(t.substr(m + 39));
+  replace_once(t, fmt::format("[ManufacturerObjects]\nSupportedObjects={}\n", k),
+               fmt::format("[ManufacturerObjects]\nSupportedObjects={}\n", k + 2));
+  const std::size_t end = t.find('\n', t.find(fmt::format("\n{}=0x", k), m) + 1);
+  t.insert(end + 1, fmt::format("{}=0x2100\n{}=0x2101\n", k + 1, k + 2));
 }
 
 /// cia402-emu.eds with 0x1010 and 0x1020; `dcf`: with ParameterValues (the
 /// commissioning engineer's), written to a temporary file; its path.
-std::string drive_file(bool dcf, const std::string& name) {
+std::string drive_file(bool dcf, const std::string& name, bool string_value = true) {
   std::string t = read_text(std::string(CANMOTION_EXAMPLES_DIR) + "/cia402-emu.eds");
   list_store_and_verify(t);
   if (dcf) {
@@ -82,7 +92,7 @@ std::string drive_file(bool dcf, const std::string& name) {
                  "ParameterName=Min position limit\nObjectType=0x7\nDataType=0x0004\nAccessType=rw\nObjFlags=0x1\n"
                  "ParameterValue=-1000\n");
   }
-  t += "\n" + store_and_verify(dcf);
+  t += "\n" + store_and_verify(dcf, string_value);
   const std::string path = ::testing::TempDir() + std::to_string(::getpid()) + "-" + name;
   std::ofstream(path) << t;
   return path;
@@ -116,8 +126,13 @@ TEST(DcfDownload, WritableValuesAreTakenAndTheMastersOwnLeftOut) {
   for (const DcfValue& v : d.writes) got.push_back({v.index, v.sub, v.value});
   // File order; the ro/const ones, ObjFlags bit 0, the store command, the
   // PDO mapping and 0x1017 are not taken; 0x1020 last.
-  const std::vector<DcfValueView> want = {{0x605A, 0, 1}, {0x6065, 0, 4321}, {0x1020, 1, 15340}, {0x1020, 2, 36000000}};
+  const std::vector<DcfValueView> want = {{0x2100, 0, 0x6E697053}, {0x2101, 0, 0x55667788}, {0x605A, 0, 1},
+                                         {0x6065, 0, 4321},        {0x1020, 1, 15340},      {0x1020, 2, 36000000}};
   EXPECT_EQ(got, want);
+  // A string and a 64-bit value go as their bytes (segmented at boot).
+  EXPECT_EQ(d.writes[0].bytes, std::vector<std::uint8_t>({'S', 'p', 'i', 'n', 'd', 'l', 'e', ' ', '2'}));
+  EXPECT_EQ(d.writes[1].bytes, std::vector<std::uint8_t>({0x88, 0x77, 0x66, 0x55, 0x44, 0x33, 0x22, 0x11}));
+  EXPECT_TRUE(d.writes[2].bytes.empty());
   EXPECT_TRUE(d.dated);
   EXPECT_EQ(d.date, 15340u);
   EXPECT_EQ(d.time, 36000000u);
@@ -139,7 +154,11 @@ TEST(DcfDownload, WritableValuesAreTakenAndTheMastersOwnLeftOut) {
   const cia402::DriveConfig dc = drive_config(s.axes[0], s.buses[0], s.controller.period_s, 0);
   ASSERT_GE(dc.extra_writes.size(), 5u);
   EXPECT_TRUE(dc.extra_writes[0].dcf);
-  EXPECT_EQ(dc.extra_writes[0].index, 0x605A);
+  EXPECT_EQ(dc.extra_writes[0].index, 0x2100);
+  ASSERT_NE(dc.extra_writes[0].data, nullptr);  // its bytes, referenced
+  EXPECT_EQ(dc.extra_writes[0].data_len, 9u);
+  EXPECT_EQ(dc.extra_writes[2].index, 0x605A);
+  EXPECT_EQ(dc.extra_writes[2].data, nullptr);
   EXPECT_NE(dc.hints.extra[0].find("axes[0].drive.dcf (" + dcf + ":"), std::string::npos) << dc.hints.extra[0];
   const cia402::SdoWrite& store = dc.extra_writes.back();
   EXPECT_EQ(store.index, 0x1010);
@@ -204,7 +223,7 @@ struct Rig : test::RuntimeRig {
 TEST(DcfDownload, WrittenAtTheFirstBootAndNotAgainWhileTheDriveHoldsIt) {
   // Without the store the reset brings the EDS defaults back: written again.
   {
-    const Config master = load_string(yaml("{dcf: " + drive_file(true, "drive2-nostore.dcf") + "}"), "dcf.yaml");
+    const Config master = load_string(yaml("{dcf: " + drive_file(true, "drive2-nostore.dcf", false) + "}"), "dcf.yaml");
     const Config drive = load_string(yaml("{eds: " + drive_file(false, "drive2-plain0.eds") + "}"), "eds.yaml");
     Rig rig(master, drive);
     ASSERT_TRUE(rig.boot()) << rig.why();
@@ -214,7 +233,7 @@ TEST(DcfDownload, WrittenAtTheFirstBootAndNotAgainWhileTheDriveHoldsIt) {
     EXPECT_EQ(rig.emu().read_int(0x6065), 4321);
     EXPECT_EQ(rig.emu().read_int(0x1020, 1), 15340);
   }
-  const Config master = load_string(yaml("{dcf: {file: " + drive_file(true, "drive2-run.dcf") + ", store: true}}"), "dcf.yaml");
+  const Config master = load_string(yaml("{dcf: {file: " + drive_file(true, "drive2-run.dcf", false) + ", store: true}}"), "dcf.yaml");
   const Config drive = load_string(yaml("{eds: " + drive_file(false, "drive2-plain.eds") + "}"), "eds.yaml");
   Rig rig(master, drive);
   EXPECT_EQ(rig.emu().read_int(0x6065), 100000);  // the EDS default before the boot
@@ -226,14 +245,17 @@ TEST(DcfDownload, WrittenAtTheFirstBootAndNotAgainWhileTheDriveHoldsIt) {
   EXPECT_EQ(rig.emu().read_int(0x607D, 1), -2147483648LL);  // ObjFlags bit 0: not written
   EXPECT_EQ(rig.emu().read_int(0x1020, 1), 15340);
   EXPECT_EQ(rig.emu().read_int(0x1020, 2), 36000000);
+  EXPECT_EQ(static_cast<std::uint64_t>(rig.emu().read_int(0x2101)), 0x1122334455667788u);  // 8 bytes, segmented
   // Reset (NMT reset node): the drive starts from what the store saved, and
-  // 0x1020 shows the DCF's date, so its 4 values and the store are left out.
+  // 0x1020 shows the DCF's date, so its 5 values and the store are left out.
   rig.proxy().reboot_node();
   const std::uint64_t again_from = rig.emu().counters().sdo_requests;
   ASSERT_TRUE(rig.boot()) << rig.why();
   const std::uint64_t again = rig.emu().counters().sdo_requests - again_from;
   EXPECT_EQ(rig.emu().read_int(0x6065), 4321);
-  EXPECT_EQ(first - again, 5u) << "first boot " << first << " SDO requests, second " << again;
+  // (The emulator serves no strings: 0x2100 has no value here. The 8-byte
+  // 0x2101 takes 3 requests: initiate and two segments.)
+  EXPECT_EQ(first - again, 4u + 1u + 3u) << "first boot " << first << " SDO requests, second " << again;
 }
 
 }  // namespace
